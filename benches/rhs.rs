@@ -1,0 +1,30 @@
+//! One right-hand-side evaluation of the paper's oscillator, in free flight and in contact.
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use nalgebra::Vector2;
+use nonsmooth::Dynamics;
+use nonsmooth::model::paper::PAPER;
+use std::hint::black_box;
+
+fn rhs(c: &mut Criterion) {
+    let osc = PAPER.oscillator::<f64>(20.465).unwrap();
+    let x0 = PAPER.static_equilibrium().unwrap();
+    let mut g = c.benchmark_group("paper_rhs");
+    for (name, y) in [
+        ("free_flight", Vector2::new(-2.5e-3, 3e-2)),
+        ("contact", Vector2::new(x0, 2e-4)),
+        ("contact_reversal", Vector2::new(x0, 3e-8)),
+    ] {
+        let mut dy = Vector2::zeros();
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                osc.rhs(black_box(0.123), black_box(&y), &mut dy);
+                black_box(dy[1])
+            })
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, rhs);
+criterion_main!(benches);

@@ -1,0 +1,62 @@
+//! The [`Dynamics`] trait: all an integrator knows about a system.
+
+use nalgebra::{SMatrix, SVector};
+
+use crate::Real;
+
+/// A first-order system `ẏ = f(t, y)` of dimension `N`.
+///
+/// Only [`rhs`](Dynamics::rhs) is required; it is infallible and must not allocate — the
+/// steppers check its output for NaN/∞ and report an
+/// [`IntegrateError`](crate::integrate::IntegrateError). Provide
+/// [`jacobian`](Dynamics::jacobian) (and [`time_derivative`](Dynamics::time_derivative) for
+/// non-autonomous systems) to enable the implicit stepper without finite differences and
+/// the tangent-space Lyapunov method.
+///
+/// ```
+/// use nalgebra::{SMatrix, SVector};
+/// use nonsmooth::Dynamics;
+///
+/// /// Exponential decay ẏ = −λ·y.
+/// struct Decay(f64);
+/// impl Dynamics<f64, 1> for Decay {
+///     fn rhs(&self, _t: f64, y: &SVector<f64, 1>, dy: &mut SVector<f64, 1>) {
+///         dy[0] = -self.0 * y[0];
+///     }
+///     fn jacobian(&self, _t: f64, _y: &SVector<f64, 1>) -> Option<SMatrix<f64, 1, 1>> {
+///         Some(SMatrix::<f64, 1, 1>::new(-self.0))
+///     }
+/// }
+/// let mut dy = SVector::<f64, 1>::zeros();
+/// Decay(2.0).rhs(0.0, &SVector::<f64, 1>::new(3.0), &mut dy);
+/// assert_eq!(dy[0], -6.0);
+/// ```
+pub trait Dynamics<T: Real, const N: usize> {
+    /// Writes `f(t, y)` into `dy`.
+    fn rhs(&self, t: T, y: &SVector<T, N>, dy: &mut SVector<T, N>);
+
+    /// The Jacobian `∂f/∂y`, if known.
+    fn jacobian(&self, _t: T, _y: &SVector<T, N>) -> Option<SMatrix<T, N, N>> {
+        None
+    }
+
+    /// The explicit time derivative `∂f/∂t`, if known (zero for autonomous systems).
+    fn time_derivative(&self, _t: T, _y: &SVector<T, N>) -> Option<SVector<T, N>> {
+        None
+    }
+}
+
+impl<T: Real, const N: usize, D: Dynamics<T, N> + ?Sized> Dynamics<T, N> for &D {
+    #[inline(always)]
+    fn rhs(&self, t: T, y: &SVector<T, N>, dy: &mut SVector<T, N>) {
+        (**self).rhs(t, y, dy)
+    }
+    #[inline(always)]
+    fn jacobian(&self, t: T, y: &SVector<T, N>) -> Option<SMatrix<T, N, N>> {
+        (**self).jacobian(t, y)
+    }
+    #[inline(always)]
+    fn time_derivative(&self, t: T, y: &SVector<T, N>) -> Option<SVector<T, N>> {
+        (**self).time_derivative(t, y)
+    }
+}

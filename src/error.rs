@@ -1,0 +1,108 @@
+//! The crate's error type.
+//!
+//! One non-generic [`Error`] collects the module errors. Diagnostics are stored as `f64`
+//! (whatever the scalar type of the computation) so that errors are `Send + Sync + 'static`
+//! and can be printed, logged and matched without generic parameters.
+
+use thiserror::Error;
+
+/// A parameter that failed validation in a constructor.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[error("invalid parameter `{name}` = {value}: must be {requirement}")]
+pub struct ParameterError {
+    /// The parameter's name as documented on the constructor.
+    pub name: &'static str,
+    /// The rejected value (as `f64`).
+    pub value: f64,
+    /// What the value must satisfy, e.g. `"finite and > 0"`.
+    pub requirement: &'static str,
+}
+
+impl ParameterError {
+    /// Builds the error.
+    pub fn new(name: &'static str, value: f64, requirement: &'static str) -> Self {
+        Self {
+            name,
+            value,
+            requirement,
+        }
+    }
+}
+
+/// The crate's error: every fallible function returns [`Result`].
+#[derive(Debug, Clone, Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// A constructor rejected a parameter.
+    #[error(transparent)]
+    Parameter(#[from] ParameterError),
+    /// A bracketing root search failed.
+    #[error(transparent)]
+    Root(#[from] crate::roots::RootError),
+    /// Time integration failed.
+    #[error(transparent)]
+    Integrate(#[from] crate::integrate::IntegrateError),
+    /// Event handling failed (e.g. an accumulation of events).
+    #[error(transparent)]
+    Event(#[from] crate::event::EventError),
+    /// A sampler or sweep was misconfigured or failed.
+    #[error(transparent)]
+    Sweep(#[from] crate::sweep::SweepError),
+    /// A Lyapunov estimate failed.
+    #[error(transparent)]
+    Lyapunov(#[from] crate::lyapunov::LyapunovError),
+    /// An entropy estimate failed.
+    #[error(transparent)]
+    Entropy(#[from] crate::entropy::EntropyError),
+    /// A harmonic analysis or approximation failed.
+    #[error(transparent)]
+    Analysis(#[from] crate::analysis::AnalysisError),
+    /// Measured data could not be read or processed.
+    #[error(transparent)]
+    Signal(#[from] crate::signal::SignalError),
+    /// Parameter identification failed.
+    #[error(transparent)]
+    Identify(#[from] crate::identify::IdentifyError),
+    /// Writing output failed.
+    #[error("output error: {0}")]
+    Output(String),
+}
+
+/// `Result` with the crate's [`Error`].
+pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+/// Validates that `value` is finite and strictly positive.
+pub(crate) fn positive<T: crate::Real>(name: &'static str, value: T) -> Result<T, ParameterError> {
+    let v = crate::scalar::to_f64(value);
+    if value.is_finite() && value > T::zero() {
+        Ok(value)
+    } else {
+        Err(ParameterError::new(name, v, "finite and > 0"))
+    }
+}
+
+/// Validates that `value` is finite and non-negative.
+pub(crate) fn non_negative<T: crate::Real>(
+    name: &'static str,
+    value: T,
+) -> Result<T, ParameterError> {
+    let v = crate::scalar::to_f64(value);
+    if value.is_finite() && value >= T::zero() {
+        Ok(value)
+    } else {
+        Err(ParameterError::new(name, v, "finite and >= 0"))
+    }
+}
+
+/// Validates that `value` is finite.
+pub(crate) fn finite<T: crate::Real>(name: &'static str, value: T) -> Result<T, ParameterError> {
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(ParameterError::new(
+            name,
+            crate::scalar::to_f64(value),
+            "finite",
+        ))
+    }
+}

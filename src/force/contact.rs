@@ -1,0 +1,307 @@
+//! Compliant contact: the generalized Hertz law with nonlinear damping.
+
+use crate::error::{ParameterError, finite, non_negative, positive};
+use crate::scalar::{Exponent, lit};
+use crate::{ForceLaw, Real};
+
+/// Which side of the stop the body penetrates.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub enum Side {
+    /// The stop limits motion from above: contact when `x ≥ x_I`, the force pushes towards
+    /// smaller `x` (positive on the left-hand side). The paper's configuration.
+    Upper,
+    /// The stop limits motion from below: contact when `x ≤ x_I`, the force pushes towards
+    /// larger `x`.
+    Lower,
+}
+
+/// The generalized Hertz contact law with nonlinear damping of the paper's eq. (1).
+///
+/// # Model
+/// With the penetration `δ = x − x_I` and its rate `δ̇ = ẋ` (for [`Side::Upper`]; mirrored for
+/// [`Side::Lower`]):
+/// $$f(\delta, \dot\delta) = \delta^{n_1} + b\,\delta^{n_2}\,\mathrm{sgn}(\dot\delta)\,|\dot\delta|^{n_3},
+///   \qquad F = \begin{cases} k_I\,f & \delta \ge 0 \text{ and } f \ge 0,\\ 0 & \text{otherwise.}\end{cases}$$
+/// The force is zero when separated, never adhesive (`f < 0` during fast separation gives
+/// zero force rather than a pull) and continuous at contact onset (`f(0, ·) = 0`).
+///
+/// ## The `|δ̇|^{n3}` singularity and its regularization
+/// For `n3 < 1` the damping term is not Lipschitz at `δ̇ = 0`: its slope is infinite there.
+/// A body resting in contact (the paper's initial state) then obeys `m·v̇ ≈ −C·|v|^{n3}`
+/// near `v = 0`, which relaxes in finite time and forces an explicit integrator to crawl.
+/// [`with_rate_regularization`](Self::with_rate_regularization) replaces
+/// `sgn(δ̇)|δ̇|^{n3}` by
+/// $$\dot\delta\,(\dot\delta^2+\eta^2)^{(n_3-1)/2},$$
+/// equal to the exact term for `|δ̇| ≫ η` and linear with slope `η^{n3−1}` inside `|δ̇| ≲ η`.
+/// With `η = 0` (the default) the law is exact.
+///
+/// # References
+/// The paper's eq. (1), impact force `F_I`; `n1 = n2 = 3/2`, `n3 = 0.18667`,
+/// `k_I = 2.3983·10⁸ N/m^{3/2}`, `b = 0.8485 m^{−n3}s^{n3}`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct HertzContact<T> {
+    x_i: T,
+    side: Side,
+    k_i: T,
+    b: T,
+    n1: Exponent<T>,
+    n2: Exponent<T>,
+    n3: T,
+    eta: T,
+    /// `(n3 − 1)/2`, cached for the regularized rate term.
+    half_n3_minus_1: T,
+}
+
+impl<T: Real> HertzContact<T> {
+    /// A purely elastic Hertz contact `k_I·(x − x_I)^{3/2}` with the stop at `x_i`, on
+    /// [`Side::Upper`]. Add damping with [`with_damping`](Self::with_damping).
+    ///
+    /// # Errors
+    /// [`ParameterError`] if `x_i` is not finite or `k_i` is not finite and > 0.
+    pub fn new(x_i: T, k_i: T) -> Result<Self, ParameterError> {
+        let n3: T = T::one();
+        Ok(Self {
+            x_i: finite("x_i", x_i)?,
+            side: Side::Upper,
+            k_i: positive("k_i", k_i)?,
+            b: T::zero(),
+            n1: Exponent::ThreeHalves,
+            n2: Exponent::ThreeHalves,
+            n3,
+            eta: T::zero(),
+            half_n3_minus_1: T::zero(),
+        })
+    }
+
+    /// Sets the side of the stop.
+    pub fn with_side(mut self, side: Side) -> Self {
+        self.side = side;
+        self
+    }
+
+    /// Sets the stiffness exponent `n1` (Hertz: 3/2).
+    ///
+    /// # Errors
+    /// [`ParameterError`] unless `n1` is finite and > 0.
+    pub fn with_stiffness_exponent(mut self, n1: T) -> Result<Self, ParameterError> {
+        self.n1 = Exponent::new(positive("n1", n1)?);
+        Ok(self)
+    }
+
+    /// Sets the nonlinear damping `b·δ^{n2}·sgn(δ̇)|δ̇|^{n3}`.
+    ///
+    /// # Errors
+    /// [`ParameterError`] unless `b ≥ 0` and `n2`, `n3` are > 0, all finite.
+    pub fn with_damping(mut self, b: T, n2: T, n3: T) -> Result<Self, ParameterError> {
+        self.b = non_negative("b", b)?;
+        self.n2 = Exponent::new(positive("n2", n2)?);
+        self.n3 = positive("n3", n3)?;
+        self.half_n3_minus_1 = (self.n3 - T::one()) * lit(0.5);
+        Ok(self)
+    }
+
+    /// Regularizes `sgn(δ̇)|δ̇|^{n3}` as `δ̇(δ̇²+η²)^{(n3−1)/2}` (see the type's docs);
+    /// `eta = 0` restores the exact law.
+    ///
+    /// # Errors
+    /// [`ParameterError`] unless `eta` is finite and ≥ 0.
+    pub fn with_rate_regularization(mut self, eta: T) -> Result<Self, ParameterError> {
+        self.eta = non_negative("eta", eta)?;
+        Ok(self)
+    }
+
+    /// The stop position `x_I`.
+    pub fn stop(&self) -> T {
+        self.x_i
+    }
+
+    /// The side of the stop.
+    pub fn side(&self) -> Side {
+        self.side
+    }
+
+    /// The contact stiffness `k_I`.
+    pub fn stiffness(&self) -> T {
+        self.k_i
+    }
+
+    /// The rate regularization `η` (0 = exact).
+    pub fn rate_regularization(&self) -> T {
+        self.eta
+    }
+
+    /// Penetration `δ` and its rate for the configured side.
+    #[inline(always)]
+    fn penetration(&self, x: T, v: T) -> (T, T) {
+        match self.side {
+            Side::Upper => (x - self.x_i, v),
+            Side::Lower => (self.x_i - x, -v),
+        }
+    }
+
+    /// `g(w) = sgn(w)|w|^{n3}` or its regularization, and `g'(w)`.
+    #[inline(always)]
+    fn rate_term(&self, w: T) -> (T, T) {
+        if self.eta > T::zero() {
+            let s = w * w + self.eta * self.eta;
+            // (w²+η²)^{(n3−1)/2}: the one transcendental pair of the evaluation.
+            let p = (self.half_n3_minus_1 * s.ln()).exp();
+            let g = w * p;
+            let dg = p * (self.n3 * w * w + self.eta * self.eta) / s;
+            (g, dg)
+        } else if w == T::zero() {
+            (
+                T::zero(),
+                if self.n3 < T::one() {
+                    T::max_value().unwrap_or(T::zero())
+                } else {
+                    T::zero()
+                },
+            )
+        } else {
+            let a = w.abs();
+            let m = (self.n3 * a.ln()).exp();
+            let g = if w > T::zero() { m } else { -m };
+            (g, self.n3 * m / a)
+        }
+    }
+
+    /// The scalar `f(δ, δ̇)` of the model and its partials, for `δ > 0`.
+    #[inline(always)]
+    fn f_and_partials(&self, d: T, w: T) -> (T, T, T) {
+        let (p1, dp1) = self.n1.pow_and_derivative(d);
+        if self.b == T::zero() {
+            return (p1, dp1, T::zero());
+        }
+        let (p2, dp2) = if self.n2 == self.n1 {
+            (p1, dp1)
+        } else {
+            self.n2.pow_and_derivative(d)
+        };
+        let (g, dg) = self.rate_term(w);
+        (
+            p1 + self.b * p2 * g,
+            dp1 + self.b * dp2 * g,
+            self.b * p2 * dg,
+        )
+    }
+}
+
+impl<T: Real> ForceLaw<T> for HertzContact<T> {
+    #[inline(always)]
+    fn force(&self, x: T, v: T) -> T {
+        let (d, w) = self.penetration(x, v);
+        if d <= T::zero() {
+            return T::zero();
+        }
+        let p1 = self.n1.pow(d);
+        let f = if self.b == T::zero() {
+            p1
+        } else {
+            let p2 = if self.n2 == self.n1 {
+                p1
+            } else {
+                self.n2.pow(d)
+            };
+            p1 + self.b * p2 * self.rate_term(w).0
+        };
+        if f <= T::zero() {
+            return T::zero();
+        }
+        match self.side {
+            Side::Upper => self.k_i * f,
+            Side::Lower => -self.k_i * f,
+        }
+    }
+
+    /// Analytic partials. With `η = 0` and `n3 < 1`, `∂F/∂v` is infinite at `v = 0` in
+    /// contact; it is reported as the largest finite value of `T`.
+    #[inline(always)]
+    fn partials(&self, x: T, v: T) -> (T, T) {
+        let (d, w) = self.penetration(x, v);
+        if d <= T::zero() {
+            return (T::zero(), T::zero());
+        }
+        let (f, fd, fw) = self.f_and_partials(d, w);
+        if f <= T::zero() {
+            return (T::zero(), T::zero());
+        }
+        // For Side::Lower both δ = x_I − x and δ̇ = −v flip sign, and so does F.
+        (self.k_i * fd, self.k_i * fw)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn paper() -> HertzContact<f64> {
+        HertzContact::new(-2.086e-3, 2.3983e8)
+            .unwrap()
+            .with_damping(0.8485, 1.5, 0.18667)
+            .unwrap()
+    }
+
+    #[test]
+    fn zero_when_separated_and_elastic_at_rest() {
+        let c = paper();
+        assert_eq!(c.force(-3e-3, 1.0), 0.0);
+        let d: f64 = 5e-6;
+        assert!((c.force(-2.086e-3 + d, 0.0) - 2.3983e8 * d.powf(1.5)).abs() < 1e-9);
+    }
+
+    #[test]
+    fn no_adhesion_during_fast_separation() {
+        let c = paper();
+        // f = δ^{3/2}(1 + b·sgn(v)|v|^{n3}) < 0 when b|v|^{n3} > 1 and v < 0.
+        let v = -(2.0_f64 / 0.8485).powf(1.0 / 0.18667);
+        assert_eq!(c.force(-2.086e-3 + 1e-6, v), 0.0);
+        assert_eq!(c.partials(-2.086e-3 + 1e-6, v), (0.0, 0.0));
+    }
+
+    #[test]
+    fn lower_side_mirrors_upper() {
+        let up = paper();
+        let lo = HertzContact::new(2.086e-3, 2.3983e8)
+            .unwrap()
+            .with_side(Side::Lower)
+            .with_damping(0.8485, 1.5, 0.18667)
+            .unwrap();
+        for &(x, v) in &[(-2.08e-3, 0.01), (-2.085e-3, -1e-3), (-2.07e-3, 0.3)] {
+            assert_eq!(lo.force(-x, -v), -up.force(x, v));
+            let (a, b) = up.partials(x, v);
+            let (c, d) = lo.partials(-x, -v);
+            assert_eq!((a, b), (c, d));
+        }
+    }
+
+    #[test]
+    fn regularization_vanishes_at_large_rates() {
+        let exact = paper();
+        let reg = paper().with_rate_regularization(1e-7).unwrap();
+        let x = -2.086e-3 + 4e-6;
+        let v = 1e-2;
+        let rel = (exact.force(x, v) - reg.force(x, v)).abs() / exact.force(x, v);
+        assert!(rel < 1e-9, "{rel}");
+        // Lipschitz at v = 0: finite slope η^{n3−1}·b·k_I·δ^{n2}.
+        let (_, dv) = reg.partials(x, 0.0);
+        let expect = 2.3983e8 * 0.8485 * 4e-6_f64.powf(1.5) * 1e-7_f64.powf(0.18667 - 1.0);
+        assert!((dv - expect).abs() < 1e-9 * expect);
+    }
+
+    #[test]
+    fn validation() {
+        assert!(HertzContact::new(f64::NAN, 1.0).is_err());
+        assert!(HertzContact::new(0.0, 0.0).is_err());
+        assert!(HertzContact::new(0.0, -1.0).is_err());
+        let c = HertzContact::new(0.0, 1.0).unwrap();
+        assert!(c.with_stiffness_exponent(0.0).is_err());
+        assert!(c.with_damping(-1.0, 1.5, 0.2).is_err());
+        assert!(c.with_damping(1.0, 0.0, 0.2).is_err());
+        assert!(c.with_damping(1.0, 1.5, -0.2).is_err());
+        assert!(c.with_damping(1.0, 1.5, f64::NAN).is_err());
+        assert!(c.with_rate_regularization(-1e-9).is_err());
+    }
+}

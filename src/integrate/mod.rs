@@ -1,0 +1,10 @@
+//! (under construction)
+
+/// Errors of this module.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum IntegrateError {
+    /// Placeholder until the module lands.
+    #[error("not available")]
+    Unavailable,
+}

@@ -1,0 +1,56 @@
+//! # nonsmooth
+//!
+//! Dynamics of nonsmooth mechanical systems — oscillators with impacts, compliant
+//! (Hertz-type) contact, dry friction and harmonic forcing — from force laws to
+//! bifurcation diagrams, Lyapunov exponents and entropy indices.
+//!
+//! ## A tour
+//! | layer | what | start at |
+//! |---|---|---|
+//! | scalar, errors | `T: Real` (`f64`, `f32`), one crate [`Error`] | [`Real`], [`Error`] |
+//! | force laws | `F(x, ẋ)` terms with partials, composable by value | [`ForceLaw`], [`force`] |
+//! | excitation | harmonic, unbalanced rotor, ramped rotor | [`excite`] |
+//! | systems | `ẏ = f(t, y)`; the 1-DOF [`model::Oscillator`]; the paper's model | [`Dynamics`], [`model::paper`] |
+//! | roots | Brent's method for equilibria and events | [`roots`] |
+//!
+//! ## Quick start
+//! ```
+//! use nonsmooth::model::paper::PAPER;
+//! use nonsmooth::Dynamics;
+//! use nalgebra::Vector2;
+//!
+//! // The paper's oscillator forced at ω = 14 rad/s, assembled from generic force laws.
+//! let osc = PAPER.oscillator::<f64>(14.0)?;
+//! // Its static equilibrium, pressed ~5 µm into the stop (paper: −2.0807e-3 m).
+//! let x0 = PAPER.static_equilibrium()?;
+//! assert!((x0 + 2.0807e-3).abs() < 5e-8);
+//! // The right-hand side at rest in the equilibrium: no acceleration at t = 0.
+//! let mut dy = Vector2::zeros();
+//! osc.rhs(0.0, &Vector2::new(x0, 0.0), &mut dy);
+//! assert!(dy[1].abs() < 1e-9);
+//! # Ok::<(), nonsmooth::Error>(())
+//! ```
+#![warn(missing_docs)]
+
+pub mod analysis;
+pub mod dynamics;
+pub mod entropy;
+pub mod error;
+pub mod event;
+pub mod excite;
+pub mod force;
+pub mod identify;
+pub mod integrate;
+pub mod lyapunov;
+pub mod model;
+pub mod roots;
+pub mod scalar;
+pub mod signal;
+pub mod sweep;
+#[cfg(feature = "testing")]
+pub mod testing;
+
+pub use dynamics::Dynamics;
+pub use error::{Error, ParameterError, Result};
+pub use force::ForceLaw;
+pub use scalar::Real;
