@@ -12,6 +12,9 @@
 //! | excitation | harmonic, unbalanced rotor, ramped rotor | [`excite`] |
 //! | systems | `ẏ = f(t, y)`; the 1-DOF [`model::Oscillator`]; the paper's model | [`Dynamics`], [`model::paper`] |
 //! | roots | Brent's method for equilibria and events | [`roots`] |
+//! | integrators | DOPRI5, DOP853, RK4, Rosenbrock 2(3) with dense output | [`integrate`] |
+//! | events | crossings located on dense output, grazing pairs, resets, Zeno guard | [`event`] |
+//! | driver | system + stepper + events + observers | [`drive`] |
 //!
 //! ## Quick start
 //! ```
@@ -31,8 +34,12 @@
 //! # Ok::<(), nonsmooth::Error>(())
 //! ```
 #![warn(missing_docs)]
+// Negated comparisons (`!(a > b)`) are used on purpose: they are true for NaN, so NaN
+// inputs fail validation instead of slipping through.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod analysis;
+pub mod drive;
 pub mod dynamics;
 pub mod entropy;
 pub mod error;
@@ -41,6 +48,7 @@ pub mod excite;
 pub mod force;
 pub mod identify;
 pub mod integrate;
+pub mod linalg;
 pub mod lyapunov;
 pub mod model;
 pub mod roots;
@@ -51,6 +59,11 @@ pub mod sweep;
 pub mod testing;
 
 pub use dynamics::Dynamics;
+
+/// The README's code blocks, compiled and run as doctests.
+#[doc = include_str!("../README.md")]
+#[cfg(doctest)]
+pub struct ReadmeDoctests;
 pub use error::{Error, ParameterError, Result};
 pub use force::ForceLaw;
 pub use scalar::Real;

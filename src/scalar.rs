@@ -125,6 +125,12 @@ impl<T: Real> Exponent<T> {
     }
 }
 
+/// NaN of type `T`.
+#[inline(always)]
+pub fn nan<T: Real>() -> T {
+    lit(f64::NAN)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

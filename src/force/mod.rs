@@ -157,7 +157,7 @@ mod tests {
         assert_eq!(Sum(k, c).force(1.5, -2.0), t.force(1.5, -2.0));
         assert_eq!(t.partials(1.5, -2.0), (2.0, 0.5));
         assert_eq!(ForceLaw::<f64>::force(&(), 1.0, 1.0), 0.0);
-        assert_eq!((&t).force(1.0, 0.0), 2.0);
+        assert_eq!(ForceLaw::force(&&t, 1.0, 0.0), 2.0);
     }
 
     #[test]

@@ -1,10 +1,489 @@
-//! (under construction)
+//! Time integration: steppers with dense output and adaptive step-size control.
+//!
+//! A [`Stepper`] owns its state `(t, y)` and advances it by one *accepted* step at a time;
+//! after each step its [`DenseOutput`] covers the step and interpolates inside it. Caches
+//! (the first-same-as-last derivative) are dropped by [`Stepper::reset_state`], which the
+//! event machinery calls after a state reset.
+//!
+//! | method | type | order | dense output | for |
+//! |---|---|---|---|---|
+//! | [`Dopri5`] | explicit, embedded 5(4), FSAL | 5 | 4th order (Hairer's continuous extension) | default |
+//! | [`Dop853`] | explicit, embedded 8(5,3) | 8 | 7th order | tight tolerances |
+//! | [`Rk4`] | explicit, fixed step | 4 | cubic Hermite (3rd order) | reference, tests |
+//! | [`Rosenbrock23`] | linearly implicit, embedded 2(3), FSAL | 2 | quadratic (the method's own) | stiff phases |
+//!
+//! # Step-size control
+//! The error of a step is measured in the weighted RMS norm
+//! $$\|e\| = \sqrt{\frac1N\sum_i \Bigl(\frac{e_i}{a_i + r_i\max(|y_{0,i}|,|y_{1,i}|)}\Bigr)^2}$$
+//! with per-component absolute (`a_i`) and relative (`r_i`) [`Tolerances`]; a step is
+//! accepted when `‖e‖ ≤ 1`. The next step comes from a PI controller (Gustafsson; the
+//! constants of Hairer's DOPRI5: `β = 0.04`, safety 0.9, factor in `[0.2, 10]`). Failure
+//! counters are per step: [`IntegrateError::StepSizeTooSmall`] is raised when a step would
+//! fall below `StepOptions::h_min` or below `16·ε_mach·|t|`, never because rejections
+//! accumulated over a long run.
 
-/// Errors of this module.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+mod dop853;
+mod dopri5;
+mod rk4;
+mod rosenbrock;
+
+pub use dop853::{Dop853, Dop853Dense};
+pub use dopri5::{Dopri5, Dopri5Dense};
+pub use rk4::{HermiteDense, Rk4};
+pub use rosenbrock::{Rosenbrock23, Rosenbrock23Dense};
+
+use nalgebra::SVector;
+use thiserror::Error;
+
+use crate::error::{ParameterError, positive};
+use crate::scalar::{lit, to_f64};
+use crate::{Dynamics, Real};
+
+/// Why an integration failed.
+#[derive(Debug, Clone, PartialEq, Error)]
 #[non_exhaustive]
 pub enum IntegrateError {
-    /// Placeholder until the module lands.
-    #[error("not available")]
-    Unavailable,
+    /// The step size fell below the minimum (a singularity, an unresolved discontinuity or
+    /// too-tight tolerances).
+    #[error(
+        "step size too small at t = {t}: h = {h} (loosen the tolerances or check the model for a singularity)"
+    )]
+    StepSizeTooSmall {
+        /// Time of the failing step.
+        t: f64,
+        /// The step size that was too small.
+        h: f64,
+    },
+    /// The right-hand side returned NaN or ∞.
+    #[error(
+        "the right-hand side is not finite at t = {t} (NaN or infinity in the state derivative)"
+    )]
+    NonFiniteRhs {
+        /// Where.
+        t: f64,
+    },
+    /// The initial state contains NaN or ∞.
+    #[error("the initial state is not finite (component {index} = {value})")]
+    NonFiniteState {
+        /// The offending component.
+        index: usize,
+        /// Its value.
+        value: f64,
+    },
+    /// The final time is not after the initial time, or a time is not finite.
+    #[error("invalid time span: t0 = {t0}, t_end = {t_end} (need finite t_end > t0)")]
+    InvalidTimeSpan {
+        /// Start.
+        t0: f64,
+        /// End.
+        t_end: f64,
+    },
+    /// The run needed more accepted steps than allowed.
+    #[error("maximum number of steps ({max_steps}) reached at t = {t}")]
+    MaxSteps {
+        /// Time reached.
+        t: f64,
+        /// The cap.
+        max_steps: usize,
+    },
+    /// A dense-output evaluation outside the last step.
+    #[error("interpolation at t = {t} outside the last step [{t0}, {t1}]")]
+    OutsideStep {
+        /// Requested time.
+        t: f64,
+        /// Step start.
+        t0: f64,
+        /// Step end.
+        t1: f64,
+    },
+    /// The stepper was used before [`Stepper::reset_state`] gave it a state.
+    #[error("the stepper has no state: call reset_state first")]
+    NotInitialized,
+    /// The linear system of an implicit stage is singular.
+    #[error("singular iteration matrix at t = {t}")]
+    SingularMatrix {
+        /// Where.
+        t: f64,
+    },
+    /// A parameter of the integrator is invalid.
+    #[error(transparent)]
+    Parameter(#[from] ParameterError),
+}
+
+/// Per-component absolute and relative tolerances.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Tolerances<T, const N: usize> {
+    /// Relative tolerances `r_i`.
+    pub rtol: SVector<T, N>,
+    /// Absolute tolerances `a_i`.
+    pub atol: SVector<T, N>,
+}
+
+impl<T: Real, const N: usize> Tolerances<T, N> {
+    /// The same `rtol` and `atol` for every component.
+    ///
+    /// # Errors
+    /// [`ParameterError`] unless both are finite and > 0.
+    pub fn new(rtol: T, atol: T) -> Result<Self, ParameterError> {
+        positive("rtol", rtol)?;
+        positive("atol", atol)?;
+        Ok(Self {
+            rtol: SVector::repeat(rtol),
+            atol: SVector::repeat(atol),
+        })
+    }
+
+    /// One `rtol` and an `atol` per component (e.g. metres for `x`, m/s for `ẋ`).
+    ///
+    /// # Errors
+    /// [`ParameterError`] unless all are finite and > 0.
+    pub fn per_component(rtol: T, atol: [T; N]) -> Result<Self, ParameterError> {
+        positive("rtol", rtol)?;
+        for a in atol {
+            positive("atol", a)?;
+        }
+        Ok(Self {
+            rtol: SVector::repeat(rtol),
+            atol: SVector::from(atol),
+        })
+    }
+
+    /// The weighted RMS norm of `err` relative to `y0`, `y1` (see the module docs).
+    #[inline(always)]
+    pub fn error_norm(&self, err: &SVector<T, N>, y0: &SVector<T, N>, y1: &SVector<T, N>) -> T {
+        let mut s = T::zero();
+        for i in 0..N {
+            let sc = self.atol[i] + self.rtol[i] * y0[i].abs().max(y1[i].abs());
+            let q = err[i] / sc;
+            s += q * q;
+        }
+        (s / lit::<T>(N as f64)).sqrt()
+    }
+}
+
+/// Step-size options shared by the adaptive steppers.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub struct StepOptions<T> {
+    /// Initial step (`None`: chosen automatically, Hairer's algorithm).
+    pub h_init: Option<T>,
+    /// Largest step allowed.
+    pub h_max: T,
+    /// Smallest step allowed; below it the step fails with
+    /// [`IntegrateError::StepSizeTooSmall`].
+    pub h_min: T,
+    /// Safety factor of the controller.
+    pub safety: T,
+    /// Smallest step-size ratio `h_new/h`.
+    pub fac_min: T,
+    /// Largest step-size ratio `h_new/h`.
+    pub fac_max: T,
+    /// PI controller constant `β` (0 gives the classical I controller).
+    pub beta: T,
+}
+
+impl<T: Real> Default for StepOptions<T> {
+    fn default() -> Self {
+        Self {
+            h_init: None,
+            h_max: T::max_value().unwrap_or(lit(1e300)),
+            h_min: T::zero(),
+            safety: lit(0.9),
+            fac_min: lit(0.2),
+            fac_max: lit(10.0),
+            beta: lit(0.04),
+        }
+    }
+}
+
+impl<T: Real> StepOptions<T> {
+    /// Sets the largest step.
+    ///
+    /// # Errors
+    /// [`ParameterError`] unless `h_max` is finite and > 0.
+    pub fn with_h_max(mut self, h_max: T) -> Result<Self, ParameterError> {
+        self.h_max = positive("h_max", h_max)?;
+        Ok(self)
+    }
+
+    /// Sets the smallest step.
+    ///
+    /// # Errors
+    /// [`ParameterError`] unless `h_min` is finite and ≥ 0.
+    pub fn with_h_min(mut self, h_min: T) -> Result<Self, ParameterError> {
+        self.h_min = crate::error::non_negative("h_min", h_min)?;
+        Ok(self)
+    }
+
+    /// Sets the initial step.
+    ///
+    /// # Errors
+    /// [`ParameterError`] unless `h` is finite and > 0.
+    pub fn with_h_init(mut self, h: T) -> Result<Self, ParameterError> {
+        self.h_init = Some(positive("h_init", h)?);
+        Ok(self)
+    }
+}
+
+/// Counters of the work done.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct Stats {
+    /// Right-hand-side evaluations.
+    pub rhs_evals: u64,
+    /// Accepted steps.
+    pub accepted: u64,
+    /// Rejected steps.
+    pub rejected: u64,
+    /// Jacobian evaluations (implicit methods).
+    pub jacobian_evals: u64,
+    /// LU decompositions (implicit methods).
+    pub decompositions: u64,
+    /// Located events.
+    pub events: u64,
+}
+
+/// Interpolation inside the last accepted step.
+///
+/// Valid only for the last accepted step; its span is `[t0, t1]` of that step.
+pub trait DenseOutput<T: Real, const N: usize> {
+    /// The step's `(t0, t1)`.
+    fn span(&self) -> (T, T);
+
+    /// The states at the step's ends.
+    fn endpoints(&self) -> (&SVector<T, N>, &SVector<T, N>);
+
+    /// The derivatives `f(t, y)` at the step's ends.
+    fn end_derivatives(&self) -> (&SVector<T, N>, &SVector<T, N>);
+
+    /// Writes `y(t)` into `out` without checking the span (for callers that already know
+    /// `t ∈ [t0, t1]`; outside it the polynomial is extrapolated).
+    fn interpolate_unchecked(&self, t: T, out: &mut SVector<T, N>);
+
+    /// Writes `y(t)` into `out`.
+    ///
+    /// # Errors
+    /// [`IntegrateError::OutsideStep`] if `t` is outside the step (beyond a relative
+    /// rounding margin).
+    fn interpolate_into(&self, t: T, out: &mut SVector<T, N>) -> Result<(), IntegrateError> {
+        let (t0, t1) = self.span();
+        let margin = lit::<T>(8.0) * T::default_epsilon() * (t0.abs().max(t1.abs()));
+        if t < t0.min(t1) - margin || t > t0.max(t1) + margin {
+            return Err(IntegrateError::OutsideStep {
+                t: to_f64(t),
+                t0: to_f64(t0),
+                t1: to_f64(t1),
+            });
+        }
+        self.interpolate_unchecked(t, out);
+        Ok(())
+    }
+
+    /// `y(t)` by value.
+    ///
+    /// # Errors
+    /// As [`interpolate_into`](DenseOutput::interpolate_into).
+    fn interpolate(&self, t: T) -> Result<SVector<T, N>, IntegrateError> {
+        let mut out = SVector::zeros();
+        self.interpolate_into(t, &mut out)?;
+        Ok(out)
+    }
+}
+
+/// A one-step integrator that owns its state.
+///
+/// ```
+/// use nonsmooth::integrate::{Dopri5, Stepper, Tolerances, DenseOutput};
+/// use nonsmooth::Dynamics;
+/// use nalgebra::SVector;
+///
+/// struct Decay;
+/// impl Dynamics<f64, 1> for Decay {
+///     fn rhs(&self, _t: f64, y: &SVector<f64, 1>, dy: &mut SVector<f64, 1>) { dy[0] = -y[0]; }
+/// }
+/// let mut st = Dopri5::new(Tolerances::new(1e-10, 1e-12)?);
+/// st.reset_state(0.0, SVector::<f64, 1>::new(1.0));
+/// while st.current().0 < 1.0 {
+///     st.step(&Decay, 1.0)?;
+/// }
+/// assert!((st.current().1[0] - (-1.0f64).exp()).abs() < 1e-9);
+/// # Ok::<(), nonsmooth::Error>(())
+/// ```
+pub trait Stepper<T: Real, const N: usize> {
+    /// The dense output of the last accepted step.
+    type Dense: DenseOutput<T, N>;
+
+    /// Sets the state to `(t, y)` and drops every cached derivative (the next step
+    /// re-evaluates `f(t, y)`). The step-size history is kept.
+    fn reset_state(&mut self, t: T, y: SVector<T, N>);
+
+    /// Advances by one accepted step, never past `t_limit`.
+    ///
+    /// # Errors
+    /// [`IntegrateError`] if the step cannot be taken.
+    fn step<S: Dynamics<T, N>>(&mut self, sys: &S, t_limit: T) -> Result<(), IntegrateError>;
+
+    /// The current `(t, y)`.
+    fn current(&self) -> (T, &SVector<T, N>);
+
+    /// The dense output of the last accepted step.
+    fn dense(&self) -> &Self::Dense;
+
+    /// Work counters since construction.
+    fn stats(&self) -> &Stats;
+
+    /// Mutable work counters (the driver records events here).
+    fn stats_mut(&mut self) -> &mut Stats;
+
+    /// The order of the propagated solution.
+    fn order(&self) -> u8;
+}
+
+/// PI step-size controller state (shared by the embedded methods).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Controller<T> {
+    pub(crate) opts: StepOptions<T>,
+    /// `1/q − 0.75·β` with `q` the order used for the error estimate.
+    expo: T,
+    err_old: T,
+    rejected_last: bool,
+}
+
+impl<T: Real> Controller<T> {
+    pub(crate) fn new(opts: StepOptions<T>, error_order: T) -> Self {
+        let expo = T::one() / error_order - lit::<T>(0.75) * opts.beta;
+        Self {
+            opts,
+            expo,
+            err_old: lit(1e-4),
+            rejected_last: false,
+        }
+    }
+
+    /// Given the error norm of a trial step of size `h`, returns `(accept, h_next)`.
+    #[inline(always)]
+    pub(crate) fn propose(&mut self, err: T, h: T) -> (bool, T) {
+        let o = &self.opts;
+        if !err.is_finite() {
+            self.rejected_last = true;
+            return (false, h * lit(0.1));
+        }
+        let fac11 = if err > T::zero() {
+            (self.expo * err.ln()).exp()
+        } else {
+            T::zero()
+        };
+        if err <= T::one() {
+            // PI: fac = err^expo / err_old^β.
+            let fac = fac11 / (o.beta * self.err_old.ln()).exp();
+            let fac = (fac / o.safety)
+                .max(T::one() / o.fac_max)
+                .min(T::one() / o.fac_min);
+            let mut h_new = h / fac;
+            if self.rejected_last {
+                h_new = h_new.min(h);
+            }
+            self.err_old = err.max(lit(1e-4));
+            self.rejected_last = false;
+            (true, h_new.min(o.h_max))
+        } else {
+            let fac = (fac11 / o.safety).min(T::one() / o.fac_min);
+            self.rejected_last = true;
+            (false, h / fac)
+        }
+    }
+}
+
+/// Hairer's initial step-size guess for a method of order `order`.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn initial_step<T: Real, const N: usize, S: Dynamics<T, N>>(
+    sys: &S,
+    t0: T,
+    y0: &SVector<T, N>,
+    f0: &SVector<T, N>,
+    order: u8,
+    tol: &Tolerances<T, N>,
+    h_max: T,
+    dir_span: T,
+    evals: &mut u64,
+) -> T {
+    let mut d0 = T::zero();
+    let mut d1 = T::zero();
+    for i in 0..N {
+        let sc = tol.atol[i] + tol.rtol[i] * y0[i].abs();
+        d0 += (y0[i] / sc) * (y0[i] / sc);
+        d1 += (f0[i] / sc) * (f0[i] / sc);
+    }
+    let n = lit::<T>(N as f64);
+    d0 = (d0 / n).sqrt();
+    d1 = (d1 / n).sqrt();
+    let mut h0 = if d0 < lit(1e-5) || d1 < lit(1e-5) {
+        lit(1e-6)
+    } else {
+        lit::<T>(0.01) * d0 / d1
+    };
+    h0 = h0.min(h_max).min(dir_span.abs());
+    let y1 = y0 + f0 * h0;
+    let mut f1 = SVector::zeros();
+    sys.rhs(t0 + h0, &y1, &mut f1);
+    *evals += 1;
+    let mut d2 = T::zero();
+    for i in 0..N {
+        let sc = tol.atol[i] + tol.rtol[i] * y0[i].abs();
+        let q = (f1[i] - f0[i]) / sc;
+        d2 += q * q;
+    }
+    d2 = (d2 / n).sqrt() / h0;
+    let dm = d1.max(d2);
+    let h1 = if dm <= lit(1e-15) {
+        (h0 * lit(1e-3)).max(lit(1e-6))
+    } else {
+        (lit::<T>(0.01) / dm).powf(T::one() / lit::<T>(order as f64 + 1.0))
+    };
+    let h = (h0 * lit(100.0)).min(h1).min(h_max).min(dir_span.abs());
+    if h.is_finite() && h > T::zero() {
+        h
+    } else {
+        lit(1e-6)
+    }
+}
+
+/// `true` if every component is finite.
+#[inline(always)]
+pub(crate) fn all_finite<T: Real, const N: usize>(y: &SVector<T, N>) -> bool {
+    y.iter().all(|v| v.is_finite())
+}
+
+/// Validates an initial state.
+pub(crate) fn check_state<T: Real, const N: usize>(
+    y: &SVector<T, N>,
+) -> Result<(), IntegrateError> {
+    for (i, v) in y.iter().enumerate() {
+        if !v.is_finite() {
+            return Err(IntegrateError::NonFiniteState {
+                index: i,
+                value: to_f64(*v),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The smallest step that still advances `t` meaningfully.
+#[inline(always)]
+pub(crate) fn min_step<T: Real>(t: T, h_min: T) -> T {
+    (lit::<T>(16.0) * T::default_epsilon() * t.abs()).max(h_min)
+}
+
+/// Clamps a trial step so that `t + h` does not pass `t_limit`; returns `(h, lands)` where
+/// `lands` says the step ends exactly on `t_limit` (a step within 1 % of the limit is
+/// stretched to it rather than leaving a sliver).
+#[inline(always)]
+pub(crate) fn clamp_to_limit<T: Real>(t: T, h: T, t_limit: T) -> (T, bool) {
+    let rest = t_limit - t;
+    if h >= rest * lit(0.99) {
+        (rest, true)
+    } else {
+        (h, false)
+    }
 }

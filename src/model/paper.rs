@@ -64,7 +64,7 @@ pub struct PaperParameters {
     /// Numerical, *not* from the paper: the rate regularization `η` (m/s) of the contact
     /// damping term `sgn(ẋ)|ẋ|^{n3}` (see [`HertzContact`]); 0 is the exact law.
     ///
-    /// The default `10⁻⁹ m/s` is a thousand times below the friction's `ε`: inside
+    /// The default `10⁻⁸ m/s` is a hundred times below the friction's `ε`: inside
     /// `|ẋ| < ε` the regularized friction already dominates the dynamics, and the tests
     /// (`tests/integrate_paper.rs`) show that results do not move at the paper's printed
     /// precision when `η` changes by two decades.
@@ -86,7 +86,7 @@ pub const PAPER: PaperParameters = PaperParameters {
     n2: 1.5,
     n3: 0.18667,
     x_i: -2.086e-3,
-    eta: 1e-9,
+    eta: 1e-8,
 };
 
 impl Default for PaperParameters {

@@ -1,0 +1,728 @@
+//! The simulation driver: a system, a stepper, events and observers in one stepping loop.
+//!
+//! [`Simulation::run`] integrates from `(t0, y0)` to `t_end`; after each accepted step it
+//! looks for events on the step's dense output (see [`event`](crate::event) for the
+//! semantics), and streams the step — split at every located event — and the events to an
+//! [`Observer`]. Observers cannot change the trajectory; they can stop the run.
+//!
+//! ```
+//! use nonsmooth::drive::{Simulation, Termination};
+//! use nonsmooth::event::{Direction, Event, Level};
+//! use nonsmooth::integrate::{Dopri5, Tolerances};
+//! use nonsmooth::model::paper::PAPER;
+//! use nalgebra::Vector2;
+//!
+//! // The paper's oscillator at ω = 20.465 rad/s from rest, impacts = upward crossings of x_I.
+//! let osc = PAPER.oscillator::<f64>(20.465)?;
+//! let impact = Event::new(Level::new(0, PAPER.x_i)?, Direction::Rising);
+//! let tol = Tolerances::per_component(1e-8, [1e-12, 1e-10])?;
+//! let mut sim = Simulation::new(osc, Dopri5::new(tol)).with_events(impact);
+//! let x0 = PAPER.static_equilibrium()?;
+//! let out = sim.run(0.0, Vector2::new(x0, 0.0), 3.0, &mut ())?;
+//! assert_eq!(out.termination, Termination::ReachedEnd);
+//! # Ok::<(), nonsmooth::Error>(())
+//! ```
+
+use nalgebra::SVector;
+
+use crate::error::Result;
+use crate::event::{Direction, EventError, EventHistory, EventSet, ZenoGuard, locate};
+use crate::integrate::{DenseOutput, IntegrateError, Stats, Stepper, check_state};
+use crate::scalar::{lit, to_f64};
+use crate::{Dynamics, Real};
+
+/// Whether a run goes on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Control {
+    /// Go on.
+    Continue,
+    /// Stop the run after this callback.
+    Stop,
+}
+
+/// A view of (part of) an accepted step: `[t0, t1]` with the states at both ends and the
+/// step's dense output, valid on `[t0, t1]`.
+#[derive(Debug, Clone, Copy)]
+pub struct StepView<'a, T: Real, const N: usize, D> {
+    /// Start of the view.
+    pub t0: T,
+    /// End of the view.
+    pub t1: T,
+    /// State at `t0`.
+    pub y0: SVector<T, N>,
+    /// State at `t1`.
+    pub y1: SVector<T, N>,
+    /// The dense output of the underlying step (which may extend beyond the view).
+    pub dense: &'a D,
+}
+
+impl<T: Real, const N: usize, D: DenseOutput<T, N>> StepView<'_, T, N, D> {
+    /// The interpolated state at `t ∈ [t0, t1]` (ends are returned exactly).
+    #[inline(always)]
+    pub fn state_at(&self, t: T, out: &mut SVector<T, N>) {
+        if t == self.t0 {
+            *out = self.y0;
+        } else if t == self.t1 {
+            *out = self.y1;
+        } else {
+            self.dense.interpolate_unchecked(t, out);
+        }
+    }
+}
+
+/// A located event.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EventRecord<T: Real, const N: usize> {
+    /// Index of the event in the simulation's event set.
+    pub index: usize,
+    /// Located time.
+    pub t: T,
+    /// State at the event (before any reset).
+    pub y: SVector<T, N>,
+    /// State after the reset, if the event has one.
+    pub y_after: Option<SVector<T, N>>,
+    /// The actual crossing direction ([`Direction::Rising`] or [`Direction::Falling`]).
+    pub direction: Direction,
+}
+
+/// How a run ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Termination {
+    /// `t_end` was reached.
+    ReachedEnd,
+    /// An observer returned [`Control::Stop`].
+    ObserverStopped,
+    /// A terminal event (its index) fired.
+    TerminalEvent(usize),
+}
+
+/// The result of a run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Outcome<T: Real, const N: usize> {
+    /// Final time.
+    pub t: T,
+    /// Final state.
+    pub y: SVector<T, N>,
+    /// Why the run ended.
+    pub termination: Termination,
+    /// Work done in this run (difference of the stepper's counters).
+    pub stats: Stats,
+}
+
+/// Receives the accepted steps and located events of a run, in time order.
+///
+/// All hooks have defaults; `()` is the no-op observer, `&mut O` and tuples of observers are
+/// observers.
+///
+/// ```
+/// use nonsmooth::drive::{Control, EventRecord, Observer, StepView};
+/// use nonsmooth::integrate::DenseOutput;
+/// /// Counts events.
+/// #[derive(Default)]
+/// struct Counter(usize);
+/// impl Observer<f64, 2> for Counter {
+///     fn on_event(&mut self, _e: &EventRecord<f64, 2>) -> Control {
+///         self.0 += 1;
+///         Control::Continue
+///     }
+/// }
+/// ```
+pub trait Observer<T: Real, const N: usize> {
+    /// Called once before the first step.
+    fn on_start(&mut self, _t0: T, _y0: &SVector<T, N>) {}
+
+    /// Called for each accepted step (or the part of it between events).
+    fn on_step<D: DenseOutput<T, N>>(&mut self, _step: &StepView<'_, T, N, D>) -> Control {
+        Control::Continue
+    }
+
+    /// Called for each located event, after the step part that leads to it.
+    fn on_event(&mut self, _event: &EventRecord<T, N>) -> Control {
+        Control::Continue
+    }
+
+    /// Called once at the end of a successful run.
+    fn on_finish(&mut self, _outcome: &Outcome<T, N>) {}
+}
+
+impl<T: Real, const N: usize> Observer<T, N> for () {}
+
+impl<T: Real, const N: usize, O: Observer<T, N> + ?Sized> Observer<T, N> for &mut O {
+    fn on_start(&mut self, t0: T, y0: &SVector<T, N>) {
+        (**self).on_start(t0, y0)
+    }
+    #[inline(always)]
+    fn on_step<D: DenseOutput<T, N>>(&mut self, step: &StepView<'_, T, N, D>) -> Control {
+        (**self).on_step(step)
+    }
+    fn on_event(&mut self, event: &EventRecord<T, N>) -> Control {
+        (**self).on_event(event)
+    }
+    fn on_finish(&mut self, outcome: &Outcome<T, N>) {
+        (**self).on_finish(outcome)
+    }
+}
+
+macro_rules! observer_tuple {
+    ($($name:ident $idx:tt),+) => {
+        impl<T: Real, const N: usize, $($name: Observer<T, N>),+> Observer<T, N> for ($($name,)+) {
+            fn on_start(&mut self, t0: T, y0: &SVector<T, N>) {
+                $(self.$idx.on_start(t0, y0);)+
+            }
+            #[inline(always)]
+            fn on_step<DD: DenseOutput<T, N>>(&mut self, step: &StepView<'_, T, N, DD>) -> Control {
+                let mut c = Control::Continue;
+                $(if self.$idx.on_step(step) == Control::Stop { c = Control::Stop; })+
+                c
+            }
+            fn on_event(&mut self, event: &EventRecord<T, N>) -> Control {
+                let mut c = Control::Continue;
+                $(if self.$idx.on_event(event) == Control::Stop { c = Control::Stop; })+
+                c
+            }
+            fn on_finish(&mut self, outcome: &Outcome<T, N>) {
+                $(self.$idx.on_finish(outcome);)+
+            }
+        }
+    };
+}
+
+observer_tuple!(A 0);
+observer_tuple!(A 0, B 1);
+observer_tuple!(A 0, B 1, C 2);
+observer_tuple!(A 0, B 1, C 2, D 3);
+observer_tuple!(A 0, B 1, C 2, D 3, E 4);
+observer_tuple!(A 0, B 1, C 2, D 3, E 4, F 5);
+
+/// Capacity of the per-step crossing scan (events per step beyond it are found on the next
+/// pass over the remainder of the step).
+const MAX_EVENTS: usize = 8;
+
+/// A system, a stepper and a set of events.
+#[derive(Debug, Clone)]
+pub struct Simulation<T: Real, const N: usize, S, St, E = ()> {
+    system: S,
+    stepper: St,
+    events: E,
+    max_steps: usize,
+    event_tol: T,
+    zeno: Option<ZenoGuard<T>>,
+    active_zeno: ZenoGuard<T>,
+    history: EventHistory<T>,
+    grid: Option<(T, T)>,
+}
+
+impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>> Simulation<T, N, S, St, ()> {
+    /// A simulation without events; default step cap 10⁸, event time tolerance 10⁻¹²
+    /// (absolute, plus 4·ε_mach·|t|), Zeno guard: more than 16 events within `10⁻⁵` of
+    /// the run's time span.
+    pub fn new(system: S, stepper: St) -> Self {
+        Self {
+            system,
+            stepper,
+            events: (),
+            max_steps: 100_000_000,
+            event_tol: lit(1e-12),
+            zeno: None,
+            active_zeno: ZenoGuard {
+                max_events: 16,
+                window: T::one(),
+            },
+            history: EventHistory::new(),
+            grid: None,
+        }
+    }
+}
+
+impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<T, N>>
+    Simulation<T, N, S, St, E>
+{
+    /// Replaces the event set.
+    pub fn with_events<E2: EventSet<T, N>>(self, events: E2) -> Simulation<T, N, S, St, E2> {
+        Simulation {
+            system: self.system,
+            stepper: self.stepper,
+            events,
+            max_steps: self.max_steps,
+            event_tol: self.event_tol,
+            zeno: self.zeno,
+            active_zeno: self.active_zeno,
+            history: self.history,
+            grid: self.grid,
+        }
+    }
+
+    /// Caps the number of accepted steps per run.
+    ///
+    /// # Errors
+    /// [`ParameterError`](crate::ParameterError) if `max_steps == 0`.
+    pub fn max_steps(mut self, max_steps: usize) -> Result<Self> {
+        if max_steps == 0 {
+            return Err(crate::ParameterError::new("max_steps", 0.0, "> 0").into());
+        }
+        self.max_steps = max_steps;
+        Ok(self)
+    }
+
+    /// Sets the absolute event-time tolerance.
+    ///
+    /// # Errors
+    /// [`ParameterError`](crate::ParameterError) unless `tol` is finite and > 0.
+    pub fn event_tolerance(mut self, tol: T) -> Result<Self> {
+        self.event_tol = crate::error::positive("event_tol", tol)?;
+        Ok(self)
+    }
+
+    /// Sets the chatter/Zeno guard (default: more than 16 events within `10⁻⁵` of the
+    /// run's time span).
+    pub fn zeno_guard(mut self, guard: ZenoGuard<T>) -> Self {
+        self.zeno = Some(guard);
+        self
+    }
+
+    /// Makes every step land exactly on the grid `origin + i·dt` (steps are cut there;
+    /// the grid is computed from `i`, never accumulated). `None` removes the grid.
+    ///
+    /// # Errors
+    /// [`ParameterError`](crate::ParameterError) unless `dt` is finite and > 0.
+    pub fn landing_grid(mut self, grid: Option<(T, T)>) -> Result<Self> {
+        if let Some((o, dt)) = grid {
+            crate::error::finite("origin", o)?;
+            crate::error::positive("dt", dt)?;
+        }
+        self.grid = grid;
+        Ok(self)
+    }
+
+    /// The system.
+    pub fn system(&self) -> &S {
+        &self.system
+    }
+
+    /// Replaces the system (e.g. another parameter value). The stepper keeps its state but
+    /// drops its cached derivative.
+    pub fn set_system(&mut self, system: S) {
+        self.system = system;
+        let (t, y) = self.stepper.current();
+        let y = *y;
+        self.stepper.reset_state(t, y);
+    }
+
+    /// The stepper.
+    pub fn stepper(&self) -> &St {
+        &self.stepper
+    }
+
+    /// The events.
+    pub fn events(&self) -> &E {
+        &self.events
+    }
+
+    /// Integrates from `(t0, y0)` to `t_end`, streaming to `observer`.
+    ///
+    /// # Errors
+    /// [`IntegrateError`] for invalid inputs (non-finite state, `t_end ≤ t0`) or failed
+    /// steps, [`EventError::Zeno`] for an accumulation of events.
+    pub fn run<O: Observer<T, N>>(
+        &mut self,
+        t0: T,
+        y0: SVector<T, N>,
+        t_end: T,
+        observer: &mut O,
+    ) -> Result<Outcome<T, N>> {
+        if !t0.is_finite() || !t_end.is_finite() || t_end <= t0 {
+            return Err(IntegrateError::InvalidTimeSpan {
+                t0: to_f64(t0),
+                t_end: to_f64(t_end),
+            }
+            .into());
+        }
+        check_state(&y0)?;
+        self.stepper.reset_state(t0, y0);
+        self.history.clear();
+        observer.on_start(t0, &y0);
+        self.advance(t_end, observer)
+    }
+
+    /// Continues from the stepper's current state to `t_end` (for continuation: the state and
+    /// step size carry over; observers get `on_start` again).
+    ///
+    /// # Errors
+    /// As [`run`](Self::run).
+    pub fn run_on<O: Observer<T, N>>(
+        &mut self,
+        t_end: T,
+        observer: &mut O,
+    ) -> Result<Outcome<T, N>> {
+        let (t0, y0) = self.stepper.current();
+        let (t0, y0) = (t0, *y0);
+        if !t_end.is_finite() || t_end <= t0 {
+            return Err(IntegrateError::InvalidTimeSpan {
+                t0: to_f64(t0),
+                t_end: to_f64(t_end),
+            }
+            .into());
+        }
+        observer.on_start(t0, &y0);
+        self.advance(t_end, observer)
+    }
+
+    fn advance<O: Observer<T, N>>(&mut self, t_end: T, observer: &mut O) -> Result<Outcome<T, N>> {
+        let stats0 = *self.stepper.stats();
+        let span = t_end - self.stepper.current().0;
+        self.active_zeno = self.zeno.unwrap_or(ZenoGuard {
+            max_events: 16,
+            window: span * lit(1e-5),
+        });
+        let n_ev = E::LEN.min(MAX_EVENTS);
+        // Per event: the side (+1/−1) of the surface the trajectory is on (used when g is
+        // exactly zero at a step boundary), and whether it is armed (false right after a
+        // reset that left the state on the far side while moving back out).
+        let mut side = [0i8; MAX_EVENTS];
+        let mut armed = [true; MAX_EVENTS];
+        {
+            let (t, y) = self.stepper.current();
+            for (i, s) in side.iter_mut().enumerate().take(n_ev) {
+                *s = sign_of(self.events.value(i, t, y));
+            }
+        }
+        let mut steps = 0usize;
+        let mut termination = Termination::ReachedEnd;
+        'outer: loop {
+            let t_now = self.stepper.current().0;
+            if t_now >= t_end {
+                break;
+            }
+            if steps >= self.max_steps {
+                return Err(IntegrateError::MaxSteps {
+                    t: to_f64(t_now),
+                    max_steps: self.max_steps,
+                }
+                .into());
+            }
+            let limit = match self.grid {
+                Some((o, dt)) => {
+                    let k = ((t_now - o) / dt).floor() + T::one();
+                    let mut next = o + k * dt;
+                    if next
+                        <= t_now * (T::one() + lit::<T>(4.0) * T::default_epsilon())
+                            + T::default_epsilon() * dt
+                    {
+                        next = o + (k + T::one()) * dt;
+                    }
+                    next.min(t_end)
+                }
+                None => t_end,
+            };
+            self.stepper.step(&self.system, limit)?;
+            steps += 1;
+            let dense = self.stepper.dense();
+            let (ts0, ts1) = dense.span();
+            let (y_start, y_end) = dense.endpoints();
+            let (f_start, f_end) = dense.end_derivatives();
+            let (y_start, y_end, f_start, f_end) = (*y_start, *y_end, *f_start, *f_end);
+            // Scan starts per event, and the crossing found from each (cached).
+            let mut st_t = [ts0; MAX_EVENTS];
+            let mut st_g = [T::zero(); MAX_EVENTS];
+            let mut st_r = [None; MAX_EVENTS];
+            let mut g_end = [T::zero(); MAX_EVENTS];
+            let mut r_end = [None; MAX_EVENTS];
+            let mut found: [Option<Crossing<T>>; MAX_EVENTS] = [None; MAX_EVENTS];
+            for i in 0..n_ev {
+                let g0 = self.events.value(i, ts0, &y_start);
+                st_g[i] = if g0 == T::zero() {
+                    signed_tiny(side[i])
+                } else {
+                    g0
+                };
+                st_r[i] = self.events.rate(i, ts0, &y_start, &f_start);
+                g_end[i] = self.events.value(i, ts1, &y_end);
+                r_end[i] = self.events.rate(i, ts1, &y_end, &f_end);
+                found[i] =
+                    self.find_crossing(i, st_t[i], st_g[i], st_r[i], ts1, g_end[i], r_end[i]);
+            }
+            let mut t_lo = ts0;
+            let mut y_lo = y_start;
+            loop {
+                let mut best: Option<(usize, Crossing<T>)> = None;
+                for (i, f) in found.iter().enumerate().take(n_ev) {
+                    if let Some(c) = f {
+                        if best.is_none_or(|(_, b)| c.t < b.t) {
+                            best = Some((i, *c));
+                        }
+                    }
+                }
+                let Some((i, c)) = best else { break };
+                // Where the scan of event i resumes (None: no further crossing this step).
+                found[i] = match c.resume {
+                    Some((tr, gr)) => {
+                        st_t[i] = tr;
+                        st_g[i] = gr;
+                        st_r[i] = None;
+                        self.find_crossing(i, tr, gr, None, ts1, g_end[i], r_end[i])
+                    }
+                    None => None,
+                };
+                let was_armed = armed[i];
+                armed[i] = true;
+                side[i] = if c.rising { 1 } else { -1 };
+                if !was_armed || !self.events.direction(i).accepts(c.rising) {
+                    // Re-arming crossing (the exit after a reset) or an unwanted direction.
+                    continue;
+                }
+                let tc = c.t;
+                let dense = self.stepper.dense();
+                let mut yc = SVector::zeros();
+                dense.interpolate_unchecked(tc, &mut yc);
+                let view = StepView {
+                    t0: t_lo,
+                    t1: tc,
+                    y0: y_lo,
+                    y1: yc,
+                    dense,
+                };
+                let stop_obs = observer.on_step(&view) == Control::Stop;
+                let direction = if c.rising {
+                    Direction::Rising
+                } else {
+                    Direction::Falling
+                };
+                self.stepper.stats_mut().events += 1;
+                if let Some(count) = self.history.push(tc, &self.active_zeno) {
+                    return Err(EventError::Zeno {
+                        t: to_f64(tc),
+                        count,
+                        window: to_f64(self.active_zeno.window),
+                    }
+                    .into());
+                }
+                if self.events.resets(i) {
+                    let mut ya = yc;
+                    self.events.apply_reset(i, tc, &mut ya);
+                    let rec = EventRecord {
+                        index: i,
+                        t: tc,
+                        y: yc,
+                        y_after: Some(ya),
+                        direction,
+                    };
+                    let stop_ev = observer.on_event(&rec) == Control::Stop;
+                    self.stepper.reset_state(tc, ya);
+                    let mut fa = SVector::zeros();
+                    self.system.rhs(tc, &ya, &mut fa);
+                    self.stepper.stats_mut().rhs_evals += 1;
+                    for (j, s) in side.iter_mut().enumerate().take(n_ev) {
+                        let g = self.events.value(j, tc, &ya);
+                        if g != T::zero() {
+                            *s = sign_of(g);
+                        }
+                        if j == i {
+                            // Left on the far side but moving back out: disarmed until it
+                            // has crossed back.
+                            let r = self.events.rate(j, tc, &ya, &fa).unwrap_or(T::zero());
+                            armed[j] =
+                                !(g != T::zero() && r != T::zero() && sign_of(g) != sign_of(r));
+                            if g == T::zero() && r != T::zero() {
+                                *s = sign_of(r);
+                            }
+                        }
+                    }
+                    if self.events.is_terminal(i) {
+                        termination = Termination::TerminalEvent(i);
+                        break 'outer;
+                    }
+                    if stop_obs || stop_ev {
+                        termination = Termination::ObserverStopped;
+                        break 'outer;
+                    }
+                    continue 'outer;
+                }
+                let rec = EventRecord {
+                    index: i,
+                    t: tc,
+                    y: yc,
+                    y_after: None,
+                    direction,
+                };
+                let stop_ev = observer.on_event(&rec) == Control::Stop;
+                if self.events.is_terminal(i) || stop_obs || stop_ev {
+                    // Rewind the stepper to the event.
+                    self.stepper.reset_state(tc, yc);
+                    termination = if self.events.is_terminal(i) {
+                        Termination::TerminalEvent(i)
+                    } else {
+                        Termination::ObserverStopped
+                    };
+                    break 'outer;
+                }
+                t_lo = tc;
+                y_lo = yc;
+            }
+            let dense = self.stepper.dense();
+            let view = StepView {
+                t0: t_lo,
+                t1: ts1,
+                y0: y_lo,
+                y1: y_end,
+                dense,
+            };
+            let stop = observer.on_step(&view) == Control::Stop;
+            for (i, s) in side.iter_mut().enumerate().take(n_ev) {
+                if g_end[i] != T::zero() {
+                    *s = sign_of(g_end[i]);
+                }
+            }
+            if stop {
+                termination = Termination::ObserverStopped;
+                break;
+            }
+        }
+        let (t, y) = self.stepper.current();
+        let s1 = *self.stepper.stats();
+        let stats = Stats {
+            rhs_evals: s1.rhs_evals - stats0.rhs_evals,
+            accepted: s1.accepted - stats0.accepted,
+            rejected: s1.rejected - stats0.rejected,
+            jacobian_evals: s1.jacobian_evals - stats0.jacobian_evals,
+            decompositions: s1.decompositions - stats0.decompositions,
+            events: s1.events - stats0.events,
+        };
+        let out = Outcome {
+            t,
+            y: *y,
+            termination,
+            stats,
+        };
+        observer.on_finish(&out);
+        Ok(out)
+    }
+
+    /// The earliest crossing (any direction) of event `i` in `(t_lo, t1]`, starting from
+    /// `g_lo ≠ 0` (rate `r_lo` if known) and ending at `g1` (rate `r1`).
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn find_crossing(
+        &self,
+        i: usize,
+        t_lo: T,
+        g_lo: T,
+        r_lo: Option<T>,
+        t1: T,
+        g1: T,
+        r1: Option<T>,
+    ) -> Option<Crossing<T>> {
+        let ev = &self.events;
+        let dense = self.stepper.dense();
+        let tol = self
+            .event_tol
+            .max(lit::<T>(4.0) * T::default_epsilon() * t1.abs());
+        let g_at = |t: T| {
+            let mut y = SVector::<T, N>::zeros();
+            dense.interpolate_unchecked(t, &mut y);
+            ev.value(i, t, &y)
+        };
+        let s = sign_of(g_lo);
+        // Interior samples (grazing safety for functions without a rate).
+        let k = ev.interior_samples(i);
+        if k > 0 {
+            let mut ta = t_lo;
+            let mut ga = g_lo;
+            for m in 1..=(k + 1) {
+                let (tb, gb) = if m == k + 1 {
+                    (t1, g1)
+                } else {
+                    let tb = t_lo + (t1 - t_lo) * lit::<T>(m as f64 / (k as f64 + 1.0));
+                    (tb, g_at(tb))
+                };
+                if gb != T::zero() && sign_of(gb) != sign_of(ga) {
+                    let (tc, _) = locate(g_at, ta, tb, ga, gb, tol);
+                    let resume = if m == k + 1 { None } else { Some((tb, gb)) };
+                    return Some(Crossing {
+                        t: tc,
+                        rising: gb > T::zero(),
+                        resume,
+                    });
+                }
+                if gb != T::zero() {
+                    ta = tb;
+                    ga = gb;
+                }
+            }
+            return None;
+        }
+        if g1 != T::zero() && sign_of(g1) != s {
+            let (tc, _) = locate(g_at, t_lo, t1, g_lo, g1, tol);
+            return Some(Crossing {
+                t: tc,
+                rising: g1 > T::zero(),
+                resume: None,
+            });
+        }
+        // Same sign at both ends (or g1 == 0): a grazing pair if the rates show an interior
+        // extremum approaching zero.
+        let r_lo = match r_lo {
+            Some(r) => Some(r),
+            None => {
+                let mut y = SVector::zeros();
+                dense.interpolate_unchecked(t_lo, &mut y);
+                let mut f = SVector::zeros();
+                self.system.rhs(t_lo, &y, &mut f);
+                ev.rate(i, t_lo, &y, &f)
+            }
+        };
+        let (Some(r_lo), Some(r1)) = (r_lo, r1) else {
+            return None;
+        };
+        let towards = if s > 0 {
+            r_lo < T::zero()
+        } else {
+            r_lo > T::zero()
+        };
+        let away = if s > 0 {
+            r1 > T::zero()
+        } else {
+            r1 < T::zero()
+        };
+        if !(towards && (away || g1 == T::zero())) {
+            return None;
+        }
+        let sg = if s > 0 { T::one() } else { -T::one() };
+        let (te, neg) = crate::roots::golden_max(|t| -sg * g_at(t), t_lo, t1, tol);
+        let ge = -neg * sg;
+        if ge == T::zero() || sign_of(ge) == s {
+            return None;
+        }
+        let (tc, _) = locate(g_at, t_lo, te, g_lo, ge, tol);
+        Some(Crossing {
+            t: tc,
+            rising: ge > T::zero(),
+            resume: Some((te, ge)),
+        })
+    }
+}
+
+/// A crossing found on a step.
+#[derive(Debug, Clone, Copy)]
+struct Crossing<T> {
+    t: T,
+    rising: bool,
+    /// Where to resume scanning this event after it (`None`: nothing more this step).
+    resume: Option<(T, T)>,
+}
+
+#[inline(always)]
+fn signed_tiny<T: Real>(side: i8) -> T {
+    let tiny = T::default_epsilon() * T::default_epsilon();
+    if side < 0 { -tiny } else { tiny }
+}
+
+#[inline(always)]
+fn sign_of<T: Real>(x: T) -> i8 {
+    if x > T::zero() {
+        1
+    } else if x < T::zero() {
+        -1
+    } else {
+        0
+    }
+}

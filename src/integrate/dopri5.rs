@@ -1,0 +1,294 @@
+//! Dormand–Prince 5(4) with Hairer's 4th-order continuous extension.
+
+use nalgebra::SVector;
+
+use super::{
+    Controller, DenseOutput, IntegrateError, Stats, StepOptions, Stepper, Tolerances, all_finite,
+    clamp_to_limit, initial_step, min_step,
+};
+use crate::scalar::{lit, to_f64};
+use crate::{Dynamics, Real};
+
+/// The explicit Runge–Kutta method of Dormand and Prince, order 5 with an embedded order-4
+/// error estimate, first-same-as-last (6 evaluations per accepted step), and Hairer's
+/// 4th-order dense output.
+///
+/// # References
+/// J. R. Dormand, P. J. Prince, *A family of embedded Runge–Kutta formulae*, J. Comput.
+/// Appl. Math. 6 (1980); E. Hairer, S. P. Nørsett, G. Wanner, *Solving ODEs I*, II.5–II.6.
+#[derive(Debug, Clone)]
+pub struct Dopri5<T: Real, const N: usize> {
+    tol: Tolerances<T, N>,
+    ctrl: Controller<T>,
+    t: T,
+    y: SVector<T, N>,
+    f: SVector<T, N>,
+    f_valid: bool,
+    initialized: bool,
+    h: Option<T>,
+    dense: Dopri5Dense<T, N>,
+    stats: Stats,
+}
+
+/// Dense output of a [`Dopri5`] step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Dopri5Dense<T: Real, const N: usize> {
+    t0: T,
+    t1: T,
+    h: T,
+    y0: SVector<T, N>,
+    y1: SVector<T, N>,
+    f0: SVector<T, N>,
+    f1: SVector<T, N>,
+    r2: SVector<T, N>,
+    r3: SVector<T, N>,
+    r4: SVector<T, N>,
+    r5: SVector<T, N>,
+}
+
+impl<T: Real, const N: usize> Dopri5Dense<T, N> {
+    fn empty() -> Self {
+        let z = SVector::zeros();
+        Self {
+            t0: T::zero(),
+            t1: T::zero(),
+            h: T::zero(),
+            y0: z,
+            y1: z,
+            f0: z,
+            f1: z,
+            r2: z,
+            r3: z,
+            r4: z,
+            r5: z,
+        }
+    }
+}
+
+impl<T: Real, const N: usize> DenseOutput<T, N> for Dopri5Dense<T, N> {
+    fn span(&self) -> (T, T) {
+        (self.t0, self.t1)
+    }
+    fn endpoints(&self) -> (&SVector<T, N>, &SVector<T, N>) {
+        (&self.y0, &self.y1)
+    }
+    fn end_derivatives(&self) -> (&SVector<T, N>, &SVector<T, N>) {
+        (&self.f0, &self.f1)
+    }
+    #[inline(always)]
+    fn interpolate_unchecked(&self, t: T, out: &mut SVector<T, N>) {
+        let th = (t - self.t0) / self.h;
+        let th1 = T::one() - th;
+        for i in 0..N {
+            out[i] = self.y0[i]
+                + th * (self.r2[i] + th1 * (self.r3[i] + th * (self.r4[i] + th1 * self.r5[i])));
+        }
+    }
+}
+
+impl<T: Real, const N: usize> Dopri5<T, N> {
+    /// A stepper with the given tolerances and default [`StepOptions`].
+    pub fn new(tol: Tolerances<T, N>) -> Self {
+        Self::with_options(tol, StepOptions::default())
+    }
+
+    /// A stepper with explicit step options.
+    pub fn with_options(tol: Tolerances<T, N>, opts: StepOptions<T>) -> Self {
+        Self {
+            tol,
+            ctrl: Controller::new(opts, lit(5.0)),
+            t: T::zero(),
+            y: SVector::zeros(),
+            f: SVector::zeros(),
+            f_valid: false,
+            initialized: false,
+            h: opts.h_init,
+            dense: Dopri5Dense::empty(),
+            stats: Stats::default(),
+        }
+    }
+
+    /// The tolerances.
+    pub fn tolerances(&self) -> &Tolerances<T, N> {
+        &self.tol
+    }
+
+    /// The step size the controller proposes next.
+    pub fn proposed_step(&self) -> Option<T> {
+        self.h
+    }
+}
+
+impl<T: Real, const N: usize> Stepper<T, N> for Dopri5<T, N> {
+    type Dense = Dopri5Dense<T, N>;
+
+    fn reset_state(&mut self, t: T, y: SVector<T, N>) {
+        self.t = t;
+        self.y = y;
+        self.f_valid = false;
+        self.initialized = true;
+    }
+
+    fn step<S: Dynamics<T, N>>(&mut self, sys: &S, t_limit: T) -> Result<(), IntegrateError> {
+        if !self.initialized {
+            return Err(IntegrateError::NotInitialized);
+        }
+        if !(t_limit > self.t) {
+            return Err(IntegrateError::InvalidTimeSpan {
+                t0: to_f64(self.t),
+                t_end: to_f64(t_limit),
+            });
+        }
+        let t = self.t;
+        let y = self.y;
+        if !self.f_valid {
+            sys.rhs(t, &y, &mut self.f);
+            self.stats.rhs_evals += 1;
+            if !all_finite(&self.f) {
+                return Err(IntegrateError::NonFiniteRhs { t: to_f64(t) });
+            }
+            self.f_valid = true;
+        }
+        let k1 = self.f;
+        let mut h = match self.h {
+            Some(h) => h,
+            None => initial_step(
+                sys,
+                t,
+                &y,
+                &k1,
+                5,
+                &self.tol,
+                self.ctrl.opts.h_max,
+                t_limit - t,
+                &mut self.stats.rhs_evals,
+            ),
+        };
+        let c = |x: f64| lit::<T>(x);
+        let (a21, a31, a32) = (c(1.0 / 5.0), c(3.0 / 40.0), c(9.0 / 40.0));
+        let (a41, a42, a43) = (c(44.0 / 45.0), c(-56.0 / 15.0), c(32.0 / 9.0));
+        let (a51, a52, a53, a54) = (
+            c(19372.0 / 6561.0),
+            c(-25360.0 / 2187.0),
+            c(64448.0 / 6561.0),
+            c(-212.0 / 729.0),
+        );
+        let (a61, a62, a63, a64, a65) = (
+            c(9017.0 / 3168.0),
+            c(-355.0 / 33.0),
+            c(46732.0 / 5247.0),
+            c(49.0 / 176.0),
+            c(-5103.0 / 18656.0),
+        );
+        let (a71, a73, a74, a75, a76) = (
+            c(35.0 / 384.0),
+            c(500.0 / 1113.0),
+            c(125.0 / 192.0),
+            c(-2187.0 / 6784.0),
+            c(11.0 / 84.0),
+        );
+        let (e1, e3, e4, e5, e6, e7) = (
+            c(71.0 / 57600.0),
+            c(-71.0 / 16695.0),
+            c(71.0 / 1920.0),
+            c(-17253.0 / 339200.0),
+            c(22.0 / 525.0),
+            c(-1.0 / 40.0),
+        );
+        let (c2, c3, c4, c5) = (c(0.2), c(0.3), c(0.8), c(8.0 / 9.0));
+        let mut k2 = SVector::zeros();
+        let mut k3 = SVector::zeros();
+        let mut k4 = SVector::zeros();
+        let mut k5 = SVector::zeros();
+        let mut k6 = SVector::zeros();
+        let mut k7 = SVector::zeros();
+        let mut nonfinite = 0u32;
+        loop {
+            let (hs, lands) = clamp_to_limit(t, h, t_limit);
+            if hs < min_step(t, self.ctrl.opts.h_min) && !lands {
+                return Err(IntegrateError::StepSizeTooSmall {
+                    t: to_f64(t),
+                    h: to_f64(hs),
+                });
+            }
+            let yt = y + k1 * (a21 * hs);
+            sys.rhs(t + c2 * hs, &yt, &mut k2);
+            let yt = y + (k1 * a31 + k2 * a32) * hs;
+            sys.rhs(t + c3 * hs, &yt, &mut k3);
+            let yt = y + (k1 * a41 + k2 * a42 + k3 * a43) * hs;
+            sys.rhs(t + c4 * hs, &yt, &mut k4);
+            let yt = y + (k1 * a51 + k2 * a52 + k3 * a53 + k4 * a54) * hs;
+            sys.rhs(t + c5 * hs, &yt, &mut k5);
+            let yt = y + (k1 * a61 + k2 * a62 + k3 * a63 + k4 * a64 + k5 * a65) * hs;
+            let t_new = if lands { t_limit } else { t + hs };
+            sys.rhs(t_new, &yt, &mut k6);
+            let y_new = y + (k1 * a71 + k3 * a73 + k4 * a74 + k5 * a75 + k6 * a76) * hs;
+            sys.rhs(t_new, &y_new, &mut k7);
+            self.stats.rhs_evals += 6;
+            let errv = (k1 * e1 + k3 * e3 + k4 * e4 + k5 * e5 + k6 * e6 + k7 * e7) * hs;
+            let err = if all_finite(&y_new) && all_finite(&k7) {
+                self.tol.error_norm(&errv, &y, &y_new)
+            } else {
+                nonfinite += 1;
+                if nonfinite > 20 {
+                    return Err(IntegrateError::NonFiniteRhs { t: to_f64(t) });
+                }
+                crate::scalar::nan()
+            };
+            let (accept, h_next) = self.ctrl.propose(err, hs);
+            if accept {
+                let ydiff = y_new - y;
+                let bspl = k1 * hs - ydiff;
+                let (d1, d3, d4, d5, d6, d7) = (
+                    c(-12715105075.0 / 11282082432.0),
+                    c(87487479700.0 / 32700410799.0),
+                    c(-10690763975.0 / 1880347072.0),
+                    c(701980252875.0 / 199316789632.0),
+                    c(-1453857185.0 / 822651844.0),
+                    c(69997945.0 / 29380423.0),
+                );
+                self.dense = Dopri5Dense {
+                    t0: t,
+                    t1: t_new,
+                    h: hs,
+                    y0: y,
+                    y1: y_new,
+                    f0: k1,
+                    f1: k7,
+                    r2: ydiff,
+                    r3: bspl,
+                    r4: ydiff - k7 * hs - bspl,
+                    r5: (k1 * d1 + k3 * d3 + k4 * d4 + k5 * d5 + k6 * d6 + k7 * d7) * hs,
+                };
+                self.t = t_new;
+                self.y = y_new;
+                self.f = k7;
+                self.h = Some(if lands { h_next.max(h) } else { h_next });
+                self.stats.accepted += 1;
+                return Ok(());
+            }
+            self.stats.rejected += 1;
+            h = h_next;
+        }
+    }
+
+    fn current(&self) -> (T, &SVector<T, N>) {
+        (self.t, &self.y)
+    }
+
+    fn dense(&self) -> &Self::Dense {
+        &self.dense
+    }
+
+    fn stats(&self) -> &Stats {
+        &self.stats
+    }
+
+    fn stats_mut(&mut self) -> &mut Stats {
+        &mut self.stats
+    }
+
+    fn order(&self) -> u8 {
+        5
+    }
+}

@@ -1,0 +1,295 @@
+//! A linearly implicit (Rosenbrock) method for stiff phases.
+
+use nalgebra::{SMatrix, SVector};
+
+use super::{
+    Controller, DenseOutput, IntegrateError, Stats, StepOptions, Stepper, Tolerances, all_finite,
+    clamp_to_limit, initial_step, min_step,
+};
+use crate::linalg::Lu;
+use crate::scalar::{epsilon, lit, to_f64};
+use crate::{Dynamics, Real};
+
+/// The L-stable Rosenbrock method of Shampine and Reichelt (MATLAB's `ode23s`): order 2
+/// with a 3rd-order error estimate, first-same-as-last, and its own quadratic dense output.
+///
+/// # Model
+/// With `W = I − h·d·J`, `d = 1/(2+√2)`, `J = ∂f/∂y` and `T = ∂f/∂t` at the step start:
+/// $$\begin{aligned}
+/// W k_1 &= f(t, y) + h d T,\\
+/// W (k_2 - k_1) &= f(t + h/2, y + h k_1/2) - k_1,\qquad y_{n+1} = y + h k_2,\\
+/// W k_3 &= f(t+h, y_{n+1}) - e_{32}(k_2 - f_1) - 2(k_1 - f_0) + h d T,\\
+/// \mathrm{err} &= \tfrac{h}{6}(k_1 - 2k_2 + k_3).
+/// \end{aligned}$$
+/// One Jacobian and one LU decomposition per step attempt (`N×N`, on the stack). The
+/// Jacobian is the system's [`Dynamics::jacobian`] or, if absent, a forward difference.
+///
+/// # References
+/// L. F. Shampine, M. W. Reichelt, *The MATLAB ODE Suite*, SIAM J. Sci. Comput. 18 (1997).
+#[derive(Debug, Clone)]
+pub struct Rosenbrock23<T: Real, const N: usize> {
+    tol: Tolerances<T, N>,
+    ctrl: Controller<T>,
+    t: T,
+    y: SVector<T, N>,
+    f: SVector<T, N>,
+    f_valid: bool,
+    initialized: bool,
+    h: Option<T>,
+    dense: Rosenbrock23Dense<T, N>,
+    stats: Stats,
+}
+
+/// Dense output of a [`Rosenbrock23`] step: `y(t0 + s·h) = y0 + h·(s(1−s)/(1−2d)·k1 + s(s−2d)/(1−2d)·k2)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Rosenbrock23Dense<T: Real, const N: usize> {
+    t0: T,
+    t1: T,
+    h: T,
+    y0: SVector<T, N>,
+    y1: SVector<T, N>,
+    f0: SVector<T, N>,
+    f1: SVector<T, N>,
+    k1: SVector<T, N>,
+    k2: SVector<T, N>,
+}
+
+impl<T: Real, const N: usize> DenseOutput<T, N> for Rosenbrock23Dense<T, N> {
+    fn span(&self) -> (T, T) {
+        (self.t0, self.t1)
+    }
+    fn endpoints(&self) -> (&SVector<T, N>, &SVector<T, N>) {
+        (&self.y0, &self.y1)
+    }
+    fn end_derivatives(&self) -> (&SVector<T, N>, &SVector<T, N>) {
+        (&self.f0, &self.f1)
+    }
+    #[inline(always)]
+    fn interpolate_unchecked(&self, t: T, out: &mut SVector<T, N>) {
+        let d = d_const::<T>();
+        let s = (t - self.t0) / self.h;
+        let den = T::one() - lit::<T>(2.0) * d;
+        let c1 = s * (T::one() - s) / den;
+        let c2 = s * (s - lit::<T>(2.0) * d) / den;
+        for i in 0..N {
+            out[i] = self.y0[i] + self.h * (c1 * self.k1[i] + c2 * self.k2[i]);
+        }
+    }
+}
+
+#[inline(always)]
+fn d_const<T: Real>() -> T {
+    T::one() / (lit::<T>(2.0) + lit::<T>(2.0).sqrt())
+}
+
+impl<T: Real, const N: usize> Rosenbrock23<T, N> {
+    /// A stepper with the given tolerances and default [`StepOptions`].
+    pub fn new(tol: Tolerances<T, N>) -> Self {
+        Self::with_options(tol, StepOptions::default())
+    }
+
+    /// A stepper with explicit step options.
+    pub fn with_options(tol: Tolerances<T, N>, opts: StepOptions<T>) -> Self {
+        let z = SVector::zeros();
+        Self {
+            tol,
+            ctrl: Controller::new(opts, lit(3.0)),
+            t: T::zero(),
+            y: z,
+            f: z,
+            f_valid: false,
+            initialized: false,
+            h: opts.h_init,
+            dense: Rosenbrock23Dense {
+                t0: T::zero(),
+                t1: T::zero(),
+                h: T::one(),
+                y0: z,
+                y1: z,
+                f0: z,
+                f1: z,
+                k1: z,
+                k2: z,
+            },
+            stats: Stats::default(),
+        }
+    }
+
+    fn jacobian<S: Dynamics<T, N>>(
+        &mut self,
+        sys: &S,
+        t: T,
+        y: &SVector<T, N>,
+        f0: &SVector<T, N>,
+    ) -> SMatrix<T, N, N> {
+        self.stats.jacobian_evals += 1;
+        if let Some(j) = sys.jacobian(t, y) {
+            return j;
+        }
+        let mut j = SMatrix::<T, N, N>::zeros();
+        let sq = epsilon::<T>().sqrt();
+        let mut f1 = SVector::zeros();
+        for c in 0..N {
+            let dy = sq
+                * (y[c]
+                    .abs()
+                    .max(self.tol.atol[c] / self.tol.rtol[c].max(epsilon())));
+            let mut yp = *y;
+            yp[c] += dy;
+            sys.rhs(t, &yp, &mut f1);
+            self.stats.rhs_evals += 1;
+            j.set_column(c, &((f1 - f0) / dy));
+        }
+        j
+    }
+
+    fn dfdt<S: Dynamics<T, N>>(
+        &mut self,
+        sys: &S,
+        t: T,
+        y: &SVector<T, N>,
+        f0: &SVector<T, N>,
+    ) -> SVector<T, N> {
+        if let Some(d) = sys.time_derivative(t, y) {
+            return d;
+        }
+        let dt = epsilon::<T>().sqrt() * t.abs().max(T::one());
+        let mut f1 = SVector::zeros();
+        sys.rhs(t + dt, y, &mut f1);
+        self.stats.rhs_evals += 1;
+        (f1 - f0) / dt
+    }
+}
+
+impl<T: Real, const N: usize> Stepper<T, N> for Rosenbrock23<T, N> {
+    type Dense = Rosenbrock23Dense<T, N>;
+
+    fn reset_state(&mut self, t: T, y: SVector<T, N>) {
+        self.t = t;
+        self.y = y;
+        self.f_valid = false;
+        self.initialized = true;
+    }
+
+    fn step<S: Dynamics<T, N>>(&mut self, sys: &S, t_limit: T) -> Result<(), IntegrateError> {
+        if !self.initialized {
+            return Err(IntegrateError::NotInitialized);
+        }
+        if !(t_limit > self.t) {
+            return Err(IntegrateError::InvalidTimeSpan {
+                t0: to_f64(self.t),
+                t_end: to_f64(t_limit),
+            });
+        }
+        let t = self.t;
+        let y = self.y;
+        if !self.f_valid {
+            sys.rhs(t, &y, &mut self.f);
+            self.stats.rhs_evals += 1;
+            if !all_finite(&self.f) {
+                return Err(IntegrateError::NonFiniteRhs { t: to_f64(t) });
+            }
+            self.f_valid = true;
+        }
+        let f0 = self.f;
+        let mut h = match self.h {
+            Some(h) => h,
+            None => initial_step(
+                sys,
+                t,
+                &y,
+                &f0,
+                2,
+                &self.tol,
+                self.ctrl.opts.h_max,
+                t_limit - t,
+                &mut self.stats.rhs_evals,
+            ),
+        };
+        let jac = self.jacobian(sys, t, &y, &f0);
+        let tdot = self.dfdt(sys, t, &y, &f0);
+        let d = d_const::<T>();
+        let e32 = lit::<T>(6.0) + lit::<T>(2.0).sqrt();
+        let half = lit::<T>(0.5);
+        let two = lit::<T>(2.0);
+        let mut f1 = SVector::zeros();
+        let mut f2 = SVector::zeros();
+        let mut nonfinite = 0u32;
+        loop {
+            let (hs, lands) = clamp_to_limit(t, h, t_limit);
+            if hs < min_step(t, self.ctrl.opts.h_min) && !lands {
+                return Err(IntegrateError::StepSizeTooSmall {
+                    t: to_f64(t),
+                    h: to_f64(hs),
+                });
+            }
+            let w = SMatrix::<T, N, N>::identity() - jac * (hs * d);
+            let Some(lu) = Lu::new(w) else {
+                return Err(IntegrateError::SingularMatrix { t: to_f64(t) });
+            };
+            self.stats.decompositions += 1;
+            let hdt = tdot * (hs * d);
+            let k1 = lu.solve(&(f0 + hdt));
+            sys.rhs(t + half * hs, &(y + k1 * (half * hs)), &mut f1);
+            let k2m = lu.solve(&(f1 - k1));
+            let k2 = k2m + k1;
+            let y_new = y + k2 * hs;
+            let t_new = if lands { t_limit } else { t + hs };
+            sys.rhs(t_new, &y_new, &mut f2);
+            self.stats.rhs_evals += 2;
+            let k3 = lu.solve(&(f2 - (k2 - f1) * e32 - (k1 - f0) * two + hdt));
+            let err = if all_finite(&y_new) && all_finite(&f2) {
+                let errv = (k1 - k2 * two + k3) * (hs / lit::<T>(6.0));
+                self.tol.error_norm(&errv, &y, &y_new)
+            } else {
+                nonfinite += 1;
+                if nonfinite > 20 {
+                    return Err(IntegrateError::NonFiniteRhs { t: to_f64(t) });
+                }
+                crate::scalar::nan()
+            };
+            let (accept, h_next) = self.ctrl.propose(err, hs);
+            if accept {
+                self.dense = Rosenbrock23Dense {
+                    t0: t,
+                    t1: t_new,
+                    h: hs,
+                    y0: y,
+                    y1: y_new,
+                    f0,
+                    f1: f2,
+                    k1,
+                    k2,
+                };
+                self.t = t_new;
+                self.y = y_new;
+                self.f = f2;
+                self.h = Some(if lands { h_next.max(h) } else { h_next });
+                self.stats.accepted += 1;
+                return Ok(());
+            }
+            self.stats.rejected += 1;
+            h = h_next;
+        }
+    }
+
+    fn current(&self) -> (T, &SVector<T, N>) {
+        (self.t, &self.y)
+    }
+
+    fn dense(&self) -> &Self::Dense {
+        &self.dense
+    }
+
+    fn stats(&self) -> &Stats {
+        &self.stats
+    }
+
+    fn stats_mut(&mut self) -> &mut Stats {
+        &mut self.stats
+    }
+
+    fn order(&self) -> u8 {
+        2
+    }
+}
