@@ -52,6 +52,7 @@ pub mod linalg;
 pub mod lyapunov;
 pub mod model;
 pub mod roots;
+pub mod sample;
 pub mod scalar;
 pub mod signal;
 pub mod sweep;
