@@ -153,15 +153,20 @@ pub fn brent<T: Real, F: FnMut(T) -> T>(
 }
 
 /// Maximizes a unimodal `f` on `[a, b]` by golden-section search to an absolute tolerance
-/// `xtol`; returns `(x*, f(x*))`.
+/// `xtol` (floored at the floating-point resolution of the interval, and capped at 300
+/// iterations, so it always terminates); returns `(x*, f(x*))`.
 pub fn golden_max<T: Real, F: FnMut(T) -> T>(mut f: F, a: T, b: T, xtol: T) -> (T, T) {
     let g = lit::<T>(0.618_033_988_749_894_9);
-    let (mut a, mut b) = (a, b);
+    let (mut a, mut b) = (a.min(b), a.max(b));
+    let floor = lit::<T>(4.0) * T::default_epsilon() * a.abs().max(b.abs());
+    let xtol = xtol.max(floor);
     let mut c = b - g * (b - a);
     let mut d = a + g * (b - a);
     let mut fc = f(c);
     let mut fd = f(d);
-    while (b - a).abs() > xtol {
+    let mut iter = 0;
+    while (b - a) > xtol && iter < 300 {
+        iter += 1;
         if fc > fd {
             b = d;
             d = c;
@@ -221,6 +226,14 @@ mod tests {
             ),
             Err(RootError::NotFinite { .. })
         ));
+    }
+
+    #[test]
+    fn golden_section_terminates_below_resolution() {
+        let (x, _) = golden_max(|x: f64| -(x - 5.0).abs(), 5.0, 5.0 + 1e-15, 1e-30);
+        assert!((x - 5.0).abs() < 1e-14);
+        let (x, _) = golden_max(|x: f64| x, 3.0, 3.0, 1e-30);
+        assert_eq!(x, 3.0);
     }
 
     #[test]

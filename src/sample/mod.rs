@@ -20,6 +20,6 @@ mod samplers;
 
 pub use period::{Regime, detect_period};
 pub use samplers::{
-    Impact, ImpactSequence, PeriodRecord, PeriodSummary, Periodic, PhaseClock, Section, SectionClock, SectionPoint,
-    Stroboscopic, Trajectory,
+    Impact, ImpactSequence, PeriodRecord, PeriodSummary, Periodic, PhaseClock, Section,
+    SectionClock, SectionPoint, Stroboscopic, Trajectory,
 };

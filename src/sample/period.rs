@@ -40,7 +40,11 @@ pub fn detect_period<T: Real, const N: usize>(
         }
         let ok = (0..points.len() - p).all(|i| {
             (0..N).all(|c| {
-                let s = if scale[c] > T::zero() { scale[c] } else { T::one() };
+                let s = if scale[c] > T::zero() {
+                    scale[c]
+                } else {
+                    T::one()
+                };
                 ((points[i + p][c] - points[i][c]) / s).abs() <= tol
             })
         });
@@ -59,11 +63,15 @@ mod tests {
     #[test]
     fn detects_periods() {
         let s = Vector2::new(1.0, 1.0);
-        let p2: Vec<_> = (0..20).map(|i| Vector2::new(if i % 2 == 0 { 1.0 } else { -1.0 }, 0.0)).collect();
+        let p2: Vec<_> = (0..20)
+            .map(|i| Vector2::new(if i % 2 == 0 { 1.0 } else { -1.0 }, 0.0))
+            .collect();
         assert_eq!(detect_period(&p2, &s, 1e-9, 8), Regime::Periodic(2));
         let p1: Vec<_> = (0..20).map(|_| Vector2::new(0.5, 0.1)).collect();
         assert_eq!(detect_period(&p1, &s, 1e-9, 8), Regime::Periodic(1));
-        let chaos: Vec<_> = (0..50).map(|i| Vector2::new((i as f64 * 1.7).sin(), 0.0)).collect();
+        let chaos: Vec<_> = (0..50)
+            .map(|i| Vector2::new((i as f64 * 1.7).sin(), 0.0))
+            .collect();
         assert_eq!(detect_period(&chaos, &s, 1e-6, 8), Regime::NotPeriodic);
         assert_eq!(Regime::Periodic(3).period(), Some(3));
     }

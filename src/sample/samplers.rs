@@ -9,7 +9,6 @@ use crate::integrate::DenseOutput;
 use crate::roots::golden_max;
 use crate::scalar::lit;
 
-
 /// The times `t_i` of a stroboscopic section.
 pub trait SectionClock<T: Real> {
     /// The `i`-th section time, if defined.
@@ -41,7 +40,10 @@ impl<T: Real> Periodic<T> {
     /// # Errors
     /// [`ParameterError`] unless `origin` is finite and `period` finite and > 0.
     pub fn new(origin: T, period: T) -> Result<Self, ParameterError> {
-        Ok(Self { origin: finite("origin", origin)?, period: positive("period", period)? })
+        Ok(Self {
+            origin: finite("origin", origin)?,
+            period: positive("period", period)?,
+        })
     }
 }
 
@@ -52,7 +54,11 @@ impl<T: Real> SectionClock<T> for Periodic<T> {
     }
     fn first_index_from(&self, t: T) -> u64 {
         let k = ((t - self.origin) / self.period - lit::<T>(1e-9)).ceil();
-        if k <= T::zero() { 0 } else { k.to_subset().unwrap_or(0.0) as u64 }
+        if k <= T::zero() {
+            0
+        } else {
+            k.to_subset().unwrap_or(0.0) as u64
+        }
     }
 }
 
@@ -87,7 +93,11 @@ struct Store<R> {
 
 impl<R> Store<R> {
     fn new(capacity: usize) -> Self {
-        Self { items: Vec::new(), capacity, dropped: 0 }
+        Self {
+            items: Vec::new(),
+            capacity,
+            dropped: 0,
+        }
     }
     fn push(&mut self, r: R) {
         if self.items.len() < self.capacity {
@@ -129,7 +139,12 @@ impl<T: Real, const N: usize> Stroboscopic<T, N, Periodic<T>> {
     ///
     /// # Errors
     /// [`ParameterError`] for a non-finite origin or `record_from`, or a non-positive period.
-    pub fn periodic(origin: T, period: T, record_from: T, capacity: usize) -> Result<Self, ParameterError> {
+    pub fn periodic(
+        origin: T,
+        period: T,
+        record_from: T,
+        capacity: usize,
+    ) -> Result<Self, ParameterError> {
         Self::new(Periodic::new(origin, period)?, record_from, capacity)
     }
 }
@@ -140,7 +155,12 @@ impl<T: Real, const N: usize, C: SectionClock<T>> Stroboscopic<T, N, C> {
     /// # Errors
     /// [`ParameterError`] if `record_from` is not finite.
     pub fn new(clock: C, record_from: T, capacity: usize) -> Result<Self, ParameterError> {
-        Ok(Self { clock, next: None, record_from: finite("record_from", record_from)?, store: Store::new(capacity) })
+        Ok(Self {
+            clock,
+            next: None,
+            record_from: finite("record_from", record_from)?,
+            store: Store::new(capacity),
+        })
     }
 
     /// The recorded points.
@@ -175,7 +195,11 @@ impl<T: Real, const N: usize, C: SectionClock<T>> Observer<T, N> for Stroboscopi
         if let Some((i, t)) = self.next {
             if (t - t0).abs() <= lit::<T>(4.0) * T::default_epsilon() * t0.abs().max(T::one()) {
                 if t0 >= self.record_from {
-                    self.store.push(SectionPoint { index: i, t: t0, y: *y0 });
+                    self.store.push(SectionPoint {
+                        index: i,
+                        t: t0,
+                        y: *y0,
+                    });
                 }
                 self.advance(i + 1);
             }
@@ -325,7 +349,12 @@ impl<T: Real, const N: usize> Observer<T, N> for ImpactSequence<T> {
         self.current_max = T::zero();
         if e.t >= self.record_from {
             self.count += 1;
-            self.store.push(Impact { t: e.t, velocity: e.y[self.velocity], interval, max_penetration: None });
+            self.store.push(Impact {
+                t: e.t,
+                velocity: e.y[self.velocity],
+                interval,
+                max_penetration: None,
+            });
         }
         Control::Continue
     }
@@ -334,7 +363,11 @@ impl<T: Real, const N: usize> Observer<T, N> for ImpactSequence<T> {
 /// The maximum of `y[pos]` over a step view, using the ends and, when `y[vel]` changes sign
 /// from + to −, the interior maximum of the interpolant (golden section).
 #[inline]
-fn component_max<T: Real, const N: usize, D: DenseOutput<T, N>>(s: &StepView<'_, T, N, D>, pos: usize, vel: usize) -> T {
+fn component_max<T: Real, const N: usize, D: DenseOutput<T, N>>(
+    s: &StepView<'_, T, N, D>,
+    pos: usize,
+    vel: usize,
+) -> T {
     let mut m = s.y0[pos].max(s.y1[pos]);
     if s.y0[vel] > T::zero() && s.y1[vel] < T::zero() {
         let tol = (s.t1 - s.t0) * lit(1e-10);
@@ -355,7 +388,11 @@ fn component_max<T: Real, const N: usize, D: DenseOutput<T, N>>(s: &StepView<'_,
 
 /// The minimum of `y[pos]` over a step view (see [`component_max`]).
 #[inline]
-fn component_min<T: Real, const N: usize, D: DenseOutput<T, N>>(s: &StepView<'_, T, N, D>, pos: usize, vel: usize) -> T {
+fn component_min<T: Real, const N: usize, D: DenseOutput<T, N>>(
+    s: &StepView<'_, T, N, D>,
+    pos: usize,
+    vel: usize,
+) -> T {
     let mut m = s.y0[pos].min(s.y1[pos]);
     if s.y0[vel] < T::zero() && s.y1[vel] > T::zero() {
         let tol = (s.t1 - s.t0) * lit(1e-10);
@@ -502,9 +539,19 @@ impl<T: Real, const N: usize, C: SectionClock<T>> Observer<T, N> for PeriodSumma
             let mut yb = SVector::zeros();
             s.state_at(t_lo, &mut ya);
             s.state_at(end, &mut yb);
-            let part = StepView { t0: t_lo, t1: end, y0: ya, y1: yb, dense: s.dense };
-            self.x_max = self.x_max.max(component_max(&part, self.position, self.velocity));
-            self.x_min = self.x_min.min(component_min(&part, self.position, self.velocity));
+            let part = StepView {
+                t0: t_lo,
+                t1: end,
+                y0: ya,
+                y1: yb,
+                dense: s.dense,
+            };
+            self.x_max = self
+                .x_max
+                .max(component_max(&part, self.position, self.velocity));
+            self.x_min = self
+                .x_min
+                .min(component_min(&part, self.position, self.velocity));
             if b <= s.t1 {
                 self.close();
                 self.open(i + 1, yb[self.position]);
@@ -550,7 +597,13 @@ impl<T: Real, const N: usize, G: EventFunction<T, N>> Section<T, N, G> {
     ///
     /// # Errors
     /// [`ParameterError`] unless `tol > 0` and `record_from` finite.
-    pub fn new(g: G, direction: Direction, tol: T, record_from: T, capacity: usize) -> Result<Self, ParameterError> {
+    pub fn new(
+        g: G,
+        direction: Direction,
+        tol: T,
+        record_from: T,
+        capacity: usize,
+    ) -> Result<Self, ParameterError> {
         Ok(Self {
             g,
             direction,
@@ -596,7 +649,11 @@ impl<T: Real, const N: usize, G: EventFunction<T, N>> Observer<T, N> for Section
                 s.state_at(tc, &mut y);
                 self.count += 1;
                 if tc >= self.record_from {
-                    self.store.push(SectionPoint { index: self.count - 1, t: tc, y });
+                    self.store.push(SectionPoint {
+                        index: self.count - 1,
+                        t: tc,
+                        y,
+                    });
                 }
             }
         }
@@ -621,7 +678,10 @@ impl<T: Real, const N: usize> Trajectory<T, N> {
     /// [`ParameterError`] for a non-positive `dt` or non-finite times.
     pub fn new(origin: T, dt: T, record_from: T, capacity: usize) -> Result<Self, ParameterError> {
         let clock = Periodic::new(origin, dt)?;
-        Ok(Self { clock, inner: Stroboscopic::new(clock, record_from, capacity)? })
+        Ok(Self {
+            clock,
+            inner: Stroboscopic::new(clock, record_from, capacity)?,
+        })
     }
 
     /// The samples.

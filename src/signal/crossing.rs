@@ -8,18 +8,7 @@ use crate::error::{finite, non_negative};
 /// of `x_I − 0.01 mm` (Sect. 3), i.e. `x_I − PAPER_IMPACT_OFFSET` in metres.
 pub const PAPER_IMPACT_OFFSET: f64 = 1.0e-5;
 
-/// Which crossings of a level count.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-pub enum Direction {
-    /// Upward: from strictly below the level to at-or-above it.
-    #[default]
-    Rising,
-    /// Downward: from strictly above the level to at-or-below it.
-    Falling,
-    /// Both (the union of the rising and the falling results).
-    Either,
-}
+pub use crate::event::Direction;
 
 /// One located crossing.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -3,12 +3,12 @@
 use nalgebra::SVector;
 
 use super::{Stop, StopEvent, SweepError};
+use crate::Dynamics;
 use crate::drive::Simulation;
 use crate::event::{Direction, Event};
 use crate::excite::Excitation;
 use crate::integrate::Stepper;
 use crate::sample::{ImpactSequence, PhaseClock, Stroboscopic};
-use crate::Dynamics;
 
 /// A stroboscopic point of a ramped run (forcing phase `2πi`).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -65,24 +65,43 @@ where
     St: Stepper<f64, N>,
     E: Excitation<f64> + Clone,
 {
-    let fail = |e: crate::Error| SweepError::Failed { param: f64::NAN, source: Box::new(e) };
+    let fail = |e: crate::Error| SweepError::Failed {
+        param: f64::NAN,
+        source: Box::new(e),
+    };
     let ev = Event::new(StopEvent(Some(stop)), Direction::Rising);
-    let mut sim = Simulation::new(system, stepper).with_events(ev).max_steps(usize::MAX).map_err(fail)?;
+    let mut sim = Simulation::new(system, stepper)
+        .with_events(ev)
+        .max_steps(usize::MAX)
+        .map_err(fail)?;
     let cap = usize::MAX;
-    let mut strobe = Stroboscopic::<f64, N, _>::new(PhaseClock(excitation.clone()), 0.0, cap).map_err(|e| fail(e.into()))?;
-    let mut impacts = ImpactSequence::new(0, stop.position, stop.velocity, stop.level, 0.0, cap).map_err(|e| fail(e.into()))?;
-    sim.run(0.0, y0, t_end, &mut (&mut strobe, &mut impacts)).map_err(fail)?;
+    let mut strobe = Stroboscopic::<f64, N, _>::new(PhaseClock(excitation.clone()), 0.0, cap)
+        .map_err(|e| fail(e.into()))?;
+    let mut impacts = ImpactSequence::new(0, stop.position, stop.velocity, stop.level, 0.0, cap)
+        .map_err(|e| fail(e.into()))?;
+    sim.run(0.0, y0, t_end, &mut (&mut strobe, &mut impacts))
+        .map_err(fail)?;
     let omega = |t: f64| excitation.angular_frequency(t).unwrap_or(f64::NAN);
     Ok(RampRecord {
         sections: strobe
             .points()
             .iter()
-            .map(|p| RampSection { index: p.index, t: p.t, omega: omega(p.t), y: p.y })
+            .map(|p| RampSection {
+                index: p.index,
+                t: p.t,
+                omega: omega(p.t),
+                y: p.y,
+            })
             .collect(),
         impacts: impacts
             .impacts()
             .iter()
-            .map(|i| RampImpact { t: i.t, omega: omega(i.t), interval: i.interval, velocity: i.velocity })
+            .map(|i| RampImpact {
+                t: i.t,
+                omega: omega(i.t),
+                interval: i.interval,
+                velocity: i.velocity,
+            })
             .collect(),
     })
 }
