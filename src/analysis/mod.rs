@@ -6,6 +6,7 @@
 //! | [`Spectrum`], [`SpectrumAnalyzer`] | one-sided amplitude spectrum of a uniformly sampled signal covering a whole number of forcing periods; harmonic amplitudes and phases; how many harmonics dominate | Fig. 9b |
 //! | [`fit_harmonics`] → [`HarmonicFit`] | least-squares truncated Fourier series $a_0 + \sum_k (a_k\cos k\omega t + b_k \sin k\omega t)$ | eq. (3) |
 //! | [`LinearizedResponse`] | the linearization about the static equilibrium $X_0$ and its grazing estimate | eq. (4), $\omega = 15.657$ |
+//! | [`steady_samples`], [`first_grazing`] | steady response sampled over whole periods from a simulation; the exact first grazing by a bracketing search in ω | eq. (3), Fig. 9, ω ≈ 14 |
 //! | [`AmplitudePhase`] | the amplitude–phase (one-point harmonic balance) method and its grazing estimate | eqs. (5)–(6), $\omega = 12.789$ |
 //!
 //! # Time origin
@@ -27,6 +28,7 @@
 mod approx;
 mod fit;
 mod spectrum;
+mod steady;
 
 pub use approx::{
     AmplitudePhase, AmplitudePhaseSolution, Forcing, ForcingAmplitude, LinearizedResponse,
@@ -37,6 +39,7 @@ pub use spectrum::{
     DOMINANCE_THRESHOLD, HarmonicComponent, PERIOD_TOLERANCE, SPACING_TOLERANCE, Spectrum,
     SpectrumAnalyzer,
 };
+pub use steady::{SteadySamples, first_grazing, steady_min_gap, steady_samples};
 
 use crate::error::ParameterError;
 use crate::roots::RootError;
@@ -184,4 +187,7 @@ pub enum AnalysisError {
     /// A root search failed to converge.
     #[error(transparent)]
     Root(#[from] RootError),
+    /// A simulation behind a steady-state analysis failed.
+    #[error("simulation failed: {0}")]
+    Simulation(String),
 }
