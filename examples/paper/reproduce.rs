@@ -1,0 +1,202 @@
+//! The computations behind the paper's numbers, shared by `examples/paper` and the golden
+//! test `tests/paper.rs`. Everything is assembled from the crate's generic parts.
+
+#![allow(dead_code)]
+
+use nalgebra::Vector2;
+use nonsmooth::analysis::{
+    AmplitudePhase, LinearizedResponse, Spectrum, TurningPoint, first_grazing, fit_harmonics,
+    steady_samples,
+};
+use nonsmooth::entropy::{
+    EntropyIndex, Histogram, HistogramEstimate, QRange, entropy_index, redundancy_curve,
+};
+use nonsmooth::integrate::{Dopri5, Tolerances};
+use nonsmooth::model::paper::{PAPER, PaperOscillator};
+use nonsmooth::sweep::{
+    Stop, SweepConfig, SweepDirection, SweepPoint, SweepResult, SweepSystem, Transition, run_point,
+    sweep,
+};
+
+pub type Res<T> = Result<T, nonsmooth::Error>;
+
+pub const TAU: f64 = std::f64::consts::TAU;
+
+pub fn stop() -> Stop {
+    Stop {
+        position: 0,
+        velocity: 1,
+        level: PAPER.x_i,
+    }
+}
+
+pub fn tolerances(rtol: f64) -> Tolerances<f64, 2> {
+    Tolerances::per_component(rtol, [rtol * 1e-4, rtol * 1e-2]).expect("valid tolerances")
+}
+
+pub fn make(w: f64) -> Res<SweepSystem<PaperOscillator<f64>>> {
+    Ok(SweepSystem {
+        system: PAPER.oscillator::<f64>(w)?,
+        period: TAU / w,
+        stop: Some(stop()),
+    })
+}
+
+pub fn rest() -> Res<Vector2<f64>> {
+    Ok(Vector2::new(PAPER.static_equilibrium()?, 0.0))
+}
+
+/// Static equilibrium and the two approximate solutions at ω = 14 with their grazing
+/// estimates: (X0, eq4 (sin, cos), eq4 grazing, eq6 (sin, cos), eq6 grazing).
+pub struct Approximations {
+    pub x0: f64,
+    pub eq4: (f64, f64),
+    pub eq4_grazing: f64,
+    pub eq6: (f64, f64),
+    pub eq6_grazing: f64,
+}
+
+pub fn approximations() -> Res<Approximations> {
+    let omega = 14.0;
+    let osc = PAPER.oscillator::<f64>(omega)?;
+    let x0 = PAPER.static_equilibrium()?;
+    let lin = LinearizedResponse::new(&osc, x0, PAPER.c)?;
+    let ap = AmplitudePhase::new(&osc, x0, PAPER.c)?;
+    let (a1, a2) = lin.coefficients(omega);
+    let eq4_grazing = lin.grazing_omega(PAPER.x_i, 10.0, 30.0)?;
+    let up = ap.solve(omega, TurningPoint::Upper)?;
+    let eq6_grazing = ap.grazing_omega(PAPER.x_i, TurningPoint::Lower, 10.0, 14.0)?;
+    Ok(Approximations {
+        x0,
+        eq4: (a1, a2),
+        eq4_grazing,
+        eq6: (up.sin_coefficient(), up.cos_coefficient()),
+        eq6_grazing,
+    })
+}
+
+/// The steady solution at ω (from rest, 100 transient periods), sampled over 4 periods.
+pub struct Steady {
+    pub omega: f64,
+    pub t: Vec<f64>,
+    pub x: Vec<f64>,
+    pub v: Vec<f64>,
+    /// a0, a1, b1, a2, b2 of the fit (3).
+    pub fit: [f64; 5],
+    /// Harmonic amplitudes j = 1..=12.
+    pub harmonics: Vec<f64>,
+}
+
+pub fn steady(omega: f64, rtol: f64) -> Res<Steady> {
+    let s = steady_samples(
+        PAPER.oscillator::<f64>(omega)?,
+        Dopri5::new(tolerances(rtol)),
+        rest()?,
+        TAU / omega,
+        100,
+        4,
+        512,
+    )?;
+    let x = s.component(0);
+    let v = s.component(1);
+    let f = fit_harmonics(&s.t, &x, omega, 2)?;
+    let sp = Spectrum::new(&s.t, &x, omega)?;
+    let harmonics = (1..=12)
+        .map(|j| sp.harmonic_amplitude(j))
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(Steady {
+        omega,
+        t: s.t,
+        x,
+        v,
+        fit: [f.a0, f.a[0], f.b[0], f.a[1], f.b[1]],
+        harmonics,
+    })
+}
+
+/// Harmonics at least `frac` of the largest.
+pub fn dominant(harmonics: &[f64], frac: f64) -> usize {
+    let max = harmonics.iter().cloned().fold(0.0, f64::max);
+    harmonics.iter().filter(|&&a| a >= frac * max).count()
+}
+
+pub fn first_grazing_omega(rtol: f64) -> Res<f64> {
+    let y0 = rest()?;
+    Ok(first_grazing(
+        |w: f64| Ok((PAPER.oscillator::<f64>(w)?, TAU / w, y0)),
+        || Dopri5::new(tolerances(rtol)),
+        0,
+        PAPER.x_i,
+        14.0,
+        14.1,
+        1e-4,
+        100,
+        2,
+    )?)
+}
+
+/// One frequency from rest with the paper's transients (100) and `record` periods.
+pub fn from_rest(omega: f64, record: u32, rtol: f64) -> Res<SweepPoint<2>> {
+    let cfg = SweepConfig::new(vec![omega])?.record(record)?;
+    Ok(run_point(
+        &cfg,
+        omega,
+        make(omega)?,
+        Dopri5::new(tolerances(rtol)),
+        rest()?,
+        100,
+    )?)
+}
+
+/// Up and down sweep with the paper's transients (100 first, 50 per step), 50 recorded.
+pub fn sweep_both(lo: f64, hi: f64, step: f64, record: u32, rtol: f64) -> Res<SweepResult<2>> {
+    let cfg = SweepConfig::grid(lo, hi, step)?
+        .direction(SweepDirection::Both)
+        .transients(100, 50)
+        .record(record)?;
+    Ok(sweep(
+        &cfg,
+        make,
+        || Dopri5::new(tolerances(rtol)),
+        rest()?,
+    )?)
+}
+
+/// The location of a transition: the midpoint of its parameter step.
+pub fn location(t: &Transition) -> f64 {
+    0.5 * (t.before + t.after)
+}
+
+/// The detected transition nearest to `value`.
+pub fn nearest(ts: &[Transition], value: f64) -> Option<f64> {
+    ts.iter()
+        .map(location)
+        .min_by(|a, b| (a - value).abs().total_cmp(&(b - value).abs()))
+}
+
+/// The entropy index of the inter-impact intervals at ω from rest (100 transient periods,
+/// `record` recorded), histogram on (0.05, 0.3) with step 0.001 (the paper's).
+pub struct Entropy {
+    pub omega: f64,
+    pub intervals: Vec<f64>,
+    pub estimate: HistogramEstimate<f64>,
+    pub index: Option<EntropyIndex<f64>>,
+    pub curve: Vec<(f64, f64)>,
+}
+
+pub fn entropy(omega: f64, record: u32, rtol: f64) -> Res<Entropy> {
+    let p = from_rest(omega, record, rtol)?;
+    let h = Histogram::new(0.05, 0.3, 0.001)?;
+    let estimate = h.estimate(&p.intervals)?;
+    let index = entropy_index(&estimate.probabilities, &QRange::default()).ok();
+    let curve = redundancy_curve(&estimate.probabilities, 0.05, 3.0, 300)
+        .map(|c| c.iter().map(|r| (r.q, r.redundancy)).collect())
+        .unwrap_or_default();
+    Ok(Entropy {
+        omega,
+        intervals: p.intervals,
+        estimate,
+        index,
+        curve,
+    })
+}
