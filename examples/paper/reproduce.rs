@@ -1,7 +1,7 @@
 //! The computations behind the paper's numbers, shared by `examples/paper` and the golden
 //! test `tests/paper.rs`. Everything is assembled from the crate's generic parts.
 
-#![allow(dead_code)]
+#![allow(dead_code, clippy::too_many_arguments)]
 
 use nalgebra::Vector2;
 use nonsmooth::analysis::{

@@ -1,4 +1,5 @@
 //! The summary table: one row per number the paper reports, beside ours.
+#![allow(clippy::too_many_arguments)]
 
 use std::fmt::Write as _;
 

@@ -452,6 +452,7 @@ impl<T: Real> PeriodSummary<T, Periodic<T>> {
     ///
     /// # Errors
     /// [`ParameterError`] for non-finite values or a non-positive period.
+    #[allow(clippy::too_many_arguments)]
     pub fn periodic(
         origin: T,
         period: T,
