@@ -6,8 +6,8 @@
 use nalgebra::SVector;
 
 use super::{
-    Controller, DenseOutput, IntegrateError, Stats, StepOptions, Stepper, Tolerances, all_finite,
-    clamp_to_limit, initial_step, min_step,
+    Controller, Core, DenseOutput, IntegrateError, Stats, StepOptions, Stepper, Tolerances,
+    all_finite, clamp_to_limit, core_accessors, min_step,
 };
 use crate::scalar::{lit, to_f64};
 use crate::{Dynamics, Real};
@@ -223,14 +223,8 @@ const D: [[f64; 16]; 4] = [
 pub struct Dop853<T: Real, const N: usize> {
     tol: Tolerances<T, N>,
     ctrl: Controller<T>,
-    t: T,
-    y: SVector<T, N>,
-    f: SVector<T, N>,
-    f_valid: bool,
-    initialized: bool,
-    h: Option<T>,
+    core: Core<T, N>,
     dense: Dop853Dense<T, N>,
-    stats: Stats,
 }
 
 /// Dense output of a [`Dop853`] step.
@@ -280,12 +274,7 @@ impl<T: Real, const N: usize> Dop853<T, N> {
         Self {
             tol,
             ctrl: Controller::new(opts, lit(8.0)),
-            t: T::zero(),
-            y: z,
-            f: z,
-            f_valid: false,
-            initialized: false,
-            h: opts.h_init,
+            core: Core::new(opts.h_init),
             dense: Dop853Dense {
                 t0: T::zero(),
                 t1: T::zero(),
@@ -296,7 +285,6 @@ impl<T: Real, const N: usize> Dop853<T, N> {
                 f1: z,
                 r: [z; 7],
             },
-            stats: Stats::default(),
         }
     }
 
@@ -325,49 +313,16 @@ impl<T: Real, const N: usize> Dop853<T, N> {
 impl<T: Real, const N: usize> Stepper<T, N> for Dop853<T, N> {
     type Dense = Dop853Dense<T, N>;
 
-    fn reset_state(&mut self, t: T, y: SVector<T, N>) {
-        self.t = t;
-        self.y = y;
-        self.f_valid = false;
-        self.initialized = true;
-    }
+    core_accessors!();
 
     fn step<S: Dynamics<T, N>>(&mut self, sys: &S, t_limit: T) -> Result<(), IntegrateError> {
-        if !self.initialized {
-            return Err(IntegrateError::NotInitialized);
-        }
-        if !(t_limit > self.t) {
-            return Err(IntegrateError::InvalidTimeSpan {
-                t0: to_f64(self.t),
-                t_end: to_f64(t_limit),
-            });
-        }
-        let t = self.t;
-        let y = self.y;
-        if !self.f_valid {
-            sys.rhs(t, &y, &mut self.f);
-            self.stats.rhs_evals += 1;
-            if !all_finite(&self.f) {
-                return Err(IntegrateError::NonFiniteRhs { t: to_f64(t) });
-            }
-            self.f_valid = true;
-        }
-        let mut h = match self.h {
-            Some(h) => h,
-            None => initial_step(
-                sys,
-                t,
-                &y,
-                &self.f,
-                8,
-                &self.tol,
-                self.ctrl.opts.h_max,
-                t_limit - t,
-                &mut self.stats.rhs_evals,
-            ),
-        };
+        self.core.begin(sys, t_limit)?;
+        let (t, y) = (self.core.t, self.core.y);
+        let mut h = self
+            .core
+            .proposed(sys, 8, &self.tol, self.ctrl.opts.h_max, t_limit);
         let mut k = [SVector::<T, N>::zeros(); 16];
-        k[0] = self.f;
+        k[0] = self.core.f;
         let mut nonfinite = 0u32;
         loop {
             let (hs, lands) = clamp_to_limit(t, h, t_limit);
@@ -390,7 +345,7 @@ impl<T: Real, const N: usize> Stepper<T, N> for Dop853<T, N> {
             let t_new = if lands { t_limit } else { t + hs };
             let mut f_new = SVector::zeros();
             sys.rhs(t_new, &y_new, &mut f_new);
-            self.stats.rhs_evals += 12;
+            self.core.stats.rhs_evals += 12;
             let err = if all_finite(&y_new) && all_finite(&f_new) {
                 let mut e3 = inc;
                 for &(j, b) in &BHH {
@@ -424,7 +379,7 @@ impl<T: Real, const N: usize> Stepper<T, N> for Dop853<T, N> {
                 for i in 13..16 {
                     Self::stage(sys, t, &y, hs, &mut k, i);
                 }
-                self.stats.rhs_evals += 3;
+                self.core.stats.rhs_evals += 3;
                 let ydiff = y_new - y;
                 let bspl = k[0] * hs - ydiff;
                 let mut r = [SVector::<T, N>::zeros(); 7];
@@ -450,32 +405,12 @@ impl<T: Real, const N: usize> Stepper<T, N> for Dop853<T, N> {
                     f1: f_new,
                     r,
                 };
-                self.t = t_new;
-                self.y = y_new;
-                self.f = f_new;
-                self.h = Some(if lands { h_next.max(h) } else { h_next });
-                self.stats.accepted += 1;
+                self.core.accept(t_new, y_new, f_new, h_next, lands, h);
                 return Ok(());
             }
-            self.stats.rejected += 1;
+            self.core.stats.rejected += 1;
             h = h_next;
         }
-    }
-
-    fn current(&self) -> (T, &SVector<T, N>) {
-        (self.t, &self.y)
-    }
-
-    fn dense(&self) -> &Self::Dense {
-        &self.dense
-    }
-
-    fn stats(&self) -> &Stats {
-        &self.stats
-    }
-
-    fn stats_mut(&mut self) -> &mut Stats {
-        &mut self.stats
     }
 
     fn order(&self) -> u8 {

@@ -3,8 +3,8 @@
 use nalgebra::SVector;
 
 use super::{
-    Controller, DenseOutput, IntegrateError, Stats, StepOptions, Stepper, Tolerances, all_finite,
-    clamp_to_limit, initial_step, min_step,
+    Controller, Core, DenseOutput, IntegrateError, Stats, StepOptions, Stepper, Tolerances,
+    all_finite, clamp_to_limit, core_accessors, min_step,
 };
 use crate::scalar::{lit, to_f64};
 use crate::{Dynamics, Real};
@@ -20,14 +20,8 @@ use crate::{Dynamics, Real};
 pub struct Dopri5<T: Real, const N: usize> {
     tol: Tolerances<T, N>,
     ctrl: Controller<T>,
-    t: T,
-    y: SVector<T, N>,
-    f: SVector<T, N>,
-    f_valid: bool,
-    initialized: bool,
-    h: Option<T>,
+    core: Core<T, N>,
     dense: Dopri5Dense<T, N>,
-    stats: Stats,
 }
 
 /// Dense output of a [`Dopri5`] step.
@@ -97,14 +91,8 @@ impl<T: Real, const N: usize> Dopri5<T, N> {
         Self {
             tol,
             ctrl: Controller::new(opts, lit(5.0)),
-            t: T::zero(),
-            y: SVector::zeros(),
-            f: SVector::zeros(),
-            f_valid: false,
-            initialized: false,
-            h: opts.h_init,
+            core: Core::new(opts.h_init),
             dense: Dopri5Dense::empty(),
-            stats: Stats::default(),
         }
     }
 
@@ -115,55 +103,21 @@ impl<T: Real, const N: usize> Dopri5<T, N> {
 
     /// The step size the controller proposes next.
     pub fn proposed_step(&self) -> Option<T> {
-        self.h
+        self.core.h
     }
 }
 
 impl<T: Real, const N: usize> Stepper<T, N> for Dopri5<T, N> {
     type Dense = Dopri5Dense<T, N>;
 
-    fn reset_state(&mut self, t: T, y: SVector<T, N>) {
-        self.t = t;
-        self.y = y;
-        self.f_valid = false;
-        self.initialized = true;
-    }
+    core_accessors!();
 
     fn step<S: Dynamics<T, N>>(&mut self, sys: &S, t_limit: T) -> Result<(), IntegrateError> {
-        if !self.initialized {
-            return Err(IntegrateError::NotInitialized);
-        }
-        if !(t_limit > self.t) {
-            return Err(IntegrateError::InvalidTimeSpan {
-                t0: to_f64(self.t),
-                t_end: to_f64(t_limit),
-            });
-        }
-        let t = self.t;
-        let y = self.y;
-        if !self.f_valid {
-            sys.rhs(t, &y, &mut self.f);
-            self.stats.rhs_evals += 1;
-            if !all_finite(&self.f) {
-                return Err(IntegrateError::NonFiniteRhs { t: to_f64(t) });
-            }
-            self.f_valid = true;
-        }
-        let k1 = self.f;
-        let mut h = match self.h {
-            Some(h) => h,
-            None => initial_step(
-                sys,
-                t,
-                &y,
-                &k1,
-                5,
-                &self.tol,
-                self.ctrl.opts.h_max,
-                t_limit - t,
-                &mut self.stats.rhs_evals,
-            ),
-        };
+        self.core.begin(sys, t_limit)?;
+        let (t, y, k1) = (self.core.t, self.core.y, self.core.f);
+        let mut h = self
+            .core
+            .proposed(sys, 5, &self.tol, self.ctrl.opts.h_max, t_limit);
         let c = |x: f64| lit::<T>(x);
         let (a21, a31, a32) = (c(1.0 / 5.0), c(3.0 / 40.0), c(9.0 / 40.0));
         let (a41, a42, a43) = (c(44.0 / 45.0), c(-56.0 / 15.0), c(32.0 / 9.0));
@@ -224,7 +178,7 @@ impl<T: Real, const N: usize> Stepper<T, N> for Dopri5<T, N> {
             sys.rhs(t_new, &yt, &mut k6);
             let y_new = y + (k1 * a71 + k3 * a73 + k4 * a74 + k5 * a75 + k6 * a76) * hs;
             sys.rhs(t_new, &y_new, &mut k7);
-            self.stats.rhs_evals += 6;
+            self.core.stats.rhs_evals += 6;
             let errv = (k1 * e1 + k3 * e3 + k4 * e4 + k5 * e5 + k6 * e6 + k7 * e7) * hs;
             let err = if all_finite(&y_new) && all_finite(&k7) {
                 self.tol.error_norm(&errv, &y, &y_new)
@@ -260,32 +214,12 @@ impl<T: Real, const N: usize> Stepper<T, N> for Dopri5<T, N> {
                     r4: ydiff - k7 * hs - bspl,
                     r5: (k1 * d1 + k3 * d3 + k4 * d4 + k5 * d5 + k6 * d6 + k7 * d7) * hs,
                 };
-                self.t = t_new;
-                self.y = y_new;
-                self.f = k7;
-                self.h = Some(if lands { h_next.max(h) } else { h_next });
-                self.stats.accepted += 1;
+                self.core.accept(t_new, y_new, k7, h_next, lands, h);
                 return Ok(());
             }
-            self.stats.rejected += 1;
+            self.core.stats.rejected += 1;
             h = h_next;
         }
-    }
-
-    fn current(&self) -> (T, &SVector<T, N>) {
-        (self.t, &self.y)
-    }
-
-    fn dense(&self) -> &Self::Dense {
-        &self.dense
-    }
-
-    fn stats(&self) -> &Stats {
-        &self.stats
-    }
-
-    fn stats_mut(&mut self) -> &mut Stats {
-        &mut self.stats
     }
 
     fn order(&self) -> u8 {

@@ -339,6 +339,140 @@ pub trait Stepper<T: Real, const N: usize> {
     fn order(&self) -> u8;
 }
 
+/// The state every one-step method keeps: `(t, y)`, the cached derivative `f(t, y)` (the
+/// first-same-as-last stage), the proposed next step and the work counters.
+#[derive(Debug, Clone)]
+pub(crate) struct Core<T: Real, const N: usize> {
+    pub(crate) t: T,
+    pub(crate) y: SVector<T, N>,
+    pub(crate) f: SVector<T, N>,
+    f_valid: bool,
+    initialized: bool,
+    pub(crate) h: Option<T>,
+    pub(crate) stats: Stats,
+}
+
+impl<T: Real, const N: usize> Core<T, N> {
+    pub(crate) fn new(h: Option<T>) -> Self {
+        Self {
+            t: T::zero(),
+            y: SVector::zeros(),
+            f: SVector::zeros(),
+            f_valid: false,
+            initialized: false,
+            h,
+            stats: Stats::default(),
+        }
+    }
+
+    /// Sets the state and drops the derivative cache.
+    pub(crate) fn reset(&mut self, t: T, y: SVector<T, N>) {
+        self.t = t;
+        self.y = y;
+        self.f_valid = false;
+        self.initialized = true;
+    }
+
+    /// Checks that there is a state and that `t_limit` lies ahead, and caches `f(t, y)`.
+    #[inline(always)]
+    pub(crate) fn begin<S: Dynamics<T, N>>(
+        &mut self,
+        sys: &S,
+        t_limit: T,
+    ) -> Result<(), IntegrateError> {
+        if !self.initialized {
+            return Err(IntegrateError::NotInitialized);
+        }
+        if !(t_limit > self.t) {
+            return Err(IntegrateError::InvalidTimeSpan {
+                t0: to_f64(self.t),
+                t_end: to_f64(t_limit),
+            });
+        }
+        if !self.f_valid {
+            sys.rhs(self.t, &self.y, &mut self.f);
+            self.stats.rhs_evals += 1;
+            if !all_finite(&self.f) {
+                return Err(IntegrateError::NonFiniteRhs { t: to_f64(self.t) });
+            }
+            self.f_valid = true;
+        }
+        Ok(())
+    }
+
+    /// The proposed step, or Hairer's initial guess for a method of order `order`.
+    #[inline(always)]
+    pub(crate) fn proposed<S: Dynamics<T, N>>(
+        &mut self,
+        sys: &S,
+        order: u8,
+        tol: &Tolerances<T, N>,
+        h_max: T,
+        t_limit: T,
+    ) -> T {
+        match self.h {
+            Some(h) => h,
+            None => initial_step(
+                sys,
+                self.t,
+                &self.y,
+                &self.f,
+                order,
+                tol,
+                h_max,
+                t_limit - self.t,
+                &mut self.stats.rhs_evals,
+            ),
+        }
+    }
+
+    /// Takes an accepted step: the new state and derivative, and the next proposed step
+    /// (not shrunk below the untruncated proposal `h` when the step was cut to land on the
+    /// limit).
+    #[inline(always)]
+    pub(crate) fn accept(
+        &mut self,
+        t: T,
+        y: SVector<T, N>,
+        f: SVector<T, N>,
+        h_next: T,
+        lands: bool,
+        h: T,
+    ) {
+        self.t = t;
+        self.y = y;
+        self.f = f;
+        self.h = Some(if lands { h_next.max(h) } else { h_next });
+        self.stats.accepted += 1;
+    }
+}
+
+/// The accessors every stepper implements the same way from its `core` and `dense` fields.
+macro_rules! core_accessors {
+    () => {
+        fn reset_state(&mut self, t: T, y: SVector<T, N>) {
+            self.core.reset(t, y);
+        }
+
+        fn current(&self) -> (T, &SVector<T, N>) {
+            (self.core.t, &self.core.y)
+        }
+
+        fn dense(&self) -> &Self::Dense {
+            &self.dense
+        }
+
+        fn stats(&self) -> &Stats {
+            &self.core.stats
+        }
+
+        fn stats_mut(&mut self) -> &mut Stats {
+            &mut self.core.stats
+        }
+    };
+}
+pub(crate) use core_accessors;
+
 /// PI step-size controller state (shared by the embedded methods).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct Controller<T> {

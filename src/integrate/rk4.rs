@@ -2,7 +2,7 @@
 
 use nalgebra::SVector;
 
-use super::{DenseOutput, IntegrateError, Stats, Stepper, all_finite};
+use super::{Core, DenseOutput, IntegrateError, Stats, Stepper, all_finite, core_accessors};
 use crate::error::{ParameterError, positive};
 use crate::scalar::{lit, to_f64};
 use crate::{Dynamics, Real};
@@ -16,13 +16,8 @@ use crate::{Dynamics, Real};
 #[derive(Debug, Clone)]
 pub struct Rk4<T: Real, const N: usize> {
     h: T,
-    t: T,
-    y: SVector<T, N>,
-    f: SVector<T, N>,
-    f_valid: bool,
-    initialized: bool,
+    core: Core<T, N>,
     dense: HermiteDense<T, N>,
-    stats: Stats,
 }
 
 /// Cubic Hermite interpolation between two states and their derivatives.
@@ -95,13 +90,8 @@ impl<T: Real, const N: usize> Rk4<T, N> {
         let z = SVector::zeros();
         Ok(Self {
             h: positive("h", h)?,
-            t: T::zero(),
-            y: z,
-            f: z,
-            f_valid: false,
-            initialized: false,
+            core: Core::new(None),
             dense: HermiteDense::new(T::zero(), T::zero(), z, z, z, z),
-            stats: Stats::default(),
         })
     }
 }
@@ -109,29 +99,11 @@ impl<T: Real, const N: usize> Rk4<T, N> {
 impl<T: Real, const N: usize> Stepper<T, N> for Rk4<T, N> {
     type Dense = HermiteDense<T, N>;
 
-    fn reset_state(&mut self, t: T, y: SVector<T, N>) {
-        self.t = t;
-        self.y = y;
-        self.f_valid = false;
-        self.initialized = true;
-    }
+    core_accessors!();
 
     fn step<S: Dynamics<T, N>>(&mut self, sys: &S, t_limit: T) -> Result<(), IntegrateError> {
-        if !self.initialized {
-            return Err(IntegrateError::NotInitialized);
-        }
-        if !(t_limit > self.t) {
-            return Err(IntegrateError::InvalidTimeSpan {
-                t0: to_f64(self.t),
-                t_end: to_f64(t_limit),
-            });
-        }
-        let (t, y) = (self.t, self.y);
-        if !self.f_valid {
-            sys.rhs(t, &y, &mut self.f);
-            self.stats.rhs_evals += 1;
-            self.f_valid = true;
-        }
+        self.core.begin(sys, t_limit)?;
+        let (t, y) = (self.core.t, self.core.y);
         // Land exactly on the limit when the remaining span is within 1e-9 of a step.
         let rest = t_limit - t;
         let (h, t_new) = if self.h >= rest * (T::one() - lit(1e-9)) {
@@ -140,7 +112,7 @@ impl<T: Real, const N: usize> Stepper<T, N> for Rk4<T, N> {
             (self.h, t + self.h)
         };
         let half = lit::<T>(0.5);
-        let k1 = self.f;
+        let k1 = self.core.f;
         let mut k2 = SVector::zeros();
         let mut k3 = SVector::zeros();
         let mut k4 = SVector::zeros();
@@ -150,32 +122,13 @@ impl<T: Real, const N: usize> Stepper<T, N> for Rk4<T, N> {
         let y_new = y + (k1 + (k2 + k3) * lit::<T>(2.0) + k4) * (h / lit::<T>(6.0));
         let mut f_new = SVector::zeros();
         sys.rhs(t_new, &y_new, &mut f_new);
-        self.stats.rhs_evals += 4;
+        self.core.stats.rhs_evals += 4;
         if !all_finite(&y_new) || !all_finite(&f_new) {
             return Err(IntegrateError::NonFiniteRhs { t: to_f64(t) });
         }
         self.dense = HermiteDense::new(t, t_new, y, y_new, k1, f_new);
-        self.t = t_new;
-        self.y = y_new;
-        self.f = f_new;
-        self.stats.accepted += 1;
+        self.core.accept(t_new, y_new, f_new, self.h, false, self.h);
         Ok(())
-    }
-
-    fn current(&self) -> (T, &SVector<T, N>) {
-        (self.t, &self.y)
-    }
-
-    fn dense(&self) -> &Self::Dense {
-        &self.dense
-    }
-
-    fn stats(&self) -> &Stats {
-        &self.stats
-    }
-
-    fn stats_mut(&mut self) -> &mut Stats {
-        &mut self.stats
     }
 
     fn order(&self) -> u8 {

@@ -3,8 +3,8 @@
 use nalgebra::{SMatrix, SVector};
 
 use super::{
-    Controller, DenseOutput, IntegrateError, Stats, StepOptions, Stepper, Tolerances, all_finite,
-    clamp_to_limit, initial_step, min_step,
+    Controller, Core, DenseOutput, IntegrateError, Stats, StepOptions, Stepper, Tolerances,
+    all_finite, clamp_to_limit, core_accessors, min_step,
 };
 use crate::linalg::Lu;
 use crate::scalar::{epsilon, lit, to_f64};
@@ -30,14 +30,8 @@ use crate::{Dynamics, Real};
 pub struct Rosenbrock23<T: Real, const N: usize> {
     tol: Tolerances<T, N>,
     ctrl: Controller<T>,
-    t: T,
-    y: SVector<T, N>,
-    f: SVector<T, N>,
-    f_valid: bool,
-    initialized: bool,
-    h: Option<T>,
+    core: Core<T, N>,
     dense: Rosenbrock23Dense<T, N>,
-    stats: Stats,
 }
 
 /// Dense output of a [`Rosenbrock23`] step: `y(t0 + s·h) = y0 + h·(s(1−s)/(1−2d)·k1 + s(s−2d)/(1−2d)·k2)`.
@@ -94,12 +88,7 @@ impl<T: Real, const N: usize> Rosenbrock23<T, N> {
         Self {
             tol,
             ctrl: Controller::new(opts, lit(3.0)),
-            t: T::zero(),
-            y: z,
-            f: z,
-            f_valid: false,
-            initialized: false,
-            h: opts.h_init,
+            core: Core::new(opts.h_init),
             dense: Rosenbrock23Dense {
                 t0: T::zero(),
                 t1: T::zero(),
@@ -111,7 +100,6 @@ impl<T: Real, const N: usize> Rosenbrock23<T, N> {
                 k1: z,
                 k2: z,
             },
-            stats: Stats::default(),
         }
     }
 
@@ -122,7 +110,7 @@ impl<T: Real, const N: usize> Rosenbrock23<T, N> {
         y: &SVector<T, N>,
         f0: &SVector<T, N>,
     ) -> SMatrix<T, N, N> {
-        self.stats.jacobian_evals += 1;
+        self.core.stats.jacobian_evals += 1;
         if let Some(j) = sys.jacobian(t, y) {
             return j;
         }
@@ -137,7 +125,7 @@ impl<T: Real, const N: usize> Rosenbrock23<T, N> {
             let mut yp = *y;
             yp[c] += dy;
             sys.rhs(t, &yp, &mut f1);
-            self.stats.rhs_evals += 1;
+            self.core.stats.rhs_evals += 1;
             j.set_column(c, &((f1 - f0) / dy));
         }
         j
@@ -156,7 +144,7 @@ impl<T: Real, const N: usize> Rosenbrock23<T, N> {
         let dt = epsilon::<T>().sqrt() * t.abs().max(T::one());
         let mut f1 = SVector::zeros();
         sys.rhs(t + dt, y, &mut f1);
-        self.stats.rhs_evals += 1;
+        self.core.stats.rhs_evals += 1;
         (f1 - f0) / dt
     }
 }
@@ -164,48 +152,15 @@ impl<T: Real, const N: usize> Rosenbrock23<T, N> {
 impl<T: Real, const N: usize> Stepper<T, N> for Rosenbrock23<T, N> {
     type Dense = Rosenbrock23Dense<T, N>;
 
-    fn reset_state(&mut self, t: T, y: SVector<T, N>) {
-        self.t = t;
-        self.y = y;
-        self.f_valid = false;
-        self.initialized = true;
-    }
+    core_accessors!();
 
     fn step<S: Dynamics<T, N>>(&mut self, sys: &S, t_limit: T) -> Result<(), IntegrateError> {
-        if !self.initialized {
-            return Err(IntegrateError::NotInitialized);
-        }
-        if !(t_limit > self.t) {
-            return Err(IntegrateError::InvalidTimeSpan {
-                t0: to_f64(self.t),
-                t_end: to_f64(t_limit),
-            });
-        }
-        let t = self.t;
-        let y = self.y;
-        if !self.f_valid {
-            sys.rhs(t, &y, &mut self.f);
-            self.stats.rhs_evals += 1;
-            if !all_finite(&self.f) {
-                return Err(IntegrateError::NonFiniteRhs { t: to_f64(t) });
-            }
-            self.f_valid = true;
-        }
-        let f0 = self.f;
-        let mut h = match self.h {
-            Some(h) => h,
-            None => initial_step(
-                sys,
-                t,
-                &y,
-                &f0,
-                2,
-                &self.tol,
-                self.ctrl.opts.h_max,
-                t_limit - t,
-                &mut self.stats.rhs_evals,
-            ),
-        };
+        self.core.begin(sys, t_limit)?;
+        let (t, y) = (self.core.t, self.core.y);
+        let f0 = self.core.f;
+        let mut h = self
+            .core
+            .proposed(sys, 2, &self.tol, self.ctrl.opts.h_max, t_limit);
         let jac = self.jacobian(sys, t, &y, &f0);
         let tdot = self.dfdt(sys, t, &y, &f0);
         let d = d_const::<T>();
@@ -227,7 +182,7 @@ impl<T: Real, const N: usize> Stepper<T, N> for Rosenbrock23<T, N> {
             let Some(lu) = Lu::new(w) else {
                 return Err(IntegrateError::SingularMatrix { t: to_f64(t) });
             };
-            self.stats.decompositions += 1;
+            self.core.stats.decompositions += 1;
             let hdt = tdot * (hs * d);
             let k1 = lu.solve(&(f0 + hdt));
             sys.rhs(t + half * hs, &(y + k1 * (half * hs)), &mut f1);
@@ -236,7 +191,7 @@ impl<T: Real, const N: usize> Stepper<T, N> for Rosenbrock23<T, N> {
             let y_new = y + k2 * hs;
             let t_new = if lands { t_limit } else { t + hs };
             sys.rhs(t_new, &y_new, &mut f2);
-            self.stats.rhs_evals += 2;
+            self.core.stats.rhs_evals += 2;
             let k3 = lu.solve(&(f2 - (k2 - f1) * e32 - (k1 - f0) * two + hdt));
             let err = if all_finite(&y_new) && all_finite(&f2) {
                 let errv = (k1 - k2 * two + k3) * (hs / lit::<T>(6.0));
@@ -261,32 +216,12 @@ impl<T: Real, const N: usize> Stepper<T, N> for Rosenbrock23<T, N> {
                     k1,
                     k2,
                 };
-                self.t = t_new;
-                self.y = y_new;
-                self.f = f2;
-                self.h = Some(if lands { h_next.max(h) } else { h_next });
-                self.stats.accepted += 1;
+                self.core.accept(t_new, y_new, f2, h_next, lands, h);
                 return Ok(());
             }
-            self.stats.rejected += 1;
+            self.core.stats.rejected += 1;
             h = h_next;
         }
-    }
-
-    fn current(&self) -> (T, &SVector<T, N>) {
-        (self.t, &self.y)
-    }
-
-    fn dense(&self) -> &Self::Dense {
-        &self.dense
-    }
-
-    fn stats(&self) -> &Stats {
-        &self.stats
-    }
-
-    fn stats_mut(&mut self) -> &mut Stats {
-        &mut self.stats
     }
 
     fn order(&self) -> u8 {
