@@ -1,6 +1,6 @@
 //! The crate's error type.
 //!
-//! One non-generic [`Error`] collects the module errors. Diagnostics are stored as `f64`
+//! One non-generic [`Error`](enum@Error) collects the module errors. Diagnostics are stored as `f64`
 //! (whatever the scalar type of the computation) so that errors are `Send + Sync + 'static`
 //! and can be printed, logged and matched without generic parameters.
 
@@ -68,7 +68,7 @@ pub enum Error {
     Output(String),
 }
 
-/// `Result` with the crate's [`Error`].
+/// `Result` with the crate's [`Error`](enum@Error).
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
 /// Validates that `value` is finite and strictly positive.
