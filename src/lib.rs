@@ -15,6 +15,11 @@
 //! | integrators | DOPRI5, DOP853, RK4, Rosenbrock 2(3) with dense output | [`integrate`] |
 //! | events | crossings located on dense output, grazing pairs, resets, Zeno guard | [`event`] |
 //! | driver | system + stepper + events + observers | [`drive`] |
+//! | samplers | stroboscopic sections, impact sequences, period summaries | [`sample`] |
+//! | sweeps | up/down continuation, hysteresis, transitions, ramps | [`sweep`] |
+//! | chaos measures | top Lyapunov exponents (two-trajectory and QR), Tsallis entropy index | [`lyapunov`], [`entropy`] |
+//! | analysis | spectra, harmonic fits, the paper's approximations, first grazing | [`analysis`] |
+//! | measured data | time series, filter, threshold impacts, identification | [`signal`], [`identify`] |
 //!
 //! ## Quick start
 //! ```

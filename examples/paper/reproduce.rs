@@ -12,6 +12,10 @@ use nonsmooth::entropy::{
     EntropyIndex, Histogram, HistogramEstimate, QRange, entropy_index, redundancy_curve,
 };
 use nonsmooth::integrate::{Dopri5, Tolerances};
+use nonsmooth::lyapunov::{
+    Diagram, DiagramSettings, IntervalRule, Norm, PAPER_D0, TwoTrajectory, pair_tolerances,
+    tle_diagram,
+};
 use nonsmooth::model::paper::{PAPER, PaperOscillator};
 use nonsmooth::sweep::{
     Stop, SweepConfig, SweepDirection, SweepPoint, SweepResult, SweepSystem, Transition, run_point,
@@ -199,4 +203,45 @@ pub fn entropy(omega: f64, record: u32, rtol: f64) -> Res<Entropy> {
         index,
         curve,
     })
+}
+
+/// The top Lyapunov exponent at ω from rest: two trajectories, d0 = `PAPER_D0`, the
+/// paper's norm, renormalized every forcing period, `transient` then `periods` periods.
+/// Returns (λ₁, standard error) in 1/s.
+pub fn tle(omega: f64, transient: usize, periods: usize, rtol: f64) -> Res<(f64, f64)> {
+    let osc = PAPER.oscillator::<f64>(omega)?;
+    let tol = pair_tolerances::<f64, 2, 4>(&tolerances(rtol))?;
+    let mut est =
+        TwoTrajectory::<f64, 2, 4, _, _>::new(osc, Dopri5::new(tol), PAPER_D0, Norm::paper())?;
+    est.start(0.0, rest()?)?;
+    let tau = TAU / omega;
+    est.transient(tau, transient)?;
+    let e = est.estimate(tau, periods)?;
+    Ok((e.exponent, e.spread))
+}
+
+/// The TLE diagram (Fig. 5) over `omegas`, both directions with continuation.
+pub fn tle_fig5(
+    omegas: &[f64],
+    transient: usize,
+    step_transient: usize,
+    periods: usize,
+    rtol: f64,
+) -> Res<Diagram<f64>> {
+    let settings = DiagramSettings::new(
+        IntervalRule::ForcingPeriod,
+        transient,
+        step_transient,
+        periods,
+    )?;
+    let tol = pair_tolerances::<f64, 2, 4>(&tolerances(rtol))?;
+    Ok(tle_diagram(
+        |w: f64| Ok(PAPER.oscillator::<f64>(w)?),
+        &Dopri5::new(tol),
+        rest()?,
+        omegas,
+        PAPER_D0,
+        Norm::paper(),
+        &settings,
+    )?)
 }
