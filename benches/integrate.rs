@@ -1,12 +1,67 @@
-//! Benchmarks of the `integrate` module (filled in as the module lands).
+//! The paper's oscillator at ω = 20.465 rad/s: every impact (upward crossing of x_I) located
+//! and the state at every t = 2πi/ω recorded (exact landing), with DOPRI5 and DOP853 at
+//! rtol 1e-6, 1e-8, 1e-10.
+//!
+//! - `w1_100`: 100 forcing periods from rest at the static equilibrium (the start of W1,
+//!   including the stiff phase in resting contact).
+//! - `w2_100`: 100 periods on the attractor (from the state after 100 periods).
+//!
+//! Time per period = reported time / 100.
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use nalgebra::Vector2;
+use nonsmooth::drive::Simulation;
+use nonsmooth::event::{Direction, Event, Level};
+use nonsmooth::integrate::{Dop853, Dopri5, Stepper, Tolerances};
+use nonsmooth::model::paper::PAPER;
+use nonsmooth::sample::{ImpactSequence, Stroboscopic};
+use std::hint::black_box;
 
-fn placeholder(c: &mut Criterion) {
-    c.bench_function("integrate_noop", |b| {
-        b.iter(|| std::hint::black_box(1.0_f64).sqrt())
-    });
+const OMEGA: f64 = 20.465;
+
+fn tol(rtol: f64) -> Tolerances<f64, 2> {
+    Tolerances::per_component(rtol, [rtol * 1e-4, rtol * 1e-2]).unwrap()
 }
 
-criterion_group!(benches, placeholder);
+fn run<St: Stepper<f64, 2>>(st: St, y0: Vector2<f64>, periods: u32) -> (usize, Vector2<f64>) {
+    let period = std::f64::consts::TAU / OMEGA;
+    let osc = PAPER.oscillator::<f64>(OMEGA).unwrap();
+    let ev = Event::new(Level::new(0, PAPER.x_i).unwrap(), Direction::Rising);
+    let mut sim = Simulation::new(osc, st)
+        .with_events(ev)
+        .landing_grid(Some((0.0, period)))
+        .unwrap();
+    let mut strobe = Stroboscopic::<f64, 2>::periodic(0.0, period, 0.0, 1 << 20).unwrap();
+    let mut imp = ImpactSequence::new(0, 0, 1, PAPER.x_i, 0.0, 1 << 20).unwrap();
+    let out = sim
+        .run(
+            0.0,
+            y0,
+            periods as f64 * period,
+            &mut (&mut strobe, &mut imp),
+        )
+        .unwrap();
+    (imp.impacts().len() + strobe.points().len(), out.y)
+}
+
+fn bench(c: &mut Criterion) {
+    let rest = Vector2::new(PAPER.static_equilibrium().unwrap(), 0.0);
+    let (_, on_attractor) = run(Dopri5::new(tol(1e-10)), rest, 100);
+    let mut g = c.benchmark_group("paper_20.465");
+    g.sample_size(10);
+    for rtol in [1e-6, 1e-8, 1e-10] {
+        g.bench_function(format!("w1_100/dopri5/{rtol:e}"), |b| {
+            b.iter(|| black_box(run(Dopri5::new(tol(rtol)), rest, 100)))
+        });
+        g.bench_function(format!("w2_100/dopri5/{rtol:e}"), |b| {
+            b.iter(|| black_box(run(Dopri5::new(tol(rtol)), on_attractor, 100)))
+        });
+        g.bench_function(format!("w2_100/dop853/{rtol:e}"), |b| {
+            b.iter(|| black_box(run(Dop853::new(tol(rtol)), on_attractor, 100)))
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench);
 criterion_main!(benches);
