@@ -39,10 +39,14 @@
 
 mod fit;
 mod objective;
+mod paper;
 mod space;
 
 pub use fit::{FitReport, NelderMeadOptions, Termination, fit_nelder_mead};
 pub use objective::{M2_TO_MM2, objective_f0, objective_f0_mm2};
+pub use paper::{
+    Forcing, PAPER_FIT_PARAMETERS, PaperFit, PaperFitReport, paper_parameter, set_paper_parameter,
+};
 pub use space::{ParamValues, Parameter, ParameterSpace, Transform};
 
 use crate::error::ParameterError;

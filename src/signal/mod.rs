@@ -47,6 +47,7 @@ mod crossing;
 mod filter;
 mod phase;
 mod series;
+mod synthetic;
 
 pub use crossing::{
     Crossing, Direction, PAPER_IMPACT_OFFSET, ThresholdCrossing, intervals, intervals_into,
@@ -57,6 +58,8 @@ pub use phase::{
     unwrap_phase_inplace,
 };
 pub use series::{Column, CsvOptions, PhaseColumn, TimeSeries};
+pub(crate) use synthetic::run_paper;
+pub use synthetic::{Forcing, NormalNoise, SyntheticExperiment, SyntheticRecord};
 
 use crate::error::ParameterError;
 use crate::scalar::to_f64;
