@@ -325,18 +325,18 @@ pub fn print_hysteresis(result: &SweepResult<2>, tol: f64) -> Vec<(f64, f64)> {
         .and_then(|b| b.points.get(..2))
         .map_or(1.0, |p| (p[1].param - p[0].param).abs());
     let values = |(a, b): &(f64, f64)| ((b - a) / step).round() as usize + 1;
-    let (wide, narrow): (Vec<(f64, f64)>, Vec<(f64, f64)>) =
-        h.iter().partition(|iv| values(iv) >= 3);
+    let wide: Vec<&(f64, f64)> = h.iter().filter(|iv| values(iv) >= 3).collect();
+    let narrow: Vec<&(f64, f64)> = h.iter().filter(|iv| values(iv) < 3).collect();
     println!(
         "hysteresis (up and down branches differ, tol {tol:e}): {} intervals of ≥ 3 values",
         wide.len()
     );
-    for iv in &wide {
+    for iv in wide {
         println!("  ω ∈ [{:.4}, {:.4}] ({} values)", iv.0, iv.1, values(iv));
     }
     let list: Vec<String> = narrow
         .iter()
-        .map(|(a, b)| {
+        .map(|&&(a, b)| {
             if a == b {
                 format!("{a:.3}")
             } else {
