@@ -56,6 +56,7 @@ pub mod integrate;
 pub mod linalg;
 pub mod lyapunov;
 pub mod model;
+pub mod output;
 pub mod roots;
 pub mod sample;
 pub mod scalar;
