@@ -283,9 +283,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             ts.len(),
             hy
         );
-        let tol = 2.0 * st_;
+        // A match must be closer than two grid steps and than a quarter of the mean spacing of
+        // the detected transitions (else "nearest" would match anything by chance).
+        let spacing = (hi - lo) / ts.len().max(1) as f64;
+        let tol = (2.0 * st_).min(0.25 * spacing);
         let reason = format!(
-            "nearest of the {} transitions (changes of impacts per period or of period) detected on the up branch, grid step {st_}",
+            "nearest of the {} transitions (changes of impacts per period or of period) detected on the up branch, grid step {st_}; match tolerance {tol:.3} rad/s",
             ts.len()
         );
         if fig == "fig3" {
@@ -439,9 +442,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     );
 
     // Identification (Sect. 2): F0 of a fit to a synthetic measurement.
-    let (dur, names): (f64, &[&str]) = if a.quick { (1.0, &["k", "c", "T"]) } else { (2.0, &["k", "c", "T", "k_i"]) };
+    let (dur, names): (f64, &[&str]) = if a.quick {
+        (1.0, &["k", "c", "T"])
+    } else {
+        (2.0, &["k", "c", "T", "k_i"])
+    };
     let (f0, floor, rel, sims) = synthetic_fit(dur, names)?;
-    println!("  fit of {names:?} on {dur} s of synthetic data: F0 = {f0:.4e} mm² (true parameters {floor:.4e}), fitted/true {rel:.4?}, {sims} simulations");
+    println!(
+        "  fit of {names:?} on {dur} s of synthetic data: F0 = {f0:.4e} mm² (true parameters {floor:.4e}), fitted/true {rel:.4?}, {sims} simulations"
+    );
     s.compare(
         "fit_F0_mm2",
         "F0 of the Nelder–Mead fit",

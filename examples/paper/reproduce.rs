@@ -258,7 +258,9 @@ pub fn synthetic_fit(duration: f64, names: &[&str]) -> Res<(f64, f64, Vec<f64>, 
         .with_noise(2e-6, 7)?
         .with_disturbance(1e-6, 60.0)?
         .generate()?;
-    let floor = PaperFit::new(rec.measured.clone(), (0.0, duration), forcing, PAPER)?.objective(&PAPER)? * M2_TO_MM2;
+    let floor = PaperFit::new(rec.measured.clone(), (0.0, duration), forcing, PAPER)?
+        .objective(&PAPER)?
+        * M2_TO_MM2;
     let mut fit = PaperFit::new(rec.measured, (0.0, duration), forcing, PAPER)?
         .with_options(NelderMeadOptions::default().with_tolerances(1e-4, 1e-6));
     for n in names {

@@ -385,11 +385,39 @@ where
         intervals,
         impact_velocities,
         impacts: impacts.count(),
-        impacts_per_period: impacts.count() as f64 / config.record as f64,
+        impacts_per_period: impacts_per_period(
+            periods.periods(),
+            regime,
+            impacts.count(),
+            config.record,
+        ),
         regime,
         grazing_margin,
         end_state: out.y,
     })
+}
+
+/// Impacts per forcing period: for a period-`p` orbit counted over the largest whole number
+/// of orbit periods in the window (a 50-period window holds no whole number of period-3
+/// orbits, and the plain average would flicker between neighbouring values); otherwise the
+/// average over the window.
+fn impacts_per_period(
+    periods: &[crate::sample::PeriodRecord<f64>],
+    regime: Regime,
+    total: u64,
+    record: u32,
+) -> f64 {
+    if let Regime::Periodic(p) = regime {
+        let whole = (periods.len() / p) * p;
+        if whole > 0 {
+            let n: u64 = periods[periods.len() - whole..]
+                .iter()
+                .map(|r| r.impacts as u64)
+                .sum();
+            return n as f64 / whole as f64;
+        }
+    }
+    total as f64 / record as f64
 }
 
 /// Runs a sweep.
