@@ -9,6 +9,7 @@
 //! Writes the CSV behind every figure the model can make, and `summary.json` /
 //! `summary.md`: one row per number the paper reports, the paper's value beside ours.
 
+mod figures;
 mod reproduce;
 mod summary;
 
@@ -71,6 +72,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         if a.quick { "quick" } else { "full" },
         a.out.display()
     );
+    if !figures::ENABLED {
+        println!("(CSV only: build with `--features plot` for the PNG figures)");
+    }
 
     // Sect. 5: static equilibrium and the approximate solutions.
     let ap = approximations()?;
@@ -183,6 +187,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             vec![t, x, fit, lin.displacement(w, t), ap6.displacement(t)]
         }),
     )?;
+    {
+        let eq4: Vec<f64> = st.t.iter().map(|&t| lin.displacement(14.0, t)).collect();
+        let eq6: Vec<f64> = st.t.iter().map(|&t| ap6.displacement(t)).collect();
+        figures::solution(&a.out, &st, &eq4, &eq6)?;
+    }
     write_csv(
         &a.out,
         "fig9b_spectrum.csv",
@@ -275,6 +284,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for (fig, lo, hi, st_) in [("fig3", 20.5, 25.0, step3), ("fig4", 17.5, 20.5, step4)] {
         let r = sweep_both(lo, hi, st_, record, rtol)?;
         write_sweep(&a.out, fig, &r)?;
+        figures::bifurcation(&a.out, fig, &r)?;
         let up = &r.branches[0];
         let ts = nonsmooth::sweep::transitions(up);
         let hy = nonsmooth::sweep::hysteresis(&r, 1e-3);
@@ -386,6 +396,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ]);
     }
     write_csv(&a.out, "fig7_q.csv", "omega_rad_s,q,states", fig7.clone())?;
+    figures::entropy(&a.out, &e)?;
+    figures::q_omega(
+        &a.out,
+        &fig7
+            .iter()
+            .filter(|r| r[1].is_finite())
+            .map(|r| (r[0], r[1]))
+            .collect::<Vec<_>>(),
+    )?;
     for (id, w) in [("q_20.44", 20.44), ("q_20.48", 20.48)] {
         let e = entropy(w, rec_q, rtol)?;
         let q = e.index.map(|i| i.q);
@@ -435,6 +454,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "fig5_tle.csv",
         "omega_rad_s,direction,tle_per_s,spread_per_s",
         rows5,
+    )?;
+    figures::tle(
+        &a.out,
+        &d.increasing
+            .iter()
+            .map(|p| (p.parameter, p.exponent))
+            .collect::<Vec<_>>(),
+        &d.decreasing
+            .iter()
+            .map(|p| (p.parameter, p.exponent))
+            .collect::<Vec<_>>(),
     )?;
     step(
         &format!("Fig. 5 (TLE, step {step5}, {periods5} periods)"),
