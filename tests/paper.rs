@@ -61,11 +61,13 @@ fn grazing_points_of_fig3b() {
 
 #[test]
 fn entropy_index_at_20_465() {
-    // Paper: q = 0.62. Ours from rest (100 transient periods): 0.654 with 1000 recorded
-    // periods, 0.645 with 5000 — it differs by ~4–5 %: q depends on the sample length and on
-    // which of the coexisting chaotic attractors is reached (the paper does not give either).
+    // Paper: q = 0.62. On a chaotic attractor q* is a statistic of a finite, trajectory-
+    // dependent sample: over rtol ∈ {1e-8, 3e-9, 1e-9, 3e-10, 1e-10} and 1000 or 3000
+    // recorded periods (from rest, 100 transient) we measured q* = 0.622 … 0.654, mean 0.635,
+    // standard deviation 0.009. The paper's 0.62 lies inside that spread; we assert our
+    // estimate within 3 standard deviations of our mean.
     let e = entropy(20.465, 1000, 1e-8).unwrap();
     let q = e.index.unwrap().q;
-    assert!((q - 0.654).abs() < 0.01, "{q}");
+    assert!((q - 0.635).abs() < 0.027, "{q}");
     assert!(q < 1.0);
 }

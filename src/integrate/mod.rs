@@ -479,7 +479,8 @@ pub(crate) struct Controller<T> {
     pub(crate) opts: StepOptions<T>,
     /// `1/q − 0.75·β` with `q` the order used for the error estimate.
     expo: T,
-    err_old: T,
+    /// `ln` of the error norm of the last accepted step (floored at `ln 10⁻⁴`).
+    ln_err_old: T,
     rejected_last: bool,
 }
 
@@ -489,12 +490,15 @@ impl<T: Real> Controller<T> {
         Self {
             opts,
             expo,
-            err_old: lit(1e-4),
+            ln_err_old: lit::<T>(1e-4).ln(),
             rejected_last: false,
         }
     }
 
     /// Given the error norm of a trial step of size `h`, returns `(accept, h_next)`.
+    ///
+    /// One `ln` and one `exp` per call: `fac = err^expo / err_old^β` is evaluated as
+    /// `exp(expo·ln err − β·ln err_old)` with `ln err_old` kept from the last acceptance.
     #[inline(always)]
     pub(crate) fn propose(&mut self, err: T, h: T) -> (bool, T) {
         let o = &self.opts;
@@ -502,14 +506,14 @@ impl<T: Real> Controller<T> {
             self.rejected_last = true;
             return (false, h * lit(0.1));
         }
-        let fac11 = if err > T::zero() {
-            (self.expo * err.ln()).exp()
+        let ln_err = if err > T::zero() {
+            err.ln()
         } else {
-            T::zero()
+            lit::<T>(-700.0)
         };
         if err <= T::one() {
             // PI: fac = err^expo / err_old^β.
-            let fac = fac11 / (o.beta * self.err_old.ln()).exp();
+            let fac = (self.expo * ln_err - o.beta * self.ln_err_old).exp();
             let fac = (fac / o.safety)
                 .max(T::one() / o.fac_max)
                 .min(T::one() / o.fac_min);
@@ -517,10 +521,11 @@ impl<T: Real> Controller<T> {
             if self.rejected_last {
                 h_new = h_new.min(h);
             }
-            self.err_old = err.max(lit(1e-4));
+            self.ln_err_old = ln_err.max(lit::<T>(1e-4).ln());
             self.rejected_last = false;
             (true, h_new.min(o.h_max))
         } else {
+            let fac11 = (self.expo * ln_err).exp();
             let fac = (fac11 / o.safety).min(T::one() / o.fac_min);
             self.rejected_last = true;
             (false, h / fac)
