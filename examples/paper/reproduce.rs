@@ -235,7 +235,7 @@ pub fn tle_fig5(
         periods,
     )?;
     let tol = pair_tolerances::<f64, 2, 4>(&tolerances(rtol))?;
-    Ok(tle_diagram(
+    tle_diagram(
         |w: f64| Ok(PAPER.oscillator::<f64>(w)?),
         &Dopri5::new(tol),
         rest()?,
@@ -243,7 +243,7 @@ pub fn tle_fig5(
         PAPER_D0,
         Norm::paper(),
         &settings,
-    )?)
+    )
 }
 
 /// A synthetic experiment at ω = 17 rad/s (`duration` s at 1 kHz, σ = 2 µm noise and a
