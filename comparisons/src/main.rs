@@ -642,7 +642,13 @@ fn ratios(rows: &[Row], w1: bool) -> (String, String) {
                 .collect();
             match time_at_error(&pts, o.err_rms) {
                 Some((pt, how)) => {
-                    let _ = write!(md, " {:.2}{how} |", ot / pt);
+                    let q = ot / pt;
+                    let cell = if q < 0.1 {
+                        format!("{q:.1e}")
+                    } else {
+                        format!("{q:.2}")
+                    };
+                    let _ = write!(md, " {cell}{how} |");
                     let _ = writeln!(
                         csv,
                         "{wl},{},{:e},{:e},{:e},{},{:e},{:e},{}",
