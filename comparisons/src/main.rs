@@ -297,6 +297,15 @@ struct Seg {
     strobe: Vec<[f64; 3]>,
 }
 
+/// How each library detects events and samples sections (printed with the table).
+const PEER_NOTES: &str = "How each library detects events and samples sections (details in README.md):
+
+- nonsmooth: `Simulation` + `Event(Level(0, x_I), Rising)` (sign changes and grazing pairs, located on the dense output) + `Stroboscopic` (interpolated) or `landing_grid` (steps cut at the sections).
+- differential-equations: custom `Solout` on its interpolant (sign change between step ends, as its own `EventSolout`); max_steps/max_rejects raised.
+- diffsol: its own root finder (`OdeBuilder::root`, `RootFound`), sections by `interpolate_inplace`; run-wide Newton-failure cap raised (it aborts BDF/SDIRK runs otherwise).
+- ode_solvers: no event location and no dense output in its step callback: impacts located on a cubic Hermite of the step ends, sections hit exactly by one `integrate()` per period; scalar atol only (state scaled to make it per-component); its DOP853 tableau has c12 = 0 (first order on forced problems).
+";
+
 /// (worst |Δt| over matched impacts, missed, extra).
 fn impact_errors(reference: &[f64], got: &[f64]) -> (f64, usize, usize) {
     let mut worst: f64 = 0.0;
@@ -476,7 +485,7 @@ fn markdown_table(rows: &[Row], reference: &Reference) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "ω = {OMEGA} rad/s. Times: median of the repetitions, seconds per 1000 forcing periods \
+        "ω = {OMEGA} rad/s. Times: median of the repetitions, CPU seconds per 1000 forcing periods \
          (`~`: extrapolated from the part done before a timeout/failure). RHS/period: W2. \
          Reference impacts: W1 {}, W2 {}. err x₁₀: worst |x − x_ref| after 10 periods over 5 \
          starts (m); RMS err x: root mean square of x − x_ref over the 10 section times of the \
@@ -905,7 +914,7 @@ fn main() {
             let t = std::time::Instant::now();
             let row = measure(m, rtol, &reference, &args);
             println!(
-                "{:<34} rtol {:.0e}: W1 {:>9} W2 {:>9} s/1000P, {:>8.0} RHS/P, impacts {}/{}, err x {}, Δt {}, missed/extra {}/{} {} [{:.0} s]",
+                "{:<34} rtol {:.0e}: W1 {:>9} W2 {:>9} s/1000P, {:>8.0} RHS/P, impacts {}/{}, err x10 {}, rms {}, Δt {}, missed/extra {}/{} {} [{:.0} s]",
                 m.label(),
                 rtol,
                 fmt_t(&row.w1),
@@ -914,6 +923,7 @@ fn main() {
                 row.w1.impacts,
                 row.w2.impacts,
                 fmt_e(row.err_x),
+                fmt_e(row.err_rms),
                 fmt_e(row.err_t),
                 row.missed,
                 row.extra,
@@ -927,6 +937,8 @@ fn main() {
     let (r2, r2csv) = ratios(&rows, false);
     let (r1, r1csv) = ratios(&rows, true);
     let mut md = String::from("# nonsmooth vs peers: work–precision\n\n");
+    md.push_str(PEER_NOTES);
+    md.push('\n');
     md.push_str(&table);
     md.push_str("\n## Our time / peer time at equal accuracy\n\nEach peer's time is interpolated on its log(RMS err x)–log(time) polyline at our error level (`*`: extrapolated by at most one decade of error along its nearest segment; `—`: our error is outside the peer's range). Below 1: nonsmooth is faster.\n\n");
     md.push_str(&r2);
