@@ -1,0 +1,962 @@
+//! Work–precision comparison of `nonsmooth` with the Rust ODE peers on the paper's impact
+//! oscillator at ω = 20.465 rad/s. See README.md for what is measured and how.
+//!
+//! ```text
+//! cargo run --release                       # everything (writes results/)
+//! cargo run --release -- --reps 5 --budget 30 --rtols 1e-6,1e-8
+//! cargo run --release -- --only nonsmooth    # methods whose label contains a string
+//! cargo run --release -- profile "nonsmooth Dopri5" 1e-8 w2   # one run, for callgrind
+//! ```
+
+mod common;
+mod de;
+mod dsol;
+mod odes;
+mod ours;
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use nonsmooth::model::paper::PAPER;
+
+use common::{Job, RunResult, Status};
+use de::DeMethod;
+use dsol::DsMethod;
+use odes::OsMethod;
+use ours::Ours;
+
+const OMEGA: f64 = 20.465;
+/// Reference tolerance (nonsmooth DOP853) and its self-check.
+const REF_RTOL: f64 = 1e-14;
+/// Accuracy starts: t = 2π(100 + 20k)/ω.
+const ACC_STARTS: [u64; 5] = [100, 120, 140, 160, 180];
+const ACC_PERIODS: u64 = 10;
+const W1_PERIODS: u64 = 1100;
+const W2_START: u64 = 100;
+const W2_PERIODS: u64 = 1000;
+/// An impact of a method farther than this from every reference impact is "extra", a
+/// reference impact with no method impact within it "missed".
+const MATCH_WINDOW: f64 = 1e-3;
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Method {
+    Ours(Ours),
+    De(DeMethod),
+    Ds(DsMethod),
+    Os(OsMethod),
+}
+
+impl Method {
+    fn all() -> Vec<Method> {
+        vec![
+            Method::Ours(Ours::Dopri5),
+            Method::Ours(Ours::Dop853),
+            Method::Ours(Ours::Dopri5Grid),
+            Method::Ours(Ours::Rosenbrock23),
+            Method::De(DeMethod::Dopri5),
+            Method::De(DeMethod::Dop853),
+            Method::De(DeMethod::Rkv988e),
+            Method::De(DeMethod::Radau5),
+            Method::De(DeMethod::Kvaerno745),
+            Method::De(DeMethod::Bdf),
+            Method::Ds(DsMethod::Tsit45),
+            Method::Ds(DsMethod::Bdf),
+            Method::Ds(DsMethod::TrBdf2),
+            Method::Ds(DsMethod::Esdirk34),
+            Method::Os(OsMethod::Dopri5),
+            Method::Os(OsMethod::Dop853),
+        ]
+    }
+
+    fn library(&self) -> &'static str {
+        match self {
+            Method::Ours(_) => "nonsmooth",
+            Method::De(_) => "differential-equations 0.7",
+            Method::Ds(_) => "diffsol 0.18",
+            Method::Os(_) => "ode_solvers 0.6",
+        }
+    }
+
+    fn name(&self) -> &'static str {
+        match self {
+            Method::Ours(Ours::Dopri5) => "Dopri5",
+            Method::Ours(Ours::Dop853) => "Dop853",
+            Method::Ours(Ours::Dopri5Grid) => "Dopri5 + landing_grid",
+            Method::Ours(Ours::Rosenbrock23) => "Rosenbrock23",
+            Method::De(DeMethod::Dopri5) => "dopri5",
+            Method::De(DeMethod::Dop853) => "dop853",
+            Method::De(DeMethod::Rkv988e) => "rkv988e",
+            Method::De(DeMethod::Radau5) => "radau5",
+            Method::De(DeMethod::Kvaerno745) => "kvaerno745",
+            Method::De(DeMethod::Bdf) => "bdf",
+            Method::Ds(DsMethod::Tsit45) => "tsit45",
+            Method::Ds(DsMethod::Bdf) => "bdf",
+            Method::Ds(DsMethod::TrBdf2) => "tr_bdf2",
+            Method::Ds(DsMethod::Esdirk34) => "esdirk34",
+            Method::Os(OsMethod::Dopri5) => "Dopri5",
+            Method::Os(OsMethod::Dop853) => "Dop853",
+        }
+    }
+
+    fn label(&self) -> String {
+        let lib = self.library().split(' ').next().unwrap_or("");
+        format!("{lib} {}", self.name())
+    }
+
+    fn run(&self, job: &Job) -> RunResult {
+        match *self {
+            Method::Ours(k) => ours::run(k, job),
+            Method::De(k) => de::run(k, job),
+            Method::Ds(k) => dsol::run(k, job),
+            Method::Os(k) => odes::run(k, job),
+        }
+    }
+}
+
+struct Args {
+    reps: usize,
+    budget: f64,
+    rtols: Vec<f64>,
+    only: Vec<String>,
+    out: PathBuf,
+    profile: Option<(String, f64, String)>,
+    accuracy: Option<(String, f64)>,
+    rhs_bench: Option<String>,
+}
+
+fn parse_args() -> Args {
+    let mut a = Args {
+        reps: 3,
+        budget: 20.0,
+        rtols: vec![1e-6, 1e-8, 1e-10],
+        only: vec![],
+        out: PathBuf::from("results"),
+        profile: None,
+        accuracy: None,
+        rhs_bench: None,
+    };
+    let v: Vec<String> = std::env::args().skip(1).collect();
+    let mut i = 0;
+    while i < v.len() {
+        match v[i].as_str() {
+            "--reps" => {
+                a.reps = v[i + 1].parse().expect("--reps N");
+                i += 1;
+            }
+            "--budget" => {
+                a.budget = v[i + 1].parse().expect("--budget SECONDS");
+                i += 1;
+            }
+            "--rtols" => {
+                a.rtols = v[i + 1]
+                    .split(',')
+                    .map(|s| s.parse().expect("--rtols a,b,c"))
+                    .collect();
+                i += 1;
+            }
+            "--only" => {
+                a.only.push(v[i + 1].clone());
+                i += 1;
+            }
+            "--out" => {
+                a.out = PathBuf::from(&v[i + 1]);
+                i += 1;
+            }
+            "profile" => {
+                a.profile = Some((
+                    v[i + 1].clone(),
+                    v[i + 2].parse().expect("profile LABEL RTOL [w1|w2]"),
+                    v.get(i + 3).cloned().unwrap_or_else(|| "w2".into()),
+                ));
+                i += 3;
+            }
+            "rhs-bench" => {
+                a.rhs_bench = Some(v[i + 1].clone());
+                i += 1;
+            }
+            "accuracy" => {
+                a.accuracy = Some((
+                    v[i + 1].clone(),
+                    v[i + 2].parse().expect("accuracy LABEL RTOL"),
+                ));
+                i += 2;
+            }
+            "-h" | "--help" => {
+                println!(
+                    "usage: nonsmooth-comparisons [--reps N] [--budget S] [--rtols a,b] [--only STR]... [--out DIR]\n       nonsmooth-comparisons profile LABEL RTOL [w1|w2]"
+                );
+                std::process::exit(0);
+            }
+            other => panic!("unknown argument {other}"),
+        }
+        i += 1;
+    }
+    a
+}
+
+/// The reference: states on the attractor and 10-period reference segments.
+struct Reference {
+    x_rest: f64,
+    /// State at 100 periods (W2 start).
+    w2_start: [f64; 2],
+    /// Per accuracy start k: (t0, y0, end state, impacts).
+    segs: Vec<Seg>,
+    w1_impacts: usize,
+    w2_impacts: usize,
+    /// Cross-checks: (label, max |Δx_end|, max |Δt_impact|, impact count mismatch).
+    checks: Vec<(String, f64, f64, usize)>,
+}
+
+fn job(t0_periods: u64, y0: [f64; 2], n: u64, rtol: f64, budget: f64) -> Job {
+    Job {
+        omega: OMEGA,
+        t0: t0_periods as f64 * std::f64::consts::TAU / OMEGA,
+        y0,
+        n_periods: n,
+        rtol,
+        budget_s: budget,
+    }
+}
+
+fn must(r: RunResult, what: &str) -> RunResult {
+    assert!(r.status.is_ok(), "{what}: {}", r.status.short());
+    r
+}
+
+fn reference() -> Reference {
+    let x_rest = PAPER.static_equilibrium().expect("equilibrium");
+    let refm = Method::Ours(Ours::Dop853);
+    let long = must(
+        refm.run(&job(0, [x_rest, 0.0], 180, REF_RTOL, 1e9)),
+        "reference long run",
+    );
+    let at = |i: u64| -> [f64; 3] { long.strobe[(i - 1) as usize] };
+    let w2 = at(W2_START);
+    let mut segs = vec![];
+    for &i in &ACC_STARTS {
+        let s = at(i);
+        let r = must(
+            refm.run(&job(i, [s[1], s[2]], ACC_PERIODS, REF_RTOL, 1e9)),
+            "reference segment",
+        );
+        segs.push(Seg {
+            start: s,
+            end: r.end,
+            impacts: r.impacts,
+            strobe: r.strobe,
+        });
+    }
+    let mut checks = vec![];
+    for (m, rtol) in [
+        (Method::Ours(Ours::Dop853), 1e-13),
+        (Method::Ours(Ours::Dop853), 1e-15),
+        (Method::Ours(Ours::Dopri5), 1e-14),
+        (Method::De(DeMethod::Rkv988e), 1e-14),
+        (Method::De(DeMethod::Rkv988e), 1e-15),
+    ] {
+        let mut dx: f64 = 0.0;
+        let mut dt: f64 = 0.0;
+        let mut mism = 0;
+        for (k, &i) in ACC_STARTS.iter().enumerate() {
+            let s = segs[k].start;
+            let r = m.run(&job(i, [s[1], s[2]], ACC_PERIODS, rtol, 120.0));
+            if !r.status.is_ok() {
+                mism += 1000;
+                continue;
+            }
+            dx = dx.max((r.end[1] - segs[k].end[1]).abs());
+            let (w, mi, ex) = impact_errors(&segs[k].impacts, &r.impacts);
+            dt = dt.max(w);
+            mism += mi + ex;
+        }
+        checks.push((format!("{} rtol {rtol:.0e}", m.label()), dx, dt, mism));
+    }
+    let w1 = must(
+        refm.run(&job(0, [x_rest, 0.0], W1_PERIODS, REF_RTOL, 1e9)),
+        "reference W1",
+    );
+    let w2r = must(
+        refm.run(&job(W2_START, [w2[1], w2[2]], W2_PERIODS, REF_RTOL, 1e9)),
+        "reference W2",
+    );
+    Reference {
+        x_rest,
+        w2_start: [w2[1], w2[2]],
+        segs,
+        w1_impacts: w1.impacts.len(),
+        w2_impacts: w2r.impacts.len(),
+        checks,
+    }
+}
+
+/// A reference segment: 10 periods from a state on the attractor.
+struct Seg {
+    start: [f64; 3],
+    end: [f64; 3],
+    impacts: Vec<f64>,
+    strobe: Vec<[f64; 3]>,
+}
+
+/// How each library detects events and samples sections (printed with the table).
+const PEER_NOTES: &str = "How each library detects events and samples sections (details in README.md):
+
+- nonsmooth: `Simulation` + `Event(Level(0, x_I), Rising)` (sign changes and grazing pairs, located on the dense output) + `Stroboscopic` (interpolated) or `landing_grid` (steps cut at the sections).
+- differential-equations: custom `Solout` on its interpolant (sign change between step ends, as its own `EventSolout`); max_steps/max_rejects raised.
+- diffsol: its own root finder (`OdeBuilder::root`, `RootFound`), sections by `interpolate_inplace`; run-wide Newton-failure cap raised (it aborts BDF/SDIRK runs otherwise).
+- ode_solvers: no event location and no dense output in its step callback: impacts located on a cubic Hermite of the step ends, sections hit exactly by one `integrate()` per period; scalar atol only (state scaled to make it per-component); its DOP853 tableau has c12 = 0 (first order on forced problems).
+";
+
+/// (worst |Δt| over matched impacts, missed, extra).
+fn impact_errors(reference: &[f64], got: &[f64]) -> (f64, usize, usize) {
+    let mut worst: f64 = 0.0;
+    let mut missed = 0;
+    for &r in reference {
+        let d = got
+            .iter()
+            .map(|&g| (g - r).abs())
+            .fold(f64::INFINITY, f64::min);
+        if d <= MATCH_WINDOW {
+            worst = worst.max(d);
+        } else {
+            missed += 1;
+        }
+    }
+    let extra = got
+        .iter()
+        .filter(|&&g| reference.iter().all(|&r| (g - r).abs() > MATCH_WINDOW))
+        .count();
+    (worst, missed, extra)
+}
+
+/// One row of the table.
+#[derive(Debug, Clone)]
+struct Row {
+    method: Method,
+    rtol: f64,
+    w1: Timing,
+    w2: Timing,
+    err_x: f64,
+    /// RMS of the x error over the 10 section times of the 5 segments (50 samples).
+    err_rms: f64,
+    err_t: f64,
+    missed: usize,
+    extra: usize,
+    acc_status: Status,
+}
+
+#[derive(Debug, Clone)]
+struct Timing {
+    /// Median seconds per 1000 periods (extrapolated from the part done on a timeout).
+    s_per_1000: f64,
+    reps: usize,
+    rhs_per_period: f64,
+    impacts: usize,
+    status: Status,
+}
+
+fn timing(m: Method, j: &Job, reps: usize) -> Timing {
+    let mut times = vec![];
+    let mut last = None;
+    for _ in 0..reps.max(1) {
+        let r = m.run(j);
+        let frac = match &r.status {
+            Status::Ok => 1.0,
+            Status::Timeout(f) | Status::Failed(_, f) => *f,
+            Status::Unsupported(_) => 0.0,
+        };
+        let periods = frac * j.n_periods as f64;
+        times.push(if periods > 0.0 {
+            r.elapsed / periods * 1000.0
+        } else {
+            f64::NAN
+        });
+        let ok = r.status.is_ok();
+        last = Some((r, periods));
+        if !ok {
+            break;
+        }
+    }
+    let (r, periods) = last.expect("one run");
+    times.sort_by(|a, b| a.total_cmp(b));
+    Timing {
+        s_per_1000: times[times.len() / 2],
+        reps: times.len(),
+        rhs_per_period: if periods > 0.0 {
+            r.rhs_evals as f64 / periods
+        } else {
+            f64::NAN
+        },
+        impacts: r.impacts.len(),
+        status: r.status,
+    }
+}
+
+fn measure(m: Method, rtol: f64, reference: &Reference, args: &Args) -> Row {
+    // Accuracy: 10 periods from each of the 5 starts.
+    let mut err_x: f64 = 0.0;
+    let (mut sq, mut nsq) = (0.0, 0usize);
+    let mut err_t: f64 = 0.0;
+    let (mut missed, mut extra) = (0, 0);
+    let mut acc_status = Status::Ok;
+    for (k, &i) in ACC_STARTS.iter().enumerate() {
+        let seg = &reference.segs[k];
+        let s = seg.start;
+        let r = m.run(&job(i, [s[1], s[2]], ACC_PERIODS, rtol, args.budget));
+        if !r.status.is_ok() {
+            acc_status = r.status.clone();
+            err_x = f64::NAN;
+            break;
+        }
+        err_x = err_x.max((r.end[1] - seg.end[1]).abs());
+        if r.strobe.len() == seg.strobe.len() {
+            for (a, b) in r.strobe.iter().zip(&seg.strobe) {
+                sq += (a[1] - b[1]).powi(2);
+                nsq += 1;
+            }
+        } else {
+            nsq = usize::MAX / 2;
+        }
+        let (w, mi, ex) = impact_errors(&seg.impacts, &r.impacts);
+        err_t = err_t.max(w);
+        missed += mi;
+        extra += ex;
+    }
+    let err_rms = if acc_status.is_ok() && nsq == ACC_STARTS.len() * ACC_PERIODS as usize {
+        (sq / nsq as f64).sqrt()
+    } else {
+        f64::NAN
+    };
+    let w2 = timing(
+        m,
+        &job(W2_START, reference.w2_start, W2_PERIODS, rtol, args.budget),
+        args.reps,
+    );
+    let w1 = timing(
+        m,
+        &job(0, [reference.x_rest, 0.0], W1_PERIODS, rtol, args.budget),
+        args.reps,
+    );
+    Row {
+        method: m,
+        rtol,
+        w1,
+        w2,
+        err_x,
+        err_rms,
+        err_t,
+        missed,
+        extra,
+        acc_status,
+    }
+}
+
+fn fmt_t(t: &Timing) -> String {
+    if t.s_per_1000.is_nan() {
+        return "—".into();
+    }
+    let approx = if t.status.is_ok() { "" } else { "~" };
+    format!("{approx}{:.3}", t.s_per_1000)
+}
+
+fn fmt_e(x: f64) -> String {
+    if x.is_nan() {
+        "—".into()
+    } else {
+        format!("{x:.1e}")
+    }
+}
+
+fn note(r: &Row) -> String {
+    let mut v = vec![];
+    for (w, t) in [
+        ("acc", &r.acc_status),
+        ("W1", &r.w1.status),
+        ("W2", &r.w2.status),
+    ] {
+        if !t.is_ok() {
+            v.push(format!("{w}: {}", t.short()));
+        }
+    }
+    let s = v.join("; ");
+    s.chars().take(140).collect()
+}
+
+fn markdown_table(rows: &[Row], reference: &Reference) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "ω = {OMEGA} rad/s. Times: median of the repetitions, CPU seconds per 1000 forcing periods \
+         (`~`: extrapolated from the part done before a timeout/failure). RHS/period: W2. \
+         Reference impacts: W1 {}, W2 {}. err x₁₀: worst |x − x_ref| after 10 periods over 5 \
+         starts (m); RMS err x: root mean square of x − x_ref over the 10 section times of the \
+         5 starts (50 samples, sections interpolated on the dense output where the method \
+         does so); Δt impact: worst impact-time error over those 10-period segments (s); \
+         missed/extra: impacts with no partner within {MATCH_WINDOW:.0e} s.\n",
+        reference.w1_impacts, reference.w2_impacts
+    );
+    let _ = writeln!(
+        s,
+        "| library | method | rtol | W1 s/1000P | W2 s/1000P | RHS/period | impacts W1 | impacts W2 | err x₁₀ (m) | RMS err x (m) | Δt impact (s) | missed/extra | notes |"
+    );
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    for r in rows {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {:.0e} | {} | {} | {:.0} | {} | {} | {} | {} | {} | {}/{} | {} |",
+            r.method.library(),
+            r.method.name(),
+            r.rtol,
+            fmt_t(&r.w1),
+            fmt_t(&r.w2),
+            r.w2.rhs_per_period,
+            r.w1.impacts,
+            r.w2.impacts,
+            fmt_e(r.err_x),
+            fmt_e(r.err_rms),
+            fmt_e(r.err_t),
+            r.missed,
+            r.extra,
+            note(r)
+        );
+    }
+    s
+}
+
+fn csv_table(rows: &[Row]) -> String {
+    let mut s = String::from(
+        "library,method,rtol,w1_s_per_1000_periods,w1_reps,w1_rhs_per_period,w1_impacts,w1_status,w2_s_per_1000_periods,w2_reps,w2_rhs_per_period,w2_impacts,w2_status,err_x_m,err_x_rms_m,err_t_impact_s,missed_impacts,extra_impacts,accuracy_status\n",
+    );
+    let q = |st: &Status| format!("\"{}\"", st.short().replace('"', "'"));
+    for r in rows {
+        let _ = writeln!(
+            s,
+            "{},{},{:e},{:e},{},{:e},{},{},{:e},{},{:e},{},{},{:e},{:e},{:e},{},{},{}",
+            r.method.library(),
+            r.method.name(),
+            r.rtol,
+            r.w1.s_per_1000,
+            r.w1.reps,
+            r.w1.rhs_per_period,
+            r.w1.impacts,
+            q(&r.w1.status),
+            r.w2.s_per_1000,
+            r.w2.reps,
+            r.w2.rhs_per_period,
+            r.w2.impacts,
+            q(&r.w2.status),
+            r.err_x,
+            r.err_rms,
+            r.err_t,
+            r.missed,
+            r.extra,
+            q(&r.acc_status)
+        );
+    }
+    s
+}
+
+/// log-log interpolation of a peer's time at error `e` on its work–precision points.
+/// Returns (time, how): how = "" inside the peer's error range, "*" extrapolated by at most
+/// one decade of error along the nearest segment, None otherwise.
+fn time_at_error(points: &[(f64, f64)], e: f64) -> Option<(f64, &'static str)> {
+    let mut p: Vec<(f64, f64)> = points
+        .iter()
+        .copied()
+        .filter(|(err, t)| err.is_finite() && *err > 0.0 && t.is_finite() && *t > 0.0)
+        .map(|(err, t)| (err.ln(), t.ln()))
+        .collect();
+    if p.is_empty() || e.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+        return None;
+    }
+    p.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let le = e.ln();
+    if p.len() == 1 {
+        return ((le - p[0].0).abs() < 0.05).then_some((p[0].1.exp(), "="));
+    }
+    let lerp = |a: (f64, f64), b: (f64, f64)| {
+        if (b.0 - a.0).abs() < 1e-12 {
+            0.5 * (a.1 + b.1)
+        } else {
+            a.1 + (b.1 - a.1) * (le - a.0) / (b.0 - a.0)
+        }
+    };
+    for w in p.windows(2) {
+        if le >= w[0].0 && le <= w[1].0 {
+            return Some((lerp(w[0], w[1]).exp(), ""));
+        }
+    }
+    let decade = 10f64.ln();
+    let n = p.len();
+    if le < p[0].0 && p[0].0 - le <= decade {
+        return Some((lerp(p[0], p[1]).exp(), "*"));
+    }
+    if le > p[n - 1].0 && le - p[n - 1].0 <= decade {
+        return Some((lerp(p[n - 2], p[n - 1]).exp(), "*"));
+    }
+    None
+}
+
+/// Our time / peer time at our error level, per workload.
+fn ratios(rows: &[Row], w1: bool) -> (String, String) {
+    fn sel(r: &Row, w1: bool) -> &Timing {
+        if w1 { &r.w1 } else { &r.w2 }
+    }
+    let pick = |r: &Row| -> Timing { sel(r, w1).clone() };
+    let ours: Vec<&Row> = rows
+        .iter()
+        .filter(|r| {
+            matches!(
+                r.method,
+                Method::Ours(Ours::Dopri5) | Method::Ours(Ours::Dop853)
+            ) && r.err_rms.is_finite()
+                && pick(r).status.is_ok()
+        })
+        .collect();
+    let mut peers: Vec<Method> = vec![];
+    for r in rows {
+        if !matches!(r.method, Method::Ours(_)) && !peers.contains(&r.method) {
+            peers.push(r.method);
+        }
+    }
+    let mut md = String::new();
+    let mut csv = String::from(
+        "workload,ours,rtol,our_rms_err_x_m,our_s_per_1000,peer,peer_s_per_1000_at_our_err,ratio_ours_over_peer,how\n",
+    );
+    let wl = if w1 { "W1" } else { "W2" };
+    let _ = write!(md, "| ours ({wl}) | rtol | RMS err x | s/1000P |");
+    for p in &peers {
+        let _ = write!(md, " {} |", p.label());
+    }
+    let _ = writeln!(md);
+    let _ = write!(md, "|---|---|---|---|");
+    for _ in &peers {
+        let _ = write!(md, "---|");
+    }
+    let _ = writeln!(md);
+    for o in &ours {
+        let ot = pick(o).s_per_1000;
+        let _ = write!(
+            md,
+            "| {} | {:.0e} | {:.1e} | {:.3} |",
+            o.method.name(),
+            o.rtol,
+            o.err_rms,
+            ot
+        );
+        for p in &peers {
+            let pts: Vec<(f64, f64)> = rows
+                .iter()
+                .filter(|r| r.method == *p && pick(r).status.is_ok())
+                .map(|r| (r.err_rms, pick(r).s_per_1000))
+                .collect();
+            match time_at_error(&pts, o.err_rms) {
+                Some((pt, how)) => {
+                    let q = ot / pt;
+                    let cell = if q < 0.1 {
+                        format!("{q:.1e}")
+                    } else {
+                        format!("{q:.2}")
+                    };
+                    let _ = write!(md, " {cell}{how} |");
+                    let _ = writeln!(
+                        csv,
+                        "{wl},{},{:e},{:e},{:e},{},{:e},{:e},{}",
+                        o.method.name(),
+                        o.rtol,
+                        o.err_rms,
+                        ot,
+                        p.label(),
+                        pt,
+                        ot / pt,
+                        if how.is_empty() {
+                            "interpolated"
+                        } else if how == "*" {
+                            "extrapolated<=1decade"
+                        } else {
+                            "single point"
+                        }
+                    );
+                }
+                None => {
+                    let _ = write!(md, " — |");
+                }
+            }
+        }
+        let _ = writeln!(md);
+    }
+    (md, csv)
+}
+
+fn write(dir: &Path, name: &str, text: &str) {
+    std::fs::create_dir_all(dir).expect("results dir");
+    std::fs::write(dir.join(name), text).expect("write result");
+}
+
+fn reference_csvs(r: &Reference, dir: &Path) {
+    let mut s = String::from("k,start_period,t0_s,x0_m,v0_m_s,t_end_s,x_end_m,v_end_m_s\n");
+    for (
+        k,
+        Seg {
+            start: st, end: e, ..
+        },
+    ) in r.segs.iter().enumerate()
+    {
+        let _ = writeln!(
+            s,
+            "{k},{},{:.17e},{:.17e},{:.17e},{:.17e},{:.17e},{:.17e}",
+            ACC_STARTS[k], st[0], st[1], st[2], e[0], e[1], e[2]
+        );
+    }
+    write(dir, "reference_states.csv", &s);
+    let mut s = String::from("k,t_s\n");
+    for (k, Seg { impacts: imp, .. }) in r.segs.iter().enumerate() {
+        for t in imp {
+            let _ = writeln!(s, "{k},{t:.17e}");
+        }
+    }
+    write(dir, "reference_impacts.csv", &s);
+    let mut s = String::from("k,i,t_s,x_m,v_m_s\n");
+    for (k, seg) in r.segs.iter().enumerate() {
+        for (i, p) in seg.strobe.iter().enumerate() {
+            let _ = writeln!(s, "{k},{},{:.17e},{:.17e},{:.17e}", i + 1, p[0], p[1], p[2]);
+        }
+    }
+    write(dir, "reference_sections.csv", &s);
+    let s = format!(
+        "omega_rad_s,x_rest_m,w2_start_period,w2_x0_m,w2_v0_m_s,w1_periods,w2_periods,acc_periods,w1_ref_impacts,w2_ref_impacts,ref_rtol\n{OMEGA},{:.17e},{W2_START},{:.17e},{:.17e},{W1_PERIODS},{W2_PERIODS},{ACC_PERIODS},{},{},{REF_RTOL:e}\n",
+        r.x_rest, r.w2_start[0], r.w2_start[1], r.w1_impacts, r.w2_impacts
+    );
+    write(dir, "reference_setup.csv", &s);
+}
+
+/// Max relative difference between the peers' hand-written right-hand side (and Jacobian) and
+/// `nonsmooth`'s `PAPER.oscillator(ω)` on a grid through free flight and contact.
+fn rhs_agreement() -> (f64, f64) {
+    use nalgebra::Vector2;
+    use nonsmooth::Dynamics;
+    let osc = PAPER.oscillator::<f64>(OMEGA).expect("model");
+    let p = common::Paper::new(OMEGA);
+    let (mut dr, mut dj): (f64, f64) = (0.0, 0.0);
+    for i in 0..41 {
+        let x = PAPER.x_i + (i as f64 - 20.0) * 2.5e-7 - 1e-4 * ((i % 3) as f64);
+        for j in 0..41 {
+            let v =
+                (j as f64 - 20.0).signum() * 10f64.powf(-9.0 + 0.4 * (j as f64 - 20.0).abs() / 2.0);
+            let t = 0.013 * (i * 41 + j) as f64;
+            let mut f = Vector2::zeros();
+            osc.rhs(t, &Vector2::new(x, v), &mut f);
+            let a = p.accel(t, x, v);
+            dr = dr.max((a - f[1]).abs() / f[1].abs().max(1e-300));
+            let jac = osc.jacobian(t, &Vector2::new(x, v)).expect("jacobian");
+            let (ax, av) = p.accel_partials(x, v);
+            dj = dj.max((ax - jac[(1, 0)]).abs() / jac[(1, 0)].abs().max(1e-300));
+            dj = dj.max((av - jac[(1, 1)]).abs() / jac[(1, 1)].abs().max(1e-300));
+        }
+    }
+    (dr, dj)
+}
+
+fn find_method(label: &str) -> Method {
+    Method::all()
+        .into_iter()
+        .find(|m| m.label() == label)
+        .unwrap_or_else(|| {
+            panic!(
+                "no method {label:?}; labels: {:?}",
+                Method::all().iter().map(|m| m.label()).collect::<Vec<_>>()
+            )
+        })
+}
+
+/// 10⁷ right-hand-side evaluations of nonsmooth's model at a free-flight (`free`) or an
+/// in-contact (`contact`) state, times varying (for callgrind: instructions per evaluation).
+fn rhs_bench(which: &str) {
+    use nalgebra::Vector2;
+    use nonsmooth::Dynamics;
+    use std::hint::black_box;
+    let osc = PAPER.oscillator::<f64>(OMEGA).expect("model");
+    let y = match which {
+        "free" => Vector2::new(-3.0e-3, 0.05),
+        "contact" => Vector2::new(PAPER.x_i + 3e-6, 0.02),
+        "none" => {
+            println!("baseline");
+            return;
+        }
+        other => panic!("rhs-bench free|contact|none, not {other}"),
+    };
+    let n = 10_000_000u64;
+    let c0 = common::cpu_now();
+    let mut acc = 0.0;
+    let mut dy = Vector2::zeros();
+    for i in 0..n {
+        let t = black_box(1e-5 * i as f64);
+        osc.rhs(t, black_box(&y), &mut dy);
+        acc += black_box(dy[1]);
+    }
+    let dt = common::cpu_now() - c0;
+    println!(
+        "{which}: {n} evaluations, {:.1} ns each (sum {acc:e})",
+        dt / n as f64 * 1e9
+    );
+}
+
+/// The W2 start state from a previous full run's `reference_setup.csv`.
+fn read_w2_start(dir: &Path) -> Option<[f64; 2]> {
+    let text = std::fs::read_to_string(dir.join("reference_setup.csv")).ok()?;
+    let mut lines = text.lines();
+    let head: Vec<&str> = lines.next()?.split(',').collect();
+    let vals: Vec<&str> = lines.next()?.split(',').collect();
+    let get = |name: &str| -> Option<f64> {
+        let i = head.iter().position(|h| *h == name)?;
+        vals.get(i)?.parse().ok()
+    };
+    Some([get("w2_x0_m")?, get("w2_v0_m_s")?])
+}
+
+fn main() {
+    let args = parse_args();
+    if let Some((label, rtol, wl)) = &args.profile {
+        let m = find_method(label);
+        // W2 starts from the reference state in results/reference_setup.csv (written by a
+        // full run); without it, from a 100-period pre-run at rtol 1e-12.
+        let x_rest = PAPER.static_equilibrium().expect("equilibrium");
+        let (j, what) = if wl == "w1" {
+            (job(0, [x_rest, 0.0], W1_PERIODS, *rtol, 1e9), "W1")
+        } else {
+            let y0 = read_w2_start(&args.out).unwrap_or_else(|| {
+                let pre = must(
+                    Method::Ours(Ours::Dop853).run(&job(0, [x_rest, 0.0], W2_START, 1e-12, 1e9)),
+                    "pre-run",
+                );
+                [pre.end[1], pre.end[2]]
+            });
+            (job(W2_START, y0, W2_PERIODS, *rtol, 1e9), "W2")
+        };
+        let r = m.run(&j);
+        println!(
+            "{} {what} rtol {rtol:e}: {} in {:.3} s, {} RHS ({:.1}/period), {} jac, {} impacts",
+            m.label(),
+            r.status.short(),
+            r.elapsed,
+            r.rhs_evals,
+            r.rhs_evals as f64 / j.n_periods as f64,
+            r.jac_evals,
+            r.impacts.len()
+        );
+        return;
+    }
+
+    if let Some(which) = &args.rhs_bench {
+        rhs_bench(which);
+        return;
+    }
+    if let Some((label, rtol)) = &args.accuracy {
+        // Per-start accuracy of one method (diagnostics).
+        let m = find_method(label);
+        let reference = reference();
+        for (k, &i) in ACC_STARTS.iter().enumerate() {
+            let Seg {
+                start: s,
+                end: e,
+                impacts: imp,
+                ..
+            } = &reference.segs[k];
+            let r = m.run(&job(i, [s[1], s[2]], ACC_PERIODS, *rtol, args.budget));
+            let (w, mi, ex) = impact_errors(imp, &r.impacts);
+            println!(
+                "{} rtol {rtol:e} start {i}: {} err x {:.2e} m, Δt {:.2e} s, missed/extra {mi}/{ex}, {} RHS",
+                m.label(),
+                r.status.short(),
+                (r.end[1] - e[1]).abs(),
+                w,
+                r.rhs_evals
+            );
+        }
+        return;
+    }
+    println!("nonsmooth vs peers — paper oscillator at ω = {OMEGA} rad/s");
+    let (dr, dj) = rhs_agreement();
+    println!(
+        "the peers' hand-written RHS vs nonsmooth's: max |Δf| = {dr:.1e} (relative), Jacobian {dj:.1e}"
+    );
+    println!("building the reference (nonsmooth Dop853, rtol {REF_RTOL:e}) ...");
+    let t = std::time::Instant::now();
+    let reference = reference();
+    println!("  done in {:.1} s", t.elapsed().as_secs_f64());
+    println!(
+        "  W1 reference impacts {}, W2 {}; x_rest = {:.6e} m; W2 start = ({:.6e} m, {:.6e} m/s)",
+        reference.w1_impacts,
+        reference.w2_impacts,
+        reference.x_rest,
+        reference.w2_start[0],
+        reference.w2_start[1]
+    );
+    let mut checks = String::from(
+        "| cross-check of the reference | max |Δx| after 10 P (m) | max |Δt impact| (s) | impact count mismatches |\n|---|---|---|---|\n",
+    );
+    for (l, dx, dt, mm) in &reference.checks {
+        println!(
+            "  cross-check {l}: max |Δx| = {dx:.2e} m, max |Δt| = {dt:.2e} s, mismatches {mm}"
+        );
+        let _ = writeln!(checks, "| {l} | {dx:.2e} | {dt:.2e} | {mm} |");
+    }
+    reference_csvs(&reference, &args.out);
+
+    let methods: Vec<Method> = Method::all()
+        .into_iter()
+        .filter(|m| {
+            args.only.is_empty() || args.only.iter().any(|o| m.label().contains(o.as_str()))
+        })
+        .collect();
+    let mut rows = vec![];
+    for &rtol in &args.rtols {
+        for &m in &methods {
+            let t = std::time::Instant::now();
+            let row = measure(m, rtol, &reference, &args);
+            println!(
+                "{:<34} rtol {:.0e}: W1 {:>9} W2 {:>9} s/1000P, {:>8.0} RHS/P, impacts {}/{}, err x10 {}, rms {}, Δt {}, missed/extra {}/{} {} [{:.0} s]",
+                m.label(),
+                rtol,
+                fmt_t(&row.w1),
+                fmt_t(&row.w2),
+                row.w2.rhs_per_period,
+                row.w1.impacts,
+                row.w2.impacts,
+                fmt_e(row.err_x),
+                fmt_e(row.err_rms),
+                fmt_e(row.err_t),
+                row.missed,
+                row.extra,
+                note(&row),
+                t.elapsed().as_secs_f64()
+            );
+            rows.push(row);
+        }
+    }
+    let table = markdown_table(&rows, &reference);
+    let (r2, r2csv) = ratios(&rows, false);
+    let (r1, r1csv) = ratios(&rows, true);
+    let mut md = String::from("# nonsmooth vs peers: work–precision\n\n");
+    md.push_str(PEER_NOTES);
+    md.push('\n');
+    md.push_str(&table);
+    md.push_str("\n## Our time / peer time at equal accuracy\n\nEach peer's time is interpolated on its log(RMS err x)–log(time) polyline at our error level (`*`: extrapolated by at most one decade of error along its nearest segment; `—`: our error is outside the peer's range). Below 1: nonsmooth is faster.\n\n");
+    md.push_str(&r2);
+    md.push('\n');
+    md.push_str(&r1);
+    md.push_str("\n## Reference\n\n");
+    md.push_str(&checks);
+    println!("\n{md}");
+    write(&args.out, "table.md", &md);
+    write(&args.out, "table.csv", &csv_table(&rows));
+    let mut rc = r2csv;
+    rc.push_str(
+        r1csv
+            .lines()
+            .skip(1)
+            .map(|l| format!("{l}\n"))
+            .collect::<String>()
+            .as_str(),
+    );
+    write(&args.out, "ratios.csv", &rc);
+}

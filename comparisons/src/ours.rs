@@ -1,0 +1,167 @@
+//! `nonsmooth` itself: `Simulation` + `Event(Level(0, x_I), Rising)` + `Stroboscopic`.
+
+use std::time::Instant;
+
+use nalgebra::{Matrix2, Vector2};
+use nonsmooth::Dynamics;
+use nonsmooth::drive::{Control, EventRecord, Observer, Simulation, StepView, Termination};
+use nonsmooth::event::{Direction, Event, Level};
+use nonsmooth::integrate::{DenseOutput, Dop853, Dopri5, Rosenbrock23, Stepper, Tolerances};
+use nonsmooth::model::paper::{PAPER, PaperOscillator};
+use nonsmooth::sample::Stroboscopic;
+
+use crate::common::{Job, RunResult, Status};
+
+/// Which stepper.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Ours {
+    Dopri5,
+    Dop853,
+    Rosenbrock23,
+    /// DOPRI5 with every step cut at the section times (`landing_grid`) instead of
+    /// interpolating them.
+    Dopri5Grid,
+}
+
+/// Impact times.
+#[derive(Default)]
+struct Impacts(Vec<f64>);
+
+impl Observer<f64, 2> for Impacts {
+    fn on_event(&mut self, e: &EventRecord<f64, 2>) -> Control {
+        self.0.push(e.t);
+        Control::Continue
+    }
+}
+
+/// Stops the run when the wall-clock budget is spent (checked every 64 steps).
+struct Budget {
+    start: Instant,
+    limit: f64,
+    calls: u32,
+    timed_out: bool,
+    t: f64,
+}
+
+impl Observer<f64, 2> for Budget {
+    #[inline]
+    fn on_step<D: DenseOutput<f64, 2>>(&mut self, s: &StepView<'_, f64, 2, D>) -> Control {
+        self.t = s.t1;
+        self.calls += 1;
+        if self.calls.is_multiple_of(64) && self.start.elapsed().as_secs_f64() > self.limit {
+            self.timed_out = true;
+            return Control::Stop;
+        }
+        Control::Continue
+    }
+}
+
+/// The model behind a never-inlined `rhs` (profiling only: callgrind then attributes the
+/// right-hand side's cost exactly, as the inclusive cost of `NoInline::rhs`).
+struct NoInline(PaperOscillator<f64>);
+
+impl Dynamics<f64, 2> for NoInline {
+    #[inline(never)]
+    fn rhs(&self, t: f64, y: &Vector2<f64>, dy: &mut Vector2<f64>) {
+        self.0.rhs(t, y, dy)
+    }
+    fn jacobian(&self, t: f64, y: &Vector2<f64>) -> Option<Matrix2<f64>> {
+        self.0.jacobian(t, y)
+    }
+    fn time_derivative(&self, t: f64, y: &Vector2<f64>) -> Option<Vector2<f64>> {
+        self.0.time_derivative(t, y)
+    }
+}
+
+pub fn run(kind: Ours, job: &Job) -> RunResult {
+    let osc = PAPER.oscillator::<f64>(job.omega).expect("model");
+    if std::env::var_os("NONSMOOTH_RHS_NOINLINE").is_some() {
+        run_with(NoInline(osc), kind, job)
+    } else {
+        run_with(osc, kind, job)
+    }
+}
+
+fn run_with<S: Dynamics<f64, 2>>(sys: S, kind: Ours, job: &Job) -> RunResult {
+    let start = Instant::now();
+    let cpu0 = crate::common::cpu_now();
+    let tol = Tolerances::per_component(job.rtol, job.atol()).expect("tolerances");
+    match kind {
+        Ours::Dopri5 => go(sys, Dopri5::new(tol), job, false, start, cpu0),
+        Ours::Dopri5Grid => go(sys, Dopri5::new(tol), job, true, start, cpu0),
+        Ours::Dop853 => go(sys, Dop853::new(tol), job, false, start, cpu0),
+        Ours::Rosenbrock23 => go(sys, Rosenbrock23::new(tol), job, false, start, cpu0),
+    }
+}
+
+fn go<S: Dynamics<f64, 2>, St: Stepper<f64, 2>>(
+    osc: S,
+    stepper: St,
+    job: &Job,
+    grid: bool,
+    start: Instant,
+    cpu0: f64,
+) -> RunResult {
+    let impact = Event::new(Level::new(0, PAPER.x_i).expect("level"), Direction::Rising);
+    let period = job.period();
+    let mut sim = Simulation::new(osc, stepper).with_events(impact);
+    if grid {
+        sim = sim.landing_grid(Some((job.t0, period))).expect("grid");
+    }
+    let mut strobe = Stroboscopic::periodic(
+        job.t0,
+        period,
+        job.t0 + 0.5 * period,
+        job.n_periods as usize + 1,
+    )
+    .expect("strobe");
+    let mut impacts = Impacts(Vec::with_capacity(4 * job.n_periods as usize));
+    let mut budget = Budget {
+        start,
+        limit: job.budget_s,
+        calls: 0,
+        timed_out: false,
+        t: job.t0,
+    };
+    let res = sim.run(
+        job.t0,
+        Vector2::new(job.y0[0], job.y0[1]),
+        job.t_end(),
+        &mut (&mut strobe, &mut impacts, &mut budget),
+    );
+    let elapsed = crate::common::cpu_now() - cpu0;
+    let stats = *sim.stepper().stats();
+    let frac = ((budget.t - job.t0) / (job.t_end() - job.t0)).clamp(0.0, 1.0);
+    let strobe: Vec<[f64; 3]> = strobe
+        .points()
+        .iter()
+        .map(|p| [p.t, p.y[0], p.y[1]])
+        .collect();
+    match res {
+        Ok(out) => {
+            let status = match out.termination {
+                Termination::ReachedEnd => Status::Ok,
+                _ if budget.timed_out => Status::Timeout(frac),
+                t => Status::Failed(format!("{t:?}"), frac),
+            };
+            RunResult {
+                status,
+                elapsed,
+                rhs_evals: stats.rhs_evals,
+                jac_evals: stats.jacobian_evals,
+                impacts: impacts.0,
+                strobe,
+                end: [out.t, out.y[0], out.y[1]],
+            }
+        }
+        Err(e) => RunResult {
+            status: Status::Failed(e.to_string(), frac),
+            elapsed,
+            rhs_evals: stats.rhs_evals,
+            jac_evals: stats.jacobian_evals,
+            impacts: impacts.0,
+            strobe,
+            end: [f64::NAN; 3],
+        },
+    }
+}
