@@ -329,3 +329,27 @@ fn landing_grid_hits_exact_times() {
         assert!(e.0.contains(&g), "grid point {g} not landed on");
     }
 }
+
+#[test]
+fn restart_at_a_switching_surface_keeps_the_solution() {
+    // x = cos t with a restart at every zero crossing: same crossings, same end state
+    // (to the tolerance), and every restart refreshes the derivative cache (one evaluation).
+    let ev = Event::new(Level::new(0, 0.0).unwrap(), Direction::Either);
+    let mut plain = Events::default();
+    let a = Simulation::new(Harmonic, Dopri5::new(tol()))
+        .with_events(ev)
+        .run(0.0, Vector2::new(1.0, 0.0), 20.0, &mut plain)
+        .unwrap();
+    let mut cut = Events::default();
+    let b = Simulation::new(Harmonic, Dopri5::new(tol()))
+        .with_events(ev.restart())
+        .run(0.0, Vector2::new(1.0, 0.0), 20.0, &mut cut)
+        .unwrap();
+    assert_eq!(plain.0.len(), cut.0.len());
+    for (p, c) in plain.0.iter().zip(&cut.0) {
+        assert!((p.t - c.t).abs() < 1e-9);
+    }
+    assert!((a.y - b.y).norm() < 1e-8);
+    assert!((b.y[0] - 20.0_f64.cos()).abs() < 1e-8);
+    assert_ne!(a.stats.rhs_evals, b.stats.rhs_evals);
+}

@@ -335,51 +335,64 @@ fn exact_contact_law_needs_the_two_trajectory_method() {
 fn d0_study_is_flat_on_the_paper_model() {
     // At the chaotic ω = 20.465, with the paper's tolerances (rtol 1e-8), the estimate must
     // be flat within its spread over a decade around PAPER_D0 (1e-4.5 .. 1e-3.5).
-    let omega = 20.465;
-    let osc = PAPER.oscillator::<f64>(omega).unwrap();
-    let tol = pair_tolerances::<f64, 2, 4>(&paper_tol()).unwrap();
-    let d0s = [
-        PAPER_D0 / 10f64.sqrt(),
-        PAPER_D0,
-        PAPER_D0 * 10f64.sqrt(),
-        // Controls, outside the plateau: too small (integration error of the difference
-        // dominates at rtol 1e-8) and too large (not local).
-        1e-8,
-        1e-1,
-    ];
-    let study = separation_study(
-        &osc,
-        &Dopri5::new(tol),
-        Norm::paper(),
-        0.0,
-        rest(),
-        &d0s,
-        TAU / omega,
-        100,
-        1000,
-    )
-    .unwrap();
-    let pts: Vec<(f64, f64)> = study
+    let study = |omega: f64, d0s: &[f64]| -> Vec<(f64, f64)> {
+        let osc = PAPER.oscillator::<f64>(omega).unwrap();
+        let tol = pair_tolerances::<f64, 2, 4>(&paper_tol()).unwrap();
+        separation_study(
+            &osc,
+            &Dopri5::new(tol),
+            Norm::paper(),
+            0.0,
+            rest(),
+            d0s,
+            TAU / omega,
+            100,
+            1000,
+        )
+        .unwrap()
         .iter()
         .map(|p| {
             let e = p.estimate.as_ref().unwrap();
-            eprintln!("d0 = {:.2e}: {:.4} ± {:.4}", p.d0, e.exponent, e.spread);
+            eprintln!(
+                "ω = {omega}, d0 = {:.2e}: {:.4} ± {:.4}",
+                p.d0, e.exponent, e.spread
+            );
             (e.exponent, e.spread)
         })
-        .collect();
-    let (c, cs) = pts[1];
-    for &(l, s) in &pts[..3] {
-        let comb = (s * s + cs * cs).sqrt();
-        assert!((l - c).abs() <= 3.0 * comb, "{l} ± {s} vs {c} ± {cs}");
+        .collect()
+    };
+    let differ =
+        |(l, s): (f64, f64), (c, cs): (f64, f64)| (l - c).abs() > 3.0 * (s * s + cs * cs).sqrt();
+    // Flat around PAPER_D0; too large (1e-1, not local) is off.
+    let pts = study(
+        20.465,
+        &[
+            PAPER_D0 / 10f64.sqrt(),
+            PAPER_D0,
+            PAPER_D0 * 10f64.sqrt(),
+            1e-1,
+        ],
+    );
+    for &p in &pts[..3] {
+        assert!(!differ(p, pts[1]), "{p:?} vs {:?}", pts[1]);
     }
-    // The controls do show the two failure modes (so the flatness test can fail).
-    for &(l, s) in &pts[3..] {
-        let comb = (s * s + cs * cs).sqrt();
-        assert!(
-            (l - c).abs() > 3.0 * comb,
-            "control {l} ± {s} vs {c} ± {cs}"
-        );
-    }
+    assert!(
+        differ(pts[3], pts[1]),
+        "too large d0: {:?} vs {:?}",
+        pts[3],
+        pts[1]
+    );
+    // Too small (1e-8: the integration error of the difference dominates at rtol 1e-8) is
+    // off too. Shown on the period-2 orbit at ω = 19, where the estimate has almost no
+    // statistical spread (on the chaotic attractor the bias, ~0.05–0.1 1/s, is within a
+    // few spreads and its detection depends on the trajectory).
+    let pts = study(19.0, &[PAPER_D0, 1e-8]);
+    assert!(
+        differ(pts[1], pts[0]),
+        "too small d0: {:?} vs {:?}",
+        pts[1],
+        pts[0]
+    );
 }
 
 // ---------------------------------------------------------------------------------------

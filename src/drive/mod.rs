@@ -545,6 +545,11 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
                     direction,
                 };
                 let stop_ev = observer.on_event(&rec) == Control::Stop;
+                if self.events.restarts(i) && !(self.events.is_terminal(i) || stop_obs || stop_ev) {
+                    // A switching point: cut the step here and start the next one on it.
+                    self.stepper.reset_state(tc, yc);
+                    continue 'outer;
+                }
                 if self.events.is_terminal(i) || stop_obs || stop_ev {
                     // Rewind the stepper to the event.
                     self.stepper.reset_state(tc, yc);

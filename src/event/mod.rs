@@ -211,6 +211,8 @@ pub struct Event<G, R = ()> {
     pub terminal: bool,
     /// Interior samples of `g` per step (grazing safety without a rate).
     pub interior_samples: usize,
+    /// Whether the stepper restarts at the event (a switching point of the dynamics).
+    pub restart: bool,
 }
 
 impl<G> Event<G, ()> {
@@ -222,6 +224,7 @@ impl<G> Event<G, ()> {
             reset: (),
             terminal: false,
             interior_samples: 0,
+            restart: false,
         }
     }
 }
@@ -235,6 +238,7 @@ impl<G, R> Event<G, R> {
             reset,
             terminal: self.terminal,
             interior_samples: self.interior_samples,
+            restart: self.restart,
         }
     }
 
@@ -247,6 +251,15 @@ impl<G, R> Event<G, R> {
     /// Samples `g` at `k` interior points of each step (for functions without a rate).
     pub fn with_interior_samples(mut self, k: usize) -> Self {
         self.interior_samples = k;
+        self
+    }
+
+    /// Restarts the stepper at the event (for a switching surface where the right-hand side
+    /// loses smoothness, e.g. contact onset): the step is cut there and the next one starts
+    /// exactly on the surface, with the derivative cache refreshed. Observers see the same
+    /// time-ordered views; the trajectory changes only within the integration tolerance.
+    pub fn restart(mut self) -> Self {
+        self.restart = true;
         self
     }
 }
@@ -270,6 +283,10 @@ pub trait EventSet<T: Real, const N: usize> {
     fn apply_reset(&self, i: usize, t: T, y: &mut SVector<T, N>);
     /// Interior samples of event `i`.
     fn interior_samples(&self, i: usize) -> usize;
+    /// Whether the stepper restarts at event `i`.
+    fn restarts(&self, _i: usize) -> bool {
+        false
+    }
 }
 
 impl<T: Real, const N: usize> EventSet<T, N> for () {
@@ -322,6 +339,9 @@ impl<T: Real, const N: usize, G: EventFunction<T, N>, R: ResetMap<T, N>> EventSe
     fn interior_samples(&self, _i: usize) -> usize {
         self.interior_samples
     }
+    fn restarts(&self, _i: usize) -> bool {
+        self.restart
+    }
 }
 
 macro_rules! event_tuple {
@@ -350,6 +370,9 @@ macro_rules! event_tuple {
             }
             fn interior_samples(&self, i: usize) -> usize {
                 match i { $($idx => self.$idx.interior_samples(0),)+ _ => 0 }
+            }
+            fn restarts(&self, i: usize) -> bool {
+                match i { $($idx => self.$idx.restarts(0),)+ _ => false }
             }
         }
     };
