@@ -556,6 +556,36 @@ pub(crate) fn stats_since(s0: &Stats, s1: &Stats) -> Stats {
     }
 }
 
+/// Drops a stepper's derivative cache at its current state (after its system changed).
+pub(crate) fn refresh_cache<T: Real, const M: usize, St: crate::integrate::Stepper<T, M>>(
+    stepper: &mut St,
+) {
+    let (t, z) = stepper.current();
+    let z = *z;
+    stepper.reset_state(t, z);
+}
+
+/// Moves a started stepper's clock to `t0`, keeping its state.
+pub(crate) fn set_clock<T: Real, const M: usize, St: crate::integrate::Stepper<T, M>>(
+    stepper: &mut St,
+    started: bool,
+    t0: T,
+) -> crate::Result<()> {
+    if !t0.is_finite() {
+        return Err(LyapunovError::NonFinite {
+            what: "t0",
+            value: crate::scalar::to_f64(t0),
+        }
+        .into());
+    }
+    if !started {
+        return Err(LyapunovError::NotStarted.into());
+    }
+    let z = *stepper.current().1;
+    stepper.reset_state(t0, z);
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -290,9 +290,7 @@ where
     pub fn set_system(&mut self, system: S) {
         self.pair.set_system(system);
         if self.started {
-            let (t, z) = self.stepper.current();
-            let z = *z;
-            self.stepper.reset_state(t, z);
+            super::refresh_cache(&mut self.stepper);
         }
     }
 
@@ -302,19 +300,7 @@ where
     /// # Errors
     /// [`LyapunovError::NonFinite`] if `t0` is not finite; [`LyapunovError::NotStarted`].
     pub fn set_time(&mut self, t0: T) -> Result<()> {
-        if !t0.is_finite() {
-            return Err(LyapunovError::NonFinite {
-                what: "t0",
-                value: to_f64(t0),
-            }
-            .into());
-        }
-        if !self.started {
-            return Err(LyapunovError::NotStarted.into());
-        }
-        let z = *self.stepper.current().1;
-        self.stepper.reset_state(t0, z);
-        Ok(())
+        super::set_clock(&mut self.stepper, self.started, t0)
     }
 
     /// Runs `intervals` renormalization intervals of length `tau` and discards them.
