@@ -473,6 +473,24 @@ macro_rules! core_accessors {
 }
 pub(crate) use core_accessors;
 
+/// The end-point accessors of a dense output stored as `t0, t1, y0, y1, f0, f1` fields.
+macro_rules! dense_endpoints {
+    () => {
+        fn span(&self) -> (T, T) {
+            (self.t0, self.t1)
+        }
+
+        fn endpoints(&self) -> (&SVector<T, N>, &SVector<T, N>) {
+            (&self.y0, &self.y1)
+        }
+
+        fn end_derivatives(&self) -> (&SVector<T, N>, &SVector<T, N>) {
+            (&self.f0, &self.f1)
+        }
+    };
+}
+pub(crate) use dense_endpoints;
+
 /// PI step-size controller state (shared by the embedded methods).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct Controller<T> {

@@ -2,7 +2,9 @@
 
 use nalgebra::SVector;
 
-use super::{Core, DenseOutput, IntegrateError, Stats, Stepper, all_finite, core_accessors};
+use super::{
+    Core, DenseOutput, IntegrateError, Stats, Stepper, all_finite, core_accessors, dense_endpoints,
+};
 use crate::error::{ParameterError, positive};
 use crate::scalar::{lit, to_f64};
 use crate::{Dynamics, Real};
@@ -53,15 +55,8 @@ impl<T: Real, const N: usize> HermiteDense<T, N> {
 }
 
 impl<T: Real, const N: usize> DenseOutput<T, N> for HermiteDense<T, N> {
-    fn span(&self) -> (T, T) {
-        (self.t0, self.t1)
-    }
-    fn endpoints(&self) -> (&SVector<T, N>, &SVector<T, N>) {
-        (&self.y0, &self.y1)
-    }
-    fn end_derivatives(&self) -> (&SVector<T, N>, &SVector<T, N>) {
-        (&self.f0, &self.f1)
-    }
+    dense_endpoints!();
+
     #[inline(always)]
     fn interpolate_unchecked(&self, t: T, out: &mut SVector<T, N>) {
         let h = self.t1 - self.t0;

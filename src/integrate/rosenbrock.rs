@@ -4,7 +4,7 @@ use nalgebra::{SMatrix, SVector};
 
 use super::{
     Controller, Core, DenseOutput, IntegrateError, Stats, StepOptions, Stepper, Tolerances,
-    all_finite, clamp_to_limit, core_accessors, min_step,
+    all_finite, clamp_to_limit, core_accessors, dense_endpoints, min_step,
 };
 use crate::linalg::Lu;
 use crate::scalar::{epsilon, lit, to_f64};
@@ -49,15 +49,8 @@ pub struct Rosenbrock23Dense<T: Real, const N: usize> {
 }
 
 impl<T: Real, const N: usize> DenseOutput<T, N> for Rosenbrock23Dense<T, N> {
-    fn span(&self) -> (T, T) {
-        (self.t0, self.t1)
-    }
-    fn endpoints(&self) -> (&SVector<T, N>, &SVector<T, N>) {
-        (&self.y0, &self.y1)
-    }
-    fn end_derivatives(&self) -> (&SVector<T, N>, &SVector<T, N>) {
-        (&self.f0, &self.f1)
-    }
+    dense_endpoints!();
+
     #[inline(always)]
     fn interpolate_unchecked(&self, t: T, out: &mut SVector<T, N>) {
         let d = d_const::<T>();

@@ -494,6 +494,14 @@ pub(crate) fn check_blocks(blocks: usize) -> Result<usize, LyapunovError> {
     }
 }
 
+/// Validates a per-interval step cap.
+pub(crate) fn check_max_steps(max_steps: usize) -> crate::Result<usize> {
+    if max_steps == 0 {
+        return Err(crate::ParameterError::new("max_steps", 0.0, ">= 1").into());
+    }
+    Ok(max_steps)
+}
+
 /// Names `y0[i]` for diagnostics (indices beyond 7 share a name).
 pub(crate) fn component_name(i: usize) -> &'static str {
     const NAMES: [&str; 8] = [

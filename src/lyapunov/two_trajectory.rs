@@ -256,10 +256,7 @@ where
     /// # Errors
     /// [`ParameterError`](crate::ParameterError) if `max_steps == 0`.
     pub fn with_max_steps_per_interval(mut self, max_steps: usize) -> Result<Self> {
-        if max_steps == 0 {
-            return Err(crate::ParameterError::new("max_steps", 0.0, ">= 1").into());
-        }
-        self.max_steps = max_steps;
+        self.max_steps = super::check_max_steps(max_steps)?;
         Ok(self)
     }
 
