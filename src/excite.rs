@@ -6,6 +6,7 @@
 
 use crate::Real;
 use crate::error::{ParameterError, finite, non_negative, positive};
+use crate::fastmath;
 use crate::scalar::lit;
 
 /// A time-dependent force `f(t)`.
@@ -122,11 +123,11 @@ impl<T: Real> Harmonic<T> {
 impl<T: Real> Excitation<T> for Harmonic<T> {
     #[inline(always)]
     fn force(&self, t: T) -> T {
-        self.amplitude * (self.omega * t + self.phase0).sin()
+        self.amplitude * fastmath::sin(self.omega * t + self.phase0)
     }
     #[inline(always)]
     fn force_rate(&self, t: T) -> T {
-        self.amplitude * self.omega * (self.omega * t + self.phase0).cos()
+        self.amplitude * self.omega * fastmath::cos(self.omega * t + self.phase0)
     }
     fn phase(&self, t: T) -> Option<T> {
         Some(self.omega * t + self.phase0)
@@ -192,11 +193,11 @@ impl<T: Real> UnbalancedRotor<T> {
 impl<T: Real> Excitation<T> for UnbalancedRotor<T> {
     #[inline(always)]
     fn force(&self, t: T) -> T {
-        self.amp * (self.omega * t).sin()
+        self.amp * fastmath::sin(self.omega * t)
     }
     #[inline(always)]
     fn force_rate(&self, t: T) -> T {
-        self.amp * self.omega * (self.omega * t).cos()
+        self.amp * self.omega * fastmath::cos(self.omega * t)
     }
     fn phase(&self, t: T) -> Option<T> {
         Some(self.omega * t)
@@ -251,13 +252,13 @@ impl<T: Real> Excitation<T> for RampedRotor<T> {
     fn force(&self, t: T) -> T {
         let w = self.omega0 + self.rate * t;
         let phi = (self.omega0 + lit::<T>(0.5) * self.rate * t) * t;
-        let (s, c) = phi.sin_cos();
+        let (s, c) = (fastmath::sin(phi), fastmath::cos(phi));
         self.m0e * (w * w * s - self.rate * c)
     }
     fn force_rate(&self, t: T) -> T {
         let w = self.omega0 + self.rate * t;
         let phi = (self.omega0 + lit::<T>(0.5) * self.rate * t) * t;
-        let (s, c) = phi.sin_cos();
+        let (s, c) = (fastmath::sin(phi), fastmath::cos(phi));
         let r = self.rate;
         self.m0e * (lit::<T>(2.0) * w * r * s + w * w * w * c + r * w * s)
     }

@@ -50,6 +50,7 @@ pub mod entropy;
 pub mod error;
 pub mod event;
 pub mod excite;
+pub mod fastmath;
 pub mod force;
 pub mod identify;
 pub mod integrate;

@@ -4,7 +4,7 @@
 use nalgebra::Vector2;
 use nonsmooth::drive::{Control, EventRecord, Observer, Simulation};
 use nonsmooth::event::{Direction, Event, Level};
-use nonsmooth::integrate::{Dop853, Dopri5, Stepper, Tolerances};
+use nonsmooth::integrate::{Dop853, Dopri5, StepOptions, Stepper, Tolerances};
 use nonsmooth::model::paper::{PAPER, PaperParameters};
 
 #[derive(Default)]
@@ -139,4 +139,38 @@ fn runs_are_bit_identical() {
             .all(|(x, y)| x.t.to_bits() == y.t.to_bits() && x.y == y.y)
     );
     assert!(!ia.is_empty());
+}
+
+#[test]
+fn predictive_controller_cuts_rejections_and_keeps_the_trajectory() {
+    // The two controllers on the period-2 orbit at ω = 19 (stable, so trajectories that
+    // start together stay together up to the integration error). The predictive correction
+    // must reject fewer trial steps at the contact's non-smooth points (measured: −30 % at
+    // ω = 20.465) and land on the same orbit to the integration error.
+    let run = |pred: bool| {
+        let opts = StepOptions::default().with_predictive(pred);
+        let osc = PAPER.oscillator::<f64>(19.0).unwrap();
+        let ev = Event::new(Level::new(0, PAPER.x_i).unwrap(), Direction::Rising);
+        let mut sim = Simulation::new(osc, Dopri5::with_options(tol(1e-8), opts)).with_events(ev);
+        let x0 = PAPER.static_equilibrium().unwrap();
+        let mut imp = Impacts::default();
+        let t_end = 120.0 * std::f64::consts::TAU / 19.0;
+        let out = sim
+            .run(0.0, Vector2::new(x0, 0.0), t_end, &mut imp)
+            .unwrap();
+        (out.y, imp.0.len(), *sim.stepper().stats())
+    };
+    let (y_pi, n_pi, s_pi) = run(false);
+    let (y_pr, n_pr, s_pr) = run(true);
+    assert_eq!(n_pi, n_pr, "same impacts");
+    assert!(
+        (s_pr.rejected as f64) < 0.85 * s_pi.rejected as f64,
+        "rejections: predictive {} vs PI {}",
+        s_pr.rejected,
+        s_pi.rejected
+    );
+    // Measured: 11775 → 8197 rejections; the end states differ by 1.9e-8 m, 7.6e-8 m/s
+    // (Poincaré scatter on this orbit at rtol 1e-8 reaches 1e-8 m, 4e-7 m/s).
+    assert!((y_pi[0] - y_pr[0]).abs() < 1e-7, "{y_pi:?} vs {y_pr:?}");
+    assert!((y_pi[1] - y_pr[1]).abs() < 1e-6, "{y_pi:?} vs {y_pr:?}");
 }

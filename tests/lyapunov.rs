@@ -383,12 +383,15 @@ fn d0_study_is_flat_on_the_paper_model() {
         pts[1]
     );
     // Too small (1e-8: the integration error of the difference dominates at rtol 1e-8) is
-    // off too. Shown on the period-2 orbit at ω = 19, where the estimate has almost no
-    // statistical spread (on the chaotic attractor the bias, ~0.05–0.1 1/s, is within a
-    // few spreads and its detection depends on the trajectory).
+    // off too: biased and/or noisy. Shown on the period-2 orbit at ω = 19, where the
+    // estimate has almost no statistical spread at a sound d0. Measured (DOPRI5 with the
+    // predictive controller): d0 = 1e-4 → −2.1234 ± 0.0006; d0 = 1e-8 → −2.076 ± 0.025
+    // (bias 0.05, spread ×40). The older PI-only step sequence gave a bias beyond three
+    // spreads; with the predictive correction the bias shrinks and the noise shows instead,
+    // so the control accepts either symptom.
     let pts = study(19.0, &[PAPER_D0, 1e-8]);
     assert!(
-        differ(pts[1], pts[0]),
+        differ(pts[1], pts[0]) || pts[1].1 > 10.0 * pts[0].1,
         "too small d0: {:?} vs {:?}",
         pts[1],
         pts[0]

@@ -6,7 +6,9 @@ use nalgebra::{Matrix2, Vector2};
 use nonsmooth::Dynamics;
 use nonsmooth::drive::{Control, EventRecord, Observer, Simulation, StepView, Termination};
 use nonsmooth::event::{Direction, Event, Level};
-use nonsmooth::integrate::{DenseOutput, Dop853, Dopri5, Rosenbrock23, Stepper, Tolerances};
+use nonsmooth::integrate::{
+    DenseOutput, Dop853, Dopri5, Rosenbrock23, StepOptions, Stepper, Tolerances,
+};
 use nonsmooth::model::paper::{PAPER, PaperOscillator};
 use nonsmooth::sample::Stroboscopic;
 
@@ -21,6 +23,8 @@ pub enum Ours {
     /// DOPRI5 with every step cut at the section times (`landing_grid`) instead of
     /// interpolating them.
     Dopri5Grid,
+    /// DOPRI5 with the predictive controller correction on.
+    Dopri5Pred,
 }
 
 /// Impact times.
@@ -89,6 +93,14 @@ fn run_with<S: Dynamics<f64, 2>>(sys: S, kind: Ours, job: &Job) -> RunResult {
     match kind {
         Ours::Dopri5 => go(sys, Dopri5::new(tol), job, false, start, cpu0),
         Ours::Dopri5Grid => go(sys, Dopri5::new(tol), job, true, start, cpu0),
+        Ours::Dopri5Pred => go(
+            sys,
+            Dopri5::with_options(tol, StepOptions::default().with_predictive(true)),
+            job,
+            false,
+            start,
+            cpu0,
+        ),
         Ours::Dop853 => go(sys, Dop853::new(tol), job, false, start, cpu0),
         Ours::Rosenbrock23 => go(sys, Rosenbrock23::new(tol), job, false, start, cpu0),
     }

@@ -180,6 +180,17 @@ pub struct StepOptions<T> {
     pub fac_max: T,
     /// PI controller constant `β` (0 gives the classical I controller).
     pub beta: T,
+    /// Gustafsson's predictive correction on accepted steps (default `false`): when the
+    /// errors grow while the steps shrink — the approach to a point where the solution is
+    /// not smooth — the next step is cut by the observed trend instead of being tried at
+    /// the PI controller's size and rejected. It can only shorten the PI proposal.
+    ///
+    /// Measured on the paper's oscillator (ω = 20.465, DOPRI5, rtol 10⁻⁸): a third fewer
+    /// rejected steps and 6 % fewer evaluations (10 % at 10⁻¹⁰), but at equal *accuracy*
+    /// no gain beyond the run-to-run spread, and a 3–10× larger scatter of Poincaré points
+    /// on periodic orbits (the steps it accepts next to non-smooth points carry errors the
+    /// embedded estimate underrates). Hence off by default.
+    pub predictive: bool,
 }
 
 impl<T: Real> Default for StepOptions<T> {
@@ -192,6 +203,7 @@ impl<T: Real> Default for StepOptions<T> {
             fac_min: lit(0.2),
             fac_max: lit(10.0),
             beta: lit(0.04),
+            predictive: false,
         }
     }
 }
@@ -213,6 +225,13 @@ impl<T: Real> StepOptions<T> {
     pub fn with_h_min(mut self, h_min: T) -> Result<Self, ParameterError> {
         self.h_min = crate::error::non_negative("h_min", h_min)?;
         Ok(self)
+    }
+
+    /// Switches Gustafsson's predictive correction on or off (see
+    /// [`predictive`](Self::predictive)).
+    pub fn with_predictive(mut self, on: bool) -> Self {
+        self.predictive = on;
+        self
     }
 
     /// Sets the initial step.
@@ -499,6 +518,12 @@ pub(crate) struct Controller<T> {
     expo: T,
     /// `ln` of the error norm of the last accepted step (floored at `ln 10⁻⁴`).
     ln_err_old: T,
+    /// `1/q`.
+    inv_q: T,
+    /// The last accepted step (0 before the first) and `ln` of its error norm floored at
+    /// `ln 10⁻²`, for the predictive correction.
+    h_acc: T,
+    ln_err_acc: T,
     rejected_last: bool,
 }
 
@@ -509,6 +534,9 @@ impl<T: Real> Controller<T> {
             opts,
             expo,
             ln_err_old: lit::<T>(1e-4).ln(),
+            inv_q: T::one() / error_order,
+            h_acc: T::zero(),
+            ln_err_acc: T::zero(),
             rejected_last: false,
         }
     }
@@ -532,9 +560,21 @@ impl<T: Real> Controller<T> {
         if err <= T::one() {
             // PI: fac = err^expo / err_old^β.
             let fac = (self.expo * ln_err - o.beta * self.ln_err_old).exp();
-            let fac = (fac / o.safety)
+            let mut fac = (fac / o.safety)
                 .max(T::one() / o.fac_max)
                 .min(T::one() / o.fac_min);
+            if o.predictive {
+                if self.h_acc > T::zero() {
+                    // Gustafsson (1994): (h_acc/h)·(err²/err_acc)^{1/q}, as in Hairer's
+                    // RADAU5; only ever shortens the PI proposal.
+                    let gus = self.h_acc / h
+                        * ((lit::<T>(2.0) * ln_err - self.ln_err_acc) * self.inv_q).exp()
+                        / o.safety;
+                    fac = fac.max(gus.max(T::one() / o.fac_max).min(T::one() / o.fac_min));
+                }
+                self.h_acc = h;
+                self.ln_err_acc = ln_err.max(lit::<T>(1e-2).ln());
+            }
             let mut h_new = h / fac;
             if self.rejected_last {
                 h_new = h_new.min(h);
