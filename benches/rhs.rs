@@ -1,4 +1,5 @@
-//! One right-hand-side evaluation of the paper's oscillator, in free flight and in contact.
+//! One right-hand-side evaluation of the paper's oscillator, in free flight and in contact;
+//! and the forcing's `sin` (`nonsmooth::fastmath` against `libm`, as a ratio in one run).
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use nalgebra::Vector2;
@@ -26,5 +27,22 @@ fn rhs(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, rhs);
+fn sine(c: &mut Criterion) {
+    // A run's arguments: ω·t over 1000 forcing periods.
+    let xs: Vec<f64> = (0..1024).map(|i| 20.465 * 0.30 * i as f64 + 0.1).collect();
+    let mut g = c.benchmark_group("forcing_sin_1024");
+    g.bench_function("libm", |b| {
+        b.iter(|| xs.iter().map(|&x| black_box(x).sin()).sum::<f64>())
+    });
+    g.bench_function("fastmath", |b| {
+        b.iter(|| {
+            xs.iter()
+                .map(|&x| nonsmooth::fastmath::sin(black_box(x)))
+                .sum::<f64>()
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, rhs, sine);
 criterion_main!(benches);
