@@ -4,8 +4,8 @@
 Workloads (the paper's oscillator at omega = 20.465 rad/s; see README.md):
   W1  1100 forcing periods from rest at the static equilibrium,
   W2  1000 periods from the state reached after 100 periods,
-  accuracy: x after 10 periods from 5 states on the attractor (worst of 5, and the RMS over
-  the 10 section times of the 5 runs) and the worst impact-time error over those periods,
+  accuracy: x after 10 periods from states on the attractor (worst of the brief's 5, and the
+  RMS over the 10 section times of 40 runs) and the worst impact-time error over those periods,
   against the Rust binary's reference (results/reference_*.csv: run `cargo run --release`
   first).
 
@@ -41,6 +41,9 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 RESULTS = os.path.join(HERE, "results")
 
 # The paper's parameters (nonsmooth::model::paper::PAPER).
+# err x10 is the worst end error over the brief's 5 fixed starts (forcing periods); the RMS
+# and the impact errors use every start of the reference (40, see README.md).
+BRIEF_STARTS = (100, 120, 140, 160, 180)
 M, M0E, K, C, T_FR, EPS = 8.735, 0.01805, 1418.9, 6.6511, 0.63133, 1e-6
 K_I, B, N3, X_I, ETA = 2.3983e8, 0.8485, 0.18667, -2.086e-3, 1e-8
 HALF_N3_M1 = (N3 - 1.0) * 0.5
@@ -194,6 +197,7 @@ def read_reference():
     for s in states:
         k = int(s["k"])
         segs.append(dict(t0=float(s["t0_s"]), y0=(float(s["x0_m"]), float(s["v0_m_s"])),
+                         brief=int(s["start_period"]) in BRIEF_STARTS,
                          x_end=float(s["x_end_m"]),
                          impacts=[float(i["t_s"]) for i in imps if int(i["k"]) == k],
                          xs=[float(q["x_m"]) for q in secs if int(q["k"]) == k]))
@@ -261,7 +265,8 @@ def main():
                 if r["status"] != "ok":
                     acc_status, err_x = r["status"], float("nan")
                     break
-                err_x = max(err_x, abs(r["x_end"] - s["x_end"]))
+                if s["brief"]:
+                    err_x = max(err_x, abs(r["x_end"] - s["x_end"]))
                 if len(r["xs"]) == len(s["xs"]):
                     sq += sum((a - b) ** 2 for a, b in zip(r["xs"], s["xs"]))
                     nsq += len(s["xs"])
