@@ -252,13 +252,13 @@ impl<T: Real> Excitation<T> for RampedRotor<T> {
     fn force(&self, t: T) -> T {
         let w = self.omega0 + self.rate * t;
         let phi = (self.omega0 + lit::<T>(0.5) * self.rate * t) * t;
-        let (s, c) = (fastmath::sin(phi), fastmath::cos(phi));
+        let (s, c) = fastmath::sin_cos(phi);
         self.m0e * (w * w * s - self.rate * c)
     }
     fn force_rate(&self, t: T) -> T {
         let w = self.omega0 + self.rate * t;
         let phi = (self.omega0 + lit::<T>(0.5) * self.rate * t) * t;
-        let (s, c) = (fastmath::sin(phi), fastmath::cos(phi));
+        let (s, c) = fastmath::sin_cos(phi);
         let r = self.rate;
         self.m0e * (lit::<T>(2.0) * w * r * s + w * w * w * c + r * w * s)
     }

@@ -6,8 +6,8 @@
 use nalgebra::SVector;
 
 use super::{
-    Controller, Core, DenseOutput, IntegrateError, Stats, StepOptions, Stepper, Tolerances,
-    all_finite, clamp_to_limit, core_accessors, dense_endpoints, min_step,
+    Controller, Core, DenseOutput, HermiteDense, IntegrateError, Stats, StepOptions, Stepper,
+    Tolerances, all_finite, clamp_to_limit, core_accessors, dense_endpoints, min_step,
 };
 use crate::scalar::{lit, to_f64};
 use crate::{Dynamics, Real};
@@ -259,13 +259,8 @@ pub struct Dop853<T: Real, const N: usize> {
 /// Dense output of a [`Dop853`] step.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Dop853Dense<T: Real, const N: usize> {
-    t0: T,
-    t1: T,
+    ends: HermiteDense<T, N>,
     h: T,
-    y0: SVector<T, N>,
-    y1: SVector<T, N>,
-    f0: SVector<T, N>,
-    f1: SVector<T, N>,
     r: [SVector<T, N>; 7],
 }
 
@@ -274,12 +269,13 @@ impl<T: Real, const N: usize> DenseOutput<T, N> for Dop853Dense<T, N> {
 
     #[inline(always)]
     fn interpolate_unchecked(&self, t: T, out: &mut SVector<T, N>) {
-        let s = (t - self.t0) / self.h;
+        let (t0, y0) = (self.ends.t0, &self.ends.y0);
+        let s = (t - t0) / self.h;
         let s1 = T::one() - s;
         let r = &self.r;
         for i in 0..N {
             let conpar = r[3][i] + s * (r[4][i] + s1 * (r[5][i] + s * r[6][i]));
-            out[i] = self.y0[i] + s * (r[0][i] + s1 * (r[1][i] + s * (r[2][i] + s1 * conpar)));
+            out[i] = y0[i] + s * (r[0][i] + s1 * (r[1][i] + s * (r[2][i] + s1 * conpar)));
         }
     }
 }
@@ -298,13 +294,8 @@ impl<T: Real, const N: usize> Dop853<T, N> {
             ctrl: Controller::new(opts, lit(8.0)),
             core: Core::new(opts.h_init),
             dense: Dop853Dense {
-                t0: T::zero(),
-                t1: T::zero(),
+                ends: HermiteDense::zeros(),
                 h: T::zero(),
-                y0: z,
-                y1: z,
-                f0: z,
-                f1: z,
                 r: [z; 7],
             },
         }
@@ -414,13 +405,8 @@ impl<T: Real, const N: usize> Stepper<T, N> for Dop853<T, N> {
                     r[3 + m] = acc * hs;
                 }
                 self.dense = Dop853Dense {
-                    t0: t,
-                    t1: t_new,
+                    ends: HermiteDense::new(t, t_new, y, y_new, k[0], f_new),
                     h: hs,
-                    y0: y,
-                    y1: y_new,
-                    f0: k[0],
-                    f1: f_new,
                     r,
                 };
                 self.core.accept(t_new, y_new, f_new, h_next, lands, h);

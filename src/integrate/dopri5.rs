@@ -3,8 +3,8 @@
 use nalgebra::SVector;
 
 use super::{
-    Controller, Core, DenseOutput, IntegrateError, Stats, StepOptions, Stepper, Tolerances,
-    all_finite, clamp_to_limit, core_accessors, dense_endpoints, min_step,
+    Controller, Core, DenseOutput, HermiteDense, IntegrateError, Stats, StepOptions, Stepper,
+    Tolerances, all_finite, clamp_to_limit, core_accessors, dense_endpoints, min_step,
 };
 use crate::scalar::{lit, to_f64};
 use crate::{Dynamics, Real};
@@ -27,13 +27,8 @@ pub struct Dopri5<T: Real, const N: usize> {
 /// Dense output of a [`Dopri5`] step.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Dopri5Dense<T: Real, const N: usize> {
-    t0: T,
-    t1: T,
+    ends: HermiteDense<T, N>,
     h: T,
-    y0: SVector<T, N>,
-    y1: SVector<T, N>,
-    f0: SVector<T, N>,
-    f1: SVector<T, N>,
     r2: SVector<T, N>,
     r3: SVector<T, N>,
     r4: SVector<T, N>,
@@ -44,13 +39,8 @@ impl<T: Real, const N: usize> Dopri5Dense<T, N> {
     fn empty() -> Self {
         let z = SVector::zeros();
         Self {
-            t0: T::zero(),
-            t1: T::zero(),
+            ends: HermiteDense::zeros(),
             h: T::zero(),
-            y0: z,
-            y1: z,
-            f0: z,
-            f1: z,
             r2: z,
             r3: z,
             r4: z,
@@ -64,10 +54,11 @@ impl<T: Real, const N: usize> DenseOutput<T, N> for Dopri5Dense<T, N> {
 
     #[inline(always)]
     fn interpolate_unchecked(&self, t: T, out: &mut SVector<T, N>) {
-        let th = (t - self.t0) / self.h;
+        let (t0, y0) = (self.ends.t0, &self.ends.y0);
+        let th = (t - t0) / self.h;
         let th1 = T::one() - th;
         for i in 0..N {
-            out[i] = self.y0[i]
+            out[i] = y0[i]
                 + th * (self.r2[i] + th1 * (self.r3[i] + th * (self.r4[i] + th1 * self.r5[i])));
         }
     }
@@ -195,13 +186,8 @@ impl<T: Real, const N: usize> Stepper<T, N> for Dopri5<T, N> {
                     c(69997945.0 / 29380423.0),
                 );
                 self.dense = Dopri5Dense {
-                    t0: t,
-                    t1: t_new,
+                    ends: HermiteDense::new(t, t_new, y, y_new, k1, k7),
                     h: hs,
-                    y0: y,
-                    y1: y_new,
-                    f0: k1,
-                    f1: k7,
                     r2: ydiff,
                     r3: bspl,
                     r4: ydiff - k7 * hs - bspl,

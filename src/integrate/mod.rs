@@ -492,19 +492,20 @@ macro_rules! core_accessors {
 }
 pub(crate) use core_accessors;
 
-/// The end-point accessors of a dense output stored as `t0, t1, y0, y1, f0, f1` fields.
+/// The end-point accessors of a dense output that keeps its step's ends in an
+/// `ends: HermiteDense` field.
 macro_rules! dense_endpoints {
     () => {
         fn span(&self) -> (T, T) {
-            (self.t0, self.t1)
+            self.ends.span()
         }
 
         fn endpoints(&self) -> (&SVector<T, N>, &SVector<T, N>) {
-            (&self.y0, &self.y1)
+            self.ends.endpoints()
         }
 
         fn end_derivatives(&self) -> (&SVector<T, N>, &SVector<T, N>) {
-            (&self.f0, &self.f1)
+            self.ends.end_derivatives()
         }
     };
 }
@@ -518,8 +519,6 @@ pub(crate) struct Controller<T> {
     expo: T,
     /// `ln` of the error norm of the last accepted step (floored at `ln 10⁻⁴`).
     ln_err_old: T,
-    /// `1/q`.
-    inv_q: T,
     /// The last accepted step (0 before the first) and `ln` of its error norm floored at
     /// `ln 10⁻²`, for the predictive correction.
     h_acc: T,
@@ -534,7 +533,6 @@ impl<T: Real> Controller<T> {
             opts,
             expo,
             ln_err_old: lit::<T>(1e-4).ln(),
-            inv_q: T::one() / error_order,
             h_acc: T::zero(),
             ln_err_acc: T::zero(),
             rejected_last: false,
@@ -568,7 +566,9 @@ impl<T: Real> Controller<T> {
                     // Gustafsson (1994): (h_acc/h)·(err²/err_acc)^{1/q}, as in Hairer's
                     // RADAU5; only ever shortens the PI proposal.
                     let gus = self.h_acc / h
-                        * ((lit::<T>(2.0) * ln_err - self.ln_err_acc) * self.inv_q).exp()
+                        * ((lit::<T>(2.0) * ln_err - self.ln_err_acc)
+                            * (self.expo + lit::<T>(0.75) * o.beta))
+                            .exp()
                         / o.safety;
                     fac = fac.max(gus.max(T::one() / o.fac_max).min(T::one() / o.fac_min));
                 }

@@ -2,9 +2,7 @@
 
 use nalgebra::SVector;
 
-use super::{
-    Core, DenseOutput, IntegrateError, Stats, Stepper, all_finite, core_accessors, dense_endpoints,
-};
+use super::{Core, DenseOutput, IntegrateError, Stats, Stepper, all_finite, core_accessors};
 use crate::error::{ParameterError, positive};
 use crate::scalar::{lit, to_f64};
 use crate::{Dynamics, Real};
@@ -23,11 +21,13 @@ pub struct Rk4<T: Real, const N: usize> {
 }
 
 /// Cubic Hermite interpolation between two states and their derivatives.
+///
+/// Also the step ends `(t0, t1, y0, y1, f0, f1)` that every method's dense output keeps.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HermiteDense<T: Real, const N: usize> {
-    t0: T,
+    pub(crate) t0: T,
     t1: T,
-    y0: SVector<T, N>,
+    pub(crate) y0: SVector<T, N>,
     y1: SVector<T, N>,
     f0: SVector<T, N>,
     f1: SVector<T, N>,
@@ -52,10 +52,29 @@ impl<T: Real, const N: usize> HermiteDense<T, N> {
             f1,
         }
     }
+
+    /// All zero (before the first step).
+    pub(crate) fn zeros() -> Self {
+        let z = SVector::zeros();
+        Self::new(T::zero(), T::zero(), z, z, z, z)
+    }
 }
 
 impl<T: Real, const N: usize> DenseOutput<T, N> for HermiteDense<T, N> {
-    dense_endpoints!();
+    #[inline(always)]
+    fn span(&self) -> (T, T) {
+        (self.t0, self.t1)
+    }
+
+    #[inline(always)]
+    fn endpoints(&self) -> (&SVector<T, N>, &SVector<T, N>) {
+        (&self.y0, &self.y1)
+    }
+
+    #[inline(always)]
+    fn end_derivatives(&self) -> (&SVector<T, N>, &SVector<T, N>) {
+        (&self.f0, &self.f1)
+    }
 
     #[inline(always)]
     fn interpolate_unchecked(&self, t: T, out: &mut SVector<T, N>) {
@@ -82,11 +101,10 @@ impl<T: Real, const N: usize> Rk4<T, N> {
     /// # Errors
     /// [`ParameterError`] unless `h` is finite and > 0.
     pub fn new(h: T) -> Result<Self, ParameterError> {
-        let z = SVector::zeros();
         Ok(Self {
             h: positive("h", h)?,
             core: Core::new(None),
-            dense: HermiteDense::new(T::zero(), T::zero(), z, z, z, z),
+            dense: HermiteDense::zeros(),
         })
     }
 }

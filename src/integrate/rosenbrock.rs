@@ -3,8 +3,8 @@
 use nalgebra::{SMatrix, SVector};
 
 use super::{
-    Controller, Core, DenseOutput, IntegrateError, Stats, StepOptions, Stepper, Tolerances,
-    all_finite, clamp_to_limit, core_accessors, dense_endpoints, min_step,
+    Controller, Core, DenseOutput, HermiteDense, IntegrateError, Stats, StepOptions, Stepper,
+    Tolerances, all_finite, clamp_to_limit, core_accessors, dense_endpoints, min_step,
 };
 use crate::linalg::Lu;
 use crate::scalar::{epsilon, lit, to_f64};
@@ -37,13 +37,8 @@ pub struct Rosenbrock23<T: Real, const N: usize> {
 /// Dense output of a [`Rosenbrock23`] step: `y(t0 + s·h) = y0 + h·(s(1−s)/(1−2d)·k1 + s(s−2d)/(1−2d)·k2)`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Rosenbrock23Dense<T: Real, const N: usize> {
-    t0: T,
-    t1: T,
+    ends: HermiteDense<T, N>,
     h: T,
-    y0: SVector<T, N>,
-    y1: SVector<T, N>,
-    f0: SVector<T, N>,
-    f1: SVector<T, N>,
     k1: SVector<T, N>,
     k2: SVector<T, N>,
 }
@@ -54,12 +49,13 @@ impl<T: Real, const N: usize> DenseOutput<T, N> for Rosenbrock23Dense<T, N> {
     #[inline(always)]
     fn interpolate_unchecked(&self, t: T, out: &mut SVector<T, N>) {
         let d = d_const::<T>();
-        let s = (t - self.t0) / self.h;
+        let (t0, y0) = (self.ends.t0, &self.ends.y0);
+        let s = (t - t0) / self.h;
         let den = T::one() - lit::<T>(2.0) * d;
         let c1 = s * (T::one() - s) / den;
         let c2 = s * (s - lit::<T>(2.0) * d) / den;
         for i in 0..N {
-            out[i] = self.y0[i] + self.h * (c1 * self.k1[i] + c2 * self.k2[i]);
+            out[i] = y0[i] + self.h * (c1 * self.k1[i] + c2 * self.k2[i]);
         }
     }
 }
@@ -83,13 +79,8 @@ impl<T: Real, const N: usize> Rosenbrock23<T, N> {
             ctrl: Controller::new(opts, lit(3.0)),
             core: Core::new(opts.h_init),
             dense: Rosenbrock23Dense {
-                t0: T::zero(),
-                t1: T::zero(),
+                ends: HermiteDense::zeros(),
                 h: T::one(),
-                y0: z,
-                y1: z,
-                f0: z,
-                f1: z,
                 k1: z,
                 k2: z,
             },
@@ -199,13 +190,8 @@ impl<T: Real, const N: usize> Stepper<T, N> for Rosenbrock23<T, N> {
             let (accept, h_next) = self.ctrl.propose(err, hs);
             if accept {
                 self.dense = Rosenbrock23Dense {
-                    t0: t,
-                    t1: t_new,
+                    ends: HermiteDense::new(t, t_new, y, y_new, f0, f2),
                     h: hs,
-                    y0: y,
-                    y1: y_new,
-                    f0,
-                    f1: f2,
                     k1,
                     k2,
                 };
