@@ -7,7 +7,8 @@ use nalgebra::SVector;
 
 use super::{
     Controller, Core, DenseOutput, HermiteDense, IntegrateError, Stats, StepOptions, Stepper,
-    Tolerances, all_finite, clamp_to_limit, core_accessors, dense_endpoints, min_step,
+    Tolerances, adaptive_constructors, all_finite, clamp_to_limit, core_accessors, dense_endpoints,
+    min_step,
 };
 use crate::scalar::{lit, to_f64};
 use crate::{Dynamics, Real};
@@ -280,27 +281,19 @@ impl<T: Real, const N: usize> DenseOutput<T, N> for Dop853Dense<T, N> {
     }
 }
 
-impl<T: Real, const N: usize> Dop853<T, N> {
-    /// A stepper with the given tolerances and default [`StepOptions`].
-    pub fn new(tol: Tolerances<T, N>) -> Self {
-        Self::with_options(tol, StepOptions::default())
-    }
-
-    /// A stepper with explicit step options.
-    pub fn with_options(tol: Tolerances<T, N>, opts: StepOptions<T>) -> Self {
-        let z = SVector::zeros();
+impl<T: Real, const N: usize> Dop853Dense<T, N> {
+    fn empty() -> Self {
         Self {
-            tol,
-            ctrl: Controller::new(opts, lit(8.0)),
-            core: Core::new(opts.h_init),
-            dense: Dop853Dense {
-                ends: HermiteDense::zeros(),
-                h: T::zero(),
-                r: [z; 7],
-            },
+            ends: HermiteDense::zeros(),
+            h: T::zero(),
+            r: [SVector::zeros(); 7],
         }
     }
+}
 
+adaptive_constructors!(Dop853, Dop853Dense, 8.0);
+
+impl<T: Real, const N: usize> Dop853<T, N> {
     #[inline(always)]
     fn stage<S: Dynamics<T, N>>(
         sys: &S,

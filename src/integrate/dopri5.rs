@@ -4,7 +4,8 @@ use nalgebra::SVector;
 
 use super::{
     Controller, Core, DenseOutput, HermiteDense, IntegrateError, Stats, StepOptions, Stepper,
-    Tolerances, all_finite, clamp_to_limit, core_accessors, dense_endpoints, min_step,
+    Tolerances, adaptive_constructors, all_finite, clamp_to_limit, core_accessors, dense_endpoints,
+    min_step,
 };
 use crate::scalar::{lit, to_f64};
 use crate::{Dynamics, Real};
@@ -64,32 +65,7 @@ impl<T: Real, const N: usize> DenseOutput<T, N> for Dopri5Dense<T, N> {
     }
 }
 
-impl<T: Real, const N: usize> Dopri5<T, N> {
-    /// A stepper with the given tolerances and default [`StepOptions`].
-    pub fn new(tol: Tolerances<T, N>) -> Self {
-        Self::with_options(tol, StepOptions::default())
-    }
-
-    /// A stepper with explicit step options.
-    pub fn with_options(tol: Tolerances<T, N>, opts: StepOptions<T>) -> Self {
-        Self {
-            tol,
-            ctrl: Controller::new(opts, lit(5.0)),
-            core: Core::new(opts.h_init),
-            dense: Dopri5Dense::empty(),
-        }
-    }
-
-    /// The tolerances.
-    pub fn tolerances(&self) -> &Tolerances<T, N> {
-        &self.tol
-    }
-
-    /// The step size the controller proposes next.
-    pub fn proposed_step(&self) -> Option<T> {
-        self.core.h
-    }
-}
+adaptive_constructors!(Dopri5, Dopri5Dense, 5.0);
 
 impl<T: Real, const N: usize> Stepper<T, N> for Dopri5<T, N> {
     type Dense = Dopri5Dense<T, N>;

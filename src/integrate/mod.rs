@@ -492,6 +492,41 @@ macro_rules! core_accessors {
 }
 pub(crate) use core_accessors;
 
+/// The constructors and getters every adaptive stepper `$stepper { tol, ctrl, core, dense }`
+/// shares; `$dense::empty()` is its dense output before the first step, `$order` the order
+/// of its error estimate (for the controller's exponent).
+macro_rules! adaptive_constructors {
+    ($stepper:ident, $dense:ident, $order:expr) => {
+        impl<T: Real, const N: usize> $stepper<T, N> {
+            /// A stepper with the given tolerances and default [`StepOptions`].
+            pub fn new(tol: Tolerances<T, N>) -> Self {
+                Self::with_options(tol, StepOptions::default())
+            }
+
+            /// A stepper with explicit step options.
+            pub fn with_options(tol: Tolerances<T, N>, opts: StepOptions<T>) -> Self {
+                Self {
+                    tol,
+                    ctrl: Controller::new(opts, lit($order)),
+                    core: Core::new(opts.h_init),
+                    dense: $dense::empty(),
+                }
+            }
+
+            /// The tolerances.
+            pub fn tolerances(&self) -> &Tolerances<T, N> {
+                &self.tol
+            }
+
+            /// The step size the controller proposes next.
+            pub fn proposed_step(&self) -> Option<T> {
+                self.core.h
+            }
+        }
+    };
+}
+pub(crate) use adaptive_constructors;
+
 /// The end-point accessors of a dense output that keeps its step's ends in an
 /// `ends: HermiteDense` field.
 macro_rules! dense_endpoints {

@@ -4,7 +4,8 @@ use nalgebra::{SMatrix, SVector};
 
 use super::{
     Controller, Core, DenseOutput, HermiteDense, IntegrateError, Stats, StepOptions, Stepper,
-    Tolerances, all_finite, clamp_to_limit, core_accessors, dense_endpoints, min_step,
+    Tolerances, adaptive_constructors, all_finite, clamp_to_limit, core_accessors, dense_endpoints,
+    min_step,
 };
 use crate::linalg::Lu;
 use crate::scalar::{epsilon, lit, to_f64};
@@ -65,28 +66,20 @@ fn d_const<T: Real>() -> T {
     T::one() / (lit::<T>(2.0) + lit::<T>(2.0).sqrt())
 }
 
-impl<T: Real, const N: usize> Rosenbrock23<T, N> {
-    /// A stepper with the given tolerances and default [`StepOptions`].
-    pub fn new(tol: Tolerances<T, N>) -> Self {
-        Self::with_options(tol, StepOptions::default())
-    }
-
-    /// A stepper with explicit step options.
-    pub fn with_options(tol: Tolerances<T, N>, opts: StepOptions<T>) -> Self {
-        let z = SVector::zeros();
+impl<T: Real, const N: usize> Rosenbrock23Dense<T, N> {
+    fn empty() -> Self {
         Self {
-            tol,
-            ctrl: Controller::new(opts, lit(3.0)),
-            core: Core::new(opts.h_init),
-            dense: Rosenbrock23Dense {
-                ends: HermiteDense::zeros(),
-                h: T::one(),
-                k1: z,
-                k2: z,
-            },
+            ends: HermiteDense::zeros(),
+            h: T::one(),
+            k1: SVector::zeros(),
+            k2: SVector::zeros(),
         }
     }
+}
 
+adaptive_constructors!(Rosenbrock23, Rosenbrock23Dense, 3.0);
+
+impl<T: Real, const N: usize> Rosenbrock23<T, N> {
     fn jacobian<S: Dynamics<T, N>>(
         &mut self,
         sys: &S,
