@@ -96,66 +96,25 @@ pub fn run(m: DeMethod, job: &Job) -> RunResult {
     const MAX: usize = 2_000_000_000;
     let res = {
         let ivp = IVP::ode(&sys, t0, tf, y0).solout(Obs { rec: &mut rec });
+        // The same settings on every method: rtol, per-component atol, run-wide step and
+        // rejection limits raised (BDF has no rejection limit).
+        macro_rules! solve {
+            ($builder:expr) => {
+                ivp.method($builder.rtol(rtol).atol(atol).max_steps(MAX))
+                    .solve()
+                    .map(|s| (s.status.clone(), s.evals.function))
+            };
+            ($builder:expr, rejects) => {
+                solve!($builder.max_rejects(MAX))
+            };
+        }
         match m {
-            DeMethod::Dopri5 => ivp
-                .method(
-                    ExplicitRungeKutta::dopri5()
-                        .rtol(rtol)
-                        .atol(atol)
-                        .max_steps(MAX)
-                        .max_rejects(MAX),
-                )
-                .solve()
-                .map(|s| (s.status.clone(), s.evals.function)),
-            DeMethod::Dop853 => ivp
-                .method(
-                    ExplicitRungeKutta::dop853()
-                        .rtol(rtol)
-                        .atol(atol)
-                        .max_steps(MAX)
-                        .max_rejects(MAX),
-                )
-                .solve()
-                .map(|s| (s.status.clone(), s.evals.function)),
-            DeMethod::Rkv988e => ivp
-                .method(
-                    ExplicitRungeKutta::rkv988e()
-                        .rtol(rtol)
-                        .atol(atol)
-                        .max_steps(MAX)
-                        .max_rejects(MAX),
-                )
-                .solve()
-                .map(|s| (s.status.clone(), s.evals.function)),
-            DeMethod::Radau5 => ivp
-                .method(
-                    ImplicitRungeKutta::radau5()
-                        .rtol(rtol)
-                        .atol(atol)
-                        .max_steps(MAX)
-                        .max_rejects(MAX),
-                )
-                .solve()
-                .map(|s| (s.status.clone(), s.evals.function)),
-            DeMethod::Kvaerno745 => ivp
-                .method(
-                    DiagonallyImplicitRungeKutta::kvaerno745()
-                        .rtol(rtol)
-                        .atol(atol)
-                        .max_steps(MAX)
-                        .max_rejects(MAX),
-                )
-                .solve()
-                .map(|s| (s.status.clone(), s.evals.function)),
-            DeMethod::Bdf => ivp
-                .method(
-                    BackwardDifferentiationFormula::adaptive()
-                        .rtol(rtol)
-                        .atol(atol)
-                        .max_steps(MAX),
-                )
-                .solve()
-                .map(|s| (s.status.clone(), s.evals.function)),
+            DeMethod::Dopri5 => solve!(ExplicitRungeKutta::dopri5(), rejects),
+            DeMethod::Dop853 => solve!(ExplicitRungeKutta::dop853(), rejects),
+            DeMethod::Rkv988e => solve!(ExplicitRungeKutta::rkv988e(), rejects),
+            DeMethod::Radau5 => solve!(ImplicitRungeKutta::radau5(), rejects),
+            DeMethod::Kvaerno745 => solve!(DiagonallyImplicitRungeKutta::kvaerno745(), rejects),
+            DeMethod::Bdf => solve!(BackwardDifferentiationFormula::adaptive()),
         }
     };
     let elapsed = crate::common::cpu_now() - cpu0;
