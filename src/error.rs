@@ -70,39 +70,3 @@ pub enum Error {
 
 /// `Result` with the crate's [`Error`](enum@Error).
 pub type Result<T, E = Error> = std::result::Result<T, E>;
-
-/// Validates that `value` is finite and strictly positive.
-pub(crate) fn positive<T: crate::Real>(name: &'static str, value: T) -> Result<T, ParameterError> {
-    let v = crate::scalar::to_f64(value);
-    if value.is_finite() && value > T::zero() {
-        Ok(value)
-    } else {
-        Err(ParameterError::new(name, v, "finite and > 0"))
-    }
-}
-
-/// Validates that `value` is finite and non-negative.
-pub(crate) fn non_negative<T: crate::Real>(
-    name: &'static str,
-    value: T,
-) -> Result<T, ParameterError> {
-    let v = crate::scalar::to_f64(value);
-    if value.is_finite() && value >= T::zero() {
-        Ok(value)
-    } else {
-        Err(ParameterError::new(name, v, "finite and >= 0"))
-    }
-}
-
-/// Validates that `value` is finite.
-pub(crate) fn finite<T: crate::Real>(name: &'static str, value: T) -> Result<T, ParameterError> {
-    if value.is_finite() {
-        Ok(value)
-    } else {
-        Err(ParameterError::new(
-            name,
-            crate::scalar::to_f64(value),
-            "finite",
-        ))
-    }
-}

@@ -5,9 +5,10 @@
 //! frequency it is the root of a quadratic, never an accumulated sum.
 
 use crate::Real;
-use crate::error::{ParameterError, finite, non_negative, positive};
+use crate::error::ParameterError;
 use crate::fastmath;
 use crate::scalar::lit;
+use crate::validate::{finite, non_negative, positive};
 
 /// A time-dependent force `f(t)`.
 ///

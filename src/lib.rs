@@ -65,6 +65,7 @@ pub mod signal;
 pub mod sweep;
 #[cfg(feature = "testing")]
 pub mod testing;
+pub(crate) mod validate;
 
 pub use dynamics::Dynamics;
 

@@ -2,11 +2,11 @@
 //! their grazing estimates, written for any 1-DOF [`Oscillator`].
 
 use super::AnalysisError;
-use crate::error::{finite, non_negative, positive};
 use crate::excite::{Excitation, UnbalancedRotor};
 use crate::model::Oscillator;
 use crate::roots::{brent, golden_max};
 use crate::scalar::{lit, to_f64};
+use crate::validate::{finite, non_negative, positive};
 use crate::{ForceLaw, Real};
 
 /// The amplitude `F0(ω)` of a harmonic forcing `F0(ω)·sin ωt` as a function of its frequency.

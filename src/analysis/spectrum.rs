@@ -149,8 +149,8 @@ impl SpectrumAnalyzer {
     /// # Errors
     /// [`AnalysisError::Parameter`] unless both are finite and > 0.
     pub fn with_tolerances(mut self, period: f64, spacing: f64) -> Result<Self, AnalysisError> {
-        self.period_tolerance = crate::error::positive("period_tolerance", period)?;
-        self.spacing_tolerance = crate::error::positive("spacing_tolerance", spacing)?;
+        self.period_tolerance = crate::validate::positive("period_tolerance", period)?;
+        self.spacing_tolerance = crate::validate::positive("spacing_tolerance", spacing)?;
         Ok(self)
     }
 

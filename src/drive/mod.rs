@@ -269,7 +269,7 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
     /// # Errors
     /// [`ParameterError`](crate::ParameterError) unless `tol` is finite and > 0.
     pub fn event_tolerance(mut self, tol: T) -> Result<Self> {
-        self.event_tol = crate::error::positive("event_tol", tol)?;
+        self.event_tol = crate::validate::positive("event_tol", tol)?;
         Ok(self)
     }
 
@@ -287,8 +287,8 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
     /// [`ParameterError`](crate::ParameterError) unless `dt` is finite and > 0.
     pub fn landing_grid(mut self, grid: Option<(T, T)>) -> Result<Self> {
         if let Some((o, dt)) = grid {
-            crate::error::finite("origin", o)?;
-            crate::error::positive("dt", dt)?;
+            crate::validate::finite("origin", o)?;
+            crate::validate::positive("dt", dt)?;
         }
         self.grid = grid;
         Ok(self)

@@ -27,8 +27,9 @@ use nalgebra::SVector;
 use thiserror::Error;
 
 use crate::Real;
-use crate::error::{ParameterError, non_negative};
+use crate::error::ParameterError;
 use crate::scalar::lit;
+use crate::validate::non_negative;
 
 /// Event errors.
 #[derive(Debug, Clone, PartialEq, Error)]
@@ -118,7 +119,7 @@ impl<T: Real> Level<T> {
     pub fn new(index: usize, level: T) -> Result<Self, ParameterError> {
         Ok(Self {
             index,
-            level: crate::error::finite("level", level)?,
+            level: crate::validate::finite("level", level)?,
         })
     }
 
@@ -472,7 +473,7 @@ impl<T: Real> ZenoGuard<T> {
         }
         Ok(Self {
             max_events,
-            window: crate::error::positive("window", window)?,
+            window: crate::validate::positive("window", window)?,
         })
     }
 }

@@ -1,7 +1,8 @@
 //! Compliant contact: the generalized Hertz law with nonlinear damping.
 
-use crate::error::{ParameterError, finite, non_negative, positive};
+use crate::error::ParameterError;
 use crate::scalar::{Exponent, lit};
+use crate::validate::{finite, non_negative, positive};
 use crate::{ForceLaw, Real};
 
 /// Which side of the stop the body penetrates.

@@ -1,6 +1,7 @@
 //! Regularized dry (Coulomb) friction.
 
-use crate::error::{ParameterError, non_negative, positive};
+use crate::error::ParameterError;
+use crate::validate::{non_negative, positive};
 use crate::{ForceLaw, Real};
 
 /// How the sign function of Coulomb friction is smoothed.

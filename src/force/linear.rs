@@ -1,6 +1,7 @@
 //! Linear spring and viscous damper.
 
-use crate::error::{ParameterError, non_negative};
+use crate::error::ParameterError;
+use crate::validate::non_negative;
 use crate::{ForceLaw, Real};
 
 /// A linear spring `F = k·(x − x₀)`.
@@ -38,7 +39,7 @@ impl<T: Real> LinearSpring<T> {
     /// # Errors
     /// [`ParameterError`] if `x0` is not finite.
     pub fn with_rest_position(mut self, x0: T) -> Result<Self, ParameterError> {
-        self.x0 = crate::error::finite("x0", x0)?;
+        self.x0 = crate::validate::finite("x0", x0)?;
         Ok(self)
     }
 

@@ -1,7 +1,8 @@
 //! Nelder–Mead fitting in a [`ParameterSpace`].
 
 use super::{IdentifyError, ParamValues, ParameterSpace};
-use crate::error::{ParameterError, positive};
+use crate::error::ParameterError;
+use crate::validate::positive;
 
 /// Settings of [`fit_nelder_mead`].
 ///

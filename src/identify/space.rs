@@ -515,8 +515,8 @@ impl ParameterSpace {
         relative_step: f64,
         zero_step: f64,
     ) -> Result<Vec<Vec<f64>>, IdentifyError> {
-        crate::error::positive("relative_step", relative_step)?;
-        crate::error::positive("zero_step", zero_step)?;
+        crate::validate::positive("relative_step", relative_step)?;
+        crate::validate::positive("zero_step", zero_step)?;
         let u0 = self.to_unconstrained(at)?;
         let mut vertices = vec![u0.clone()];
         for (j, p) in self.params.iter().enumerate() {

@@ -35,8 +35,9 @@ pub use rosenbrock::{Rosenbrock23, Rosenbrock23Dense};
 use nalgebra::SVector;
 use thiserror::Error;
 
-use crate::error::{ParameterError, positive};
+use crate::error::ParameterError;
 use crate::scalar::{lit, to_f64};
+use crate::validate::positive;
 use crate::{Dynamics, Real};
 
 /// Why an integration failed.
@@ -223,7 +224,7 @@ impl<T: Real> StepOptions<T> {
     /// # Errors
     /// [`ParameterError`] unless `h_min` is finite and ≥ 0.
     pub fn with_h_min(mut self, h_min: T) -> Result<Self, ParameterError> {
-        self.h_min = crate::error::non_negative("h_min", h_min)?;
+        self.h_min = crate::validate::non_negative("h_min", h_min)?;
         Ok(self)
     }
 

@@ -3,8 +3,9 @@
 use nalgebra::SVector;
 
 use super::{Core, DenseOutput, IntegrateError, Stats, Stepper, all_finite, core_accessors};
-use crate::error::{ParameterError, positive};
+use crate::error::ParameterError;
 use crate::scalar::{lit, to_f64};
+use crate::validate::positive;
 use crate::{Dynamics, Real};
 
 /// The classical 4th-order Runge–Kutta method with a fixed step `h` (the last step of a

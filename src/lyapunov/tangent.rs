@@ -186,8 +186,8 @@ pub fn tangent_tolerances<T: Real, const N: usize, const K: usize, const M: usiz
     tangent_atol: T,
 ) -> Result<Tolerances<T, M>> {
     check_tangent_dims::<N, K, M>()?;
-    crate::error::positive("tangent_rtol", tangent_rtol)?;
-    crate::error::positive("tangent_atol", tangent_atol)?;
+    crate::validate::positive("tangent_rtol", tangent_rtol)?;
+    crate::validate::positive("tangent_atol", tangent_atol)?;
     let mut rtol = SVector::<T, M>::repeat(tangent_rtol);
     let mut atol = SVector::<T, M>::repeat(tangent_atol);
     for i in 0..N {

@@ -1,9 +1,10 @@
 use nalgebra::{SMatrix, SVector};
 
-use crate::error::{ParameterError, Result, positive};
+use crate::error::{ParameterError, Result};
 use crate::excite::Excitation;
 use crate::roots::brent;
 use crate::scalar::lit;
+use crate::validate::positive;
 use crate::{Dynamics, ForceLaw, Real};
 
 /// A 1-DOF oscillator `m·ẍ + ΣF(x, ẋ) = f(t)` with state `y = (x, ẋ)`.

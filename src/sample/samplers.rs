@@ -2,12 +2,13 @@ use crate::Real;
 use nalgebra::SVector;
 
 use crate::drive::{Control, EventRecord, Observer, StepView};
-use crate::error::{ParameterError, finite, positive};
+use crate::error::ParameterError;
 use crate::event::{Direction, EventFunction, locate};
 use crate::excite::Excitation;
 use crate::integrate::DenseOutput;
 use crate::roots::golden_max;
 use crate::scalar::lit;
+use crate::validate::{finite, positive};
 
 /// The times `t_i` of a stroboscopic section.
 pub trait SectionClock<T: Real> {

@@ -2,7 +2,7 @@
 
 use super::{SignalError, validate_samples};
 use crate::Real;
-use crate::error::{finite, non_negative};
+use crate::validate::{finite, non_negative};
 
 /// How far below the stop the paper puts its impact threshold: impacts are upward crossings
 /// of `x_I − 0.01 mm` (Sect. 3), i.e. `x_I − PAPER_IMPACT_OFFSET` in metres.

@@ -2,8 +2,8 @@
 
 use super::{Location, SignalError, validate_samples};
 use crate::Real;
-use crate::error::positive;
 use crate::scalar::{lit, to_f64};
+use crate::validate::positive;
 
 /// The filter's state before the first sample.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]

@@ -2,8 +2,8 @@
 
 use super::{Location, SignalError, validate_finite, validate_samples};
 use crate::Real;
-use crate::error::finite;
 use crate::scalar::{lit, to_f64};
+use crate::validate::finite;
 
 /// How a measured phase is given.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]

@@ -5,11 +5,12 @@ use nalgebra::Vector2;
 use super::{SignalError, TimeSeries};
 use crate::Dynamics;
 use crate::drive::{Observer, Outcome, Simulation};
-use crate::error::{ParameterError, finite, non_negative, positive};
+use crate::error::ParameterError;
 use crate::event::{Direction, Event, EventSet, Level};
 use crate::integrate::{Dopri5, Stats, Tolerances};
 use crate::model::paper::PaperParameters;
 use crate::sample::{Impact, ImpactSequence, Trajectory};
+use crate::validate::{finite, non_negative, positive};
 
 /// How the paper's rotor is driven: at a constant angular frequency, or on the experiment's
 /// linear ramp `ω(t) = ω₀ + r·t` (the phase is then `φ(t) = ω₀t + rt²/2`, see

@@ -3,9 +3,10 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::error::{ParameterError, finite, positive};
+use crate::error::ParameterError;
 use crate::scalar::{lit, to_f64};
 use crate::testing::HarmonicOscillator;
+use crate::validate::{finite, positive};
 use crate::{Dynamics, Real};
 
 /// A ball in free flight above a wall at height 0, state `(h, v)`, with Newton restitution

@@ -2,8 +2,9 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::error::{ParameterError, finite, positive};
+use crate::error::ParameterError;
 use crate::scalar::lit;
+use crate::validate::{finite, positive};
 use crate::{Dynamics, Real};
 
 /// A reference problem whose solution is known in closed form.
