@@ -39,6 +39,9 @@ pub enum Error {
     /// A bracketing root search failed.
     #[error(transparent)]
     Root(#[from] crate::roots::RootError),
+    /// A model could not be assembled or analysed.
+    #[error(transparent)]
+    Model(#[from] crate::model::ModelError),
     /// Time integration failed.
     #[error(transparent)]
     Integrate(#[from] crate::integrate::IntegrateError),

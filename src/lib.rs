@@ -10,7 +10,8 @@
 //! | scalar, errors | `T: Real` (`f64`, `f32`), one crate [`Error`] | [`Real`], [`Error`] |
 //! | force laws | `F(x, ẋ)` terms with partials, composable by value | [`ForceLaw`], [`force`] |
 //! | excitation | harmonic, unbalanced rotor, ramped rotor | [`excite`] |
-//! | systems | `ẏ = f(t, y)`; the 1-DOF [`model::Oscillator`]; the paper's model | [`Dynamics`], [`model::paper`] |
+//! | models | `ẏ = f(t, y)`; N-DOF systems from elements, the 1-DOF oscillator | [`Dynamics`], [`model::Mechanical`], [`model::Oscillator`] |
+//! | catalogue | ready systems: the paper's cart, Duffing–Ueda, a 2-DOF impact oscillator | [`systems`] |
 //! | roots | Brent's method for equilibria and events | [`roots`] |
 //! | integrators | DOPRI5, DOP853, RK4, Rosenbrock 2(3) with dense output | [`integrate`] |
 //! | events | crossings located on dense output, grazing pairs, resets, Zeno guard | [`event`] |
@@ -63,6 +64,7 @@ pub mod sample;
 pub mod scalar;
 pub mod signal;
 pub mod sweep;
+pub mod systems;
 #[cfg(feature = "testing")]
 pub mod testing;
 pub(crate) mod validate;

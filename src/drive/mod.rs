@@ -26,7 +26,7 @@
 use nalgebra::SVector;
 
 use crate::error::Result;
-use crate::event::{Direction, EventError, EventHistory, EventSet, ZenoGuard, locate};
+use crate::event::{Direction, EventError, EventHistory, EventSet, MAX_EVENTS, ZenoGuard, locate};
 use crate::integrate::{DenseOutput, IntegrateError, Stats, Stepper, check_state};
 use crate::scalar::{lit, to_f64};
 use crate::{Dynamics, Real};
@@ -194,10 +194,6 @@ observer_tuple!(A 0, B 1, C 2, D 3);
 observer_tuple!(A 0, B 1, C 2, D 3, E 4);
 observer_tuple!(A 0, B 1, C 2, D 3, E 4, F 5);
 
-/// Capacity of the per-step crossing scan (events per step beyond it are found on the next
-/// pass over the remainder of the step).
-const MAX_EVENTS: usize = 8;
-
 /// A system, a stepper and a set of events.
 #[derive(Debug, Clone)]
 pub struct Simulation<T: Real, const N: usize, S, St, E = ()> {
@@ -206,16 +202,15 @@ pub struct Simulation<T: Real, const N: usize, S, St, E = ()> {
     events: E,
     max_steps: usize,
     event_tol: T,
-    zeno: Option<ZenoGuard<T>>,
-    active_zeno: ZenoGuard<T>,
+    zeno: ZenoGuard<T>,
     history: EventHistory<T>,
     grid: Option<(T, T)>,
 }
 
 impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>> Simulation<T, N, S, St, ()> {
     /// A simulation without events; default step cap 10⁸, event time tolerance 10⁻¹²
-    /// (absolute, plus 4·ε_mach·|t|), Zeno guard: more than 16 events within `10⁻⁵` of
-    /// the run's time span.
+    /// (absolute, plus 4·ε_mach·|t|), the default [`ZenoGuard`] (a geometric accumulation
+    /// of events below 10⁻⁹ s; it does not depend on the run's span).
     pub fn new(system: S, stepper: St) -> Self {
         Self {
             system,
@@ -223,11 +218,7 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>> Simulation<T
             events: (),
             max_steps: 100_000_000,
             event_tol: lit(1e-12),
-            zeno: None,
-            active_zeno: ZenoGuard {
-                max_events: 16,
-                window: T::one(),
-            },
+            zeno: ZenoGuard::default(),
             history: EventHistory::new(),
             grid: None,
         }
@@ -237,8 +228,16 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>> Simulation<T
 impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<T, N>>
     Simulation<T, N, S, St, E>
 {
-    /// Replaces the event set.
+    /// Replaces the event set (at most [`MAX_EVENTS`] events: a larger set does not
+    /// compile). Event and reset indices are checked against the state dimension when a run
+    /// starts.
     pub fn with_events<E2: EventSet<T, N>>(self, events: E2) -> Simulation<T, N, S, St, E2> {
+        const {
+            assert!(
+                E2::LEN <= MAX_EVENTS,
+                "a simulation takes at most MAX_EVENTS (8) events"
+            )
+        };
         Simulation {
             system: self.system,
             stepper: self.stepper,
@@ -246,7 +245,6 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
             max_steps: self.max_steps,
             event_tol: self.event_tol,
             zeno: self.zeno,
-            active_zeno: self.active_zeno,
             history: self.history,
             grid: self.grid,
         }
@@ -273,10 +271,9 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
         Ok(self)
     }
 
-    /// Sets the chatter/Zeno guard (default: more than 16 events within `10⁻⁵` of the
-    /// run's time span).
+    /// Sets the chatter/Zeno guard (default: [`ZenoGuard::default`]).
     pub fn zeno_guard(mut self, guard: ZenoGuard<T>) -> Self {
-        self.zeno = Some(guard);
+        self.zeno = guard;
         self
     }
 
@@ -338,6 +335,7 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
             .into());
         }
         check_state(&y0)?;
+        self.events.check()?;
         self.stepper.reset_state(t0, y0);
         self.history.clear();
         observer.on_start(t0, &y0);
@@ -363,27 +361,41 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
             }
             .into());
         }
+        self.events.check()?;
         observer.on_start(t0, &y0);
         self.advance(t_end, observer)
     }
 
     fn advance<O: Observer<T, N>>(&mut self, t_end: T, observer: &mut O) -> Result<Outcome<T, N>> {
         let stats0 = *self.stepper.stats();
-        let span = t_end - self.stepper.current().0;
-        self.active_zeno = self.zeno.unwrap_or(ZenoGuard {
-            max_events: 16,
-            window: span * lit(1e-5),
-        });
-        let n_ev = E::LEN.min(MAX_EVENTS);
+        let n_ev = E::LEN;
         // Per event: the side (+1/−1) of the surface the trajectory is on (used when g is
-        // exactly zero at a step boundary), and whether it is armed (false right after a
-        // reset that left the state on the far side while moving back out).
+        // exactly zero at a step boundary; 0 = not known yet, for a start exactly on the
+        // surface), and whether it is armed (false right after a reset that left the state
+        // on the far side while moving back out).
         let mut side = [0i8; MAX_EVENTS];
         let mut armed = [true; MAX_EVENTS];
         {
             let (t, y) = self.stepper.current();
+            let mut f = SVector::zeros();
+            let mut have_f = false;
             for (i, s) in side.iter_mut().enumerate().take(n_ev) {
-                *s = sign_of(self.events.value(i, t, y));
+                let g = self.events.value(i, t, y);
+                if !g.is_finite() {
+                    return Err(non_finite(i, t, g));
+                }
+                *s = sign_of(g);
+                if *s == 0 {
+                    // Start on the surface: it has not been crossed; the side is the one
+                    // the trajectory moves to (from the rate, else from the first step).
+                    if !have_f {
+                        self.system.rhs(t, y, &mut f);
+                        have_f = true;
+                    }
+                    if let Some(r) = self.events.rate(i, t, y, &f) {
+                        *s = sign_of(r);
+                    }
+                }
             }
         }
         let mut steps = 0usize;
@@ -430,13 +442,29 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
             let mut found: [Option<Crossing<T>>; MAX_EVENTS] = [None; MAX_EVENTS];
             for i in 0..n_ev {
                 let g0 = self.events.value(i, ts0, &y_start);
+                g_end[i] = self.events.value(i, ts1, &y_end);
+                if !(g0.is_finite() && g_end[i].is_finite()) {
+                    let (t, g) = if g0.is_finite() {
+                        (ts1, g_end[i])
+                    } else {
+                        (ts0, g0)
+                    };
+                    return Err(non_finite(i, t, g));
+                }
+                if side[i] == 0 {
+                    // Started on the surface with no rate: the side is where it goes.
+                    side[i] = if g_end[i] != T::zero() {
+                        sign_of(g_end[i])
+                    } else {
+                        1
+                    };
+                }
                 st_g[i] = if g0 == T::zero() {
                     signed_tiny(side[i])
                 } else {
                     g0
                 };
                 st_r[i] = self.events.rate(i, ts0, &y_start, &f_start);
-                g_end[i] = self.events.value(i, ts1, &y_end);
                 r_end[i] = self.events.rate(i, ts1, &y_end, &f_end);
                 found[i] =
                     self.find_crossing(i, st_t[i], st_g[i], st_r[i], ts1, g_end[i], r_end[i]);
@@ -488,11 +516,19 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
                     Direction::Falling
                 };
                 self.stepper.stats_mut().events += 1;
-                if let Some(count) = self.history.push(tc, &self.active_zeno) {
+                if let Some((count, last)) = self.history.push(tc, &self.zeno) {
+                    // Leave the simulation at the event (after its reset) so that the
+                    // caller can change the model and continue from there.
+                    let mut ya = yc;
+                    if self.events.resets(i) {
+                        self.events.apply_reset(i, tc, &mut ya);
+                    }
+                    self.stepper.reset_state(tc, ya);
                     return Err(EventError::Zeno {
                         t: to_f64(tc),
                         count,
-                        window: to_f64(self.active_zeno.window),
+                        last_interval: to_f64(last),
+                        state: ya.iter().map(|&v| to_f64(v)).collect(),
                     }
                     .into());
                 }
@@ -639,6 +675,10 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
                     let tb = t_lo + (t1 - t_lo) * lit::<T>(m as f64 / (k as f64 + 1.0));
                     (tb, g_at(tb))
                 };
+                if !gb.is_finite() {
+                    // Not a crossing (the step ends are checked to be finite).
+                    continue;
+                }
                 if gb != T::zero() && sign_of(gb) != sign_of(ga) {
                     let (tc, _) = locate(g_at, ta, tb, ga, gb, tol);
                     let resume = if m == k + 1 { None } else { Some((tb, gb)) };
@@ -704,6 +744,15 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
             resume: Some((te, ge)),
         })
     }
+}
+
+fn non_finite<T: Real>(index: usize, t: T, g: T) -> crate::Error {
+    EventError::NonFinite {
+        index,
+        t: to_f64(t),
+        value: to_f64(g),
+    }
+    .into()
 }
 
 /// A crossing found on a step.

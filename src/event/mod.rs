@@ -35,25 +35,39 @@ use crate::validate::non_negative;
 #[derive(Debug, Clone, PartialEq, Error)]
 #[non_exhaustive]
 pub enum EventError {
-    /// Too many events in too short a time (chatter, Zeno accumulation).
+    /// Events accumulate (Zeno/chatter): their intervals shrank geometrically below the
+    /// guard's time floor. The simulation is left at the last event, so a caller can switch
+    /// model (e.g. to sticking) and continue from `t`, `state`.
     #[error(
-        "{count} events within {window} s ending at t = {t}: accumulation of events (Zeno/chatter); the run was stopped"
+        "{count} events with geometrically shrinking intervals, the last {last_interval} s, at t = {t}: accumulation of events (Zeno/chatter); the run was stopped there"
     )]
     Zeno {
         /// Time of the last event.
         t: f64,
-        /// Number of events in the window.
+        /// Number of consecutive shrinking intervals (or events in the guard's window).
         count: usize,
-        /// The window length.
-        window: f64,
+        /// The last inter-event interval.
+        last_interval: f64,
+        /// The state after the last event (after its reset, if any), to restart from.
+        state: Vec<f64>,
     },
-    /// An event index outside the configured events.
-    #[error("event index {index} out of range ({len} events)")]
+    /// An event or reset index outside the state vector.
+    #[error("event or reset index {index} out of range (state dimension {len})")]
     IndexOutOfRange {
         /// Index.
         index: usize,
-        /// Number of events.
+        /// The state dimension.
         len: usize,
+    },
+    /// An event function returned NaN or ±∞.
+    #[error("event function {index} is not finite (g = {value}) at t = {t}")]
+    NonFinite {
+        /// The event's index in the set.
+        index: usize,
+        /// Time.
+        t: f64,
+        /// The value.
+        value: f64,
     },
 }
 
@@ -101,6 +115,24 @@ pub trait EventFunction<T: Real, const N: usize> {
     fn rate(&self, _t: T, _y: &SVector<T, N>, _dy: &SVector<T, N>) -> Option<T> {
         None
     }
+
+    /// Checks that the function can be evaluated on states of dimension `N` (e.g. that a
+    /// component index is in range); the driver calls it before a run starts. Default: `Ok`.
+    ///
+    /// # Errors
+    /// [`EventError::IndexOutOfRange`] for an index `≥ N`.
+    fn check(&self) -> Result<(), EventError> {
+        Ok(())
+    }
+}
+
+/// `Err(IndexOutOfRange)` unless `index < n`.
+pub(crate) fn check_index(index: usize, n: usize) -> Result<(), EventError> {
+    if index < n {
+        Ok(())
+    } else {
+        Err(EventError::IndexOutOfRange { index, len: n })
+    }
 }
 
 /// The hyperplane `g = y[index] − level` (e.g. the stop `x = x_I`), with rate `ẏ[index]`.
@@ -143,6 +175,9 @@ impl<T: Real, const N: usize> EventFunction<T, N> for Level<T> {
     fn rate(&self, _t: T, _y: &SVector<T, N>, dy: &SVector<T, N>) -> Option<T> {
         Some(dy[self.index])
     }
+    fn check(&self) -> Result<(), EventError> {
+        check_index(self.index, N)
+    }
 }
 
 /// An event function from a closure `g(t, y)` (no rate: use interior samples for grazing).
@@ -162,6 +197,13 @@ pub trait ResetMap<T: Real, const N: usize> {
     const RESETS: bool = true;
     /// Applies the reset in place.
     fn apply(&self, t: T, y: &mut SVector<T, N>);
+    /// Checks indices against the state dimension `N` (called before a run). Default: `Ok`.
+    ///
+    /// # Errors
+    /// [`EventError::IndexOutOfRange`] for an index `≥ N`.
+    fn check(&self) -> Result<(), EventError> {
+        Ok(())
+    }
 }
 
 /// No reset.
@@ -196,6 +238,9 @@ impl<T: Real, const N: usize> ResetMap<T, N> for Restitution<T> {
     #[inline(always)]
     fn apply(&self, _t: T, y: &mut SVector<T, N>) {
         y[self.velocity] = -self.r * y[self.velocity];
+    }
+    fn check(&self) -> Result<(), EventError> {
+        check_index(self.velocity, N)
     }
 }
 
@@ -265,8 +310,11 @@ impl<G, R> Event<G, R> {
     }
 }
 
-/// A fixed set of events, dispatched by index without `dyn` (implemented for `()`, a single
-/// [`Event`] and tuples of up to four).
+/// A fixed set of events, dispatched by index without `dyn`: `()`, a single [`Event`], and
+/// tuples of up to eight sets — nested tuples too. Indices are flat: in `((a, b), c)`, `a`
+/// is 0, `b` is 1 and `c` is 2 (a tuple's [`LEN`](EventSet::LEN) is the sum of its
+/// members'). A simulation takes at most [`MAX_EVENTS`] events; a larger set is a compile
+/// error at the `Simulation::with_events` call, never a silently unchecked event.
 pub trait EventSet<T: Real, const N: usize> {
     /// The number of events.
     const LEN: usize;
@@ -288,7 +336,18 @@ pub trait EventSet<T: Real, const N: usize> {
     fn restarts(&self, _i: usize) -> bool {
         false
     }
+    /// Checks every event function and reset against the state dimension.
+    ///
+    /// # Errors
+    /// [`EventError::IndexOutOfRange`] for an index `≥ N`.
+    fn check(&self) -> Result<(), EventError> {
+        Ok(())
+    }
 }
+
+/// The most events one simulation takes (the driver keeps per-event state in fixed arrays
+/// on the stack; a larger set does not compile).
+pub const MAX_EVENTS: usize = 8;
 
 impl<T: Real, const N: usize> EventSet<T, N> for () {
     const LEN: usize = 0;
@@ -343,46 +402,75 @@ impl<T: Real, const N: usize, G: EventFunction<T, N>, R: ResetMap<T, N>> EventSe
     fn restarts(&self, _i: usize) -> bool {
         self.restart
     }
+    fn check(&self) -> Result<(), EventError> {
+        self.function.check()?;
+        self.reset.check()
+    }
+}
+
+/// Dispatches flat index `$i` to the member that holds it (members are visited in order;
+/// each takes `LEN` consecutive indices).
+macro_rules! dispatch {
+    ($self:ident, $i:ident, $default:expr, |$m:ident, $j:ident| $call:expr; $($name:ident $idx:tt),+) => {{
+        let mut $j = $i;
+        $(
+            if $j < <$name as EventSet<T, N>>::LEN {
+                let $m = &$self.$idx;
+                return $call;
+            }
+            $j -= <$name as EventSet<T, N>>::LEN;
+        )+
+        let _ = $j;
+        $default
+    }};
 }
 
 macro_rules! event_tuple {
-    ($len:expr; $($name:ident $idx:tt),+) => {
+    ($($name:ident $idx:tt),+) => {
         impl<T: Real, const N: usize, $($name: EventSet<T, N>),+> EventSet<T, N> for ($($name,)+) {
-            const LEN: usize = $len;
+            const LEN: usize = 0 $(+ <$name as EventSet<T, N>>::LEN)+;
             #[inline(always)]
             fn value(&self, i: usize, t: T, y: &SVector<T, N>) -> T {
-                match i { $($idx => self.$idx.value(0, t, y),)+ _ => T::one() }
+                dispatch!(self, i, T::one(), |m, j| m.value(j, t, y); $($name $idx),+)
             }
             #[inline(always)]
             fn rate(&self, i: usize, t: T, y: &SVector<T, N>, dy: &SVector<T, N>) -> Option<T> {
-                match i { $($idx => self.$idx.rate(0, t, y, dy),)+ _ => None }
+                dispatch!(self, i, None, |m, j| m.rate(j, t, y, dy); $($name $idx),+)
             }
             fn direction(&self, i: usize) -> Direction {
-                match i { $($idx => self.$idx.direction(0),)+ _ => Direction::Either }
+                dispatch!(self, i, Direction::Either, |m, j| m.direction(j); $($name $idx),+)
             }
             fn is_terminal(&self, i: usize) -> bool {
-                match i { $($idx => self.$idx.is_terminal(0),)+ _ => false }
+                dispatch!(self, i, false, |m, j| m.is_terminal(j); $($name $idx),+)
             }
             fn resets(&self, i: usize) -> bool {
-                match i { $($idx => self.$idx.resets(0),)+ _ => false }
+                dispatch!(self, i, false, |m, j| m.resets(j); $($name $idx),+)
             }
             fn apply_reset(&self, i: usize, t: T, y: &mut SVector<T, N>) {
-                match i { $($idx => self.$idx.apply_reset(0, t, y),)+ _ => {} }
+                dispatch!(self, i, (), |m, j| m.apply_reset(j, t, y); $($name $idx),+)
             }
             fn interior_samples(&self, i: usize) -> usize {
-                match i { $($idx => self.$idx.interior_samples(0),)+ _ => 0 }
+                dispatch!(self, i, 0, |m, j| m.interior_samples(j); $($name $idx),+)
             }
             fn restarts(&self, i: usize) -> bool {
-                match i { $($idx => self.$idx.restarts(0),)+ _ => false }
+                dispatch!(self, i, false, |m, j| m.restarts(j); $($name $idx),+)
+            }
+            fn check(&self) -> Result<(), EventError> {
+                $(self.$idx.check()?;)+
+                Ok(())
             }
         }
     };
 }
 
-event_tuple!(1; A 0);
-event_tuple!(2; A 0, B 1);
-event_tuple!(3; A 0, B 1, C 2);
-event_tuple!(4; A 0, B 1, C 2, D 3);
+event_tuple!(A 0);
+event_tuple!(A 0, B 1);
+event_tuple!(A 0, B 1, C 2);
+event_tuple!(A 0, B 1, C 2, D 3);
+event_tuple!(A 0, B 1, C 2, D 3, E 4);
+event_tuple!(A 0, B 1, C 2, D 3, E 4, F 5);
+event_tuple!(A 0, B 1, C 2, D 3, E 4, F 5, G 6);
+event_tuple!(A 0, B 1, C 2, D 3, E 4, F 5, G 6, H 7);
 
 /// Locates a crossing of `g` in `[a, b]` (with `ga`, `gb` of opposite signs, `gb` on the
 /// far side) by the Illinois variant of regula falsi, which keeps a bracket at all times.
@@ -445,25 +533,81 @@ pub(crate) fn locate<T: Real, F: FnMut(T) -> T>(
     (b, gb)
 }
 
-/// Chatter/Zeno guard: more than `max_events` events within any time window of length
-/// `window` stops the run with [`EventError::Zeno`].
+/// The chatter/Zeno guard.
+///
+/// # Rule (default, [`ZenoGuard::accumulation`])
+/// The guard trips when `count` consecutive inter-event intervals each shrink by at least
+/// the factor `ratio` (`Δ_{k+1} ≤ ratio·Δ_k`, a geometric accumulation of events) **and**
+/// the last interval is below the time floor `floor + 64·ε_mach·|t|`. Both conditions are
+/// about the events themselves, never about the length of the run:
+/// - an orbit whose events are at least `floor` apart never trips, however long the run;
+/// - a periodic orbit with at most `count` events per period never trips at all (its
+///   intervals repeat, so no run of `count` strictly shrinking intervals exists);
+/// - a true accumulation (a ball coming to rest by a geometric sequence of bounces) trips
+///   after the same number of events whatever `t_end` is.
+///
+/// The default is `count = 16`, `ratio = 0.999`, `floor = 1e-9 s`. A fixed window
+/// ([`ZenoGuard::window`]: more than `max_events` events within `window`) is available for
+/// callers who know their time scale.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ZenoGuard<T> {
-    /// Events allowed within the window (at most [`ZenoGuard::CAPACITY`]).
-    pub max_events: usize,
-    /// The window length.
-    pub window: T,
+    rule: ZenoRule<T>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum ZenoRule<T> {
+    Accumulation { count: usize, ratio: T, floor: T },
+    Window { max_events: usize, window: T },
+}
+
+impl<T: Real> Default for ZenoGuard<T> {
+    fn default() -> Self {
+        Self {
+            rule: ZenoRule::Accumulation {
+                count: 16,
+                ratio: lit(0.999),
+                floor: lit(1e-9),
+            },
+        }
+    }
 }
 
 impl<T: Real> ZenoGuard<T> {
-    /// The largest `max_events` supported (the guard keeps a fixed ring buffer).
+    /// The largest `max_events` supported by [`window`](Self::window) (the guard keeps a
+    /// fixed ring buffer).
     pub const CAPACITY: usize = 256;
 
-    /// A guard allowing `max_events` events per `window`.
+    /// Trips after `count` consecutive intervals each at most `ratio` times the previous,
+    /// the last below `floor` seconds (plus `64·ε_mach·|t|`).
+    ///
+    /// # Errors
+    /// [`ParameterError`] unless `count ≥ 2`, `0 < ratio < 1` and `floor` is finite and > 0.
+    pub fn accumulation(count: usize, ratio: T, floor: T) -> Result<Self, ParameterError> {
+        if count < 2 {
+            return Err(ParameterError::new("count", count as f64, ">= 2"));
+        }
+        if !(ratio > T::zero() && ratio < T::one()) {
+            return Err(ParameterError::new(
+                "ratio",
+                crate::scalar::to_f64(ratio),
+                "in (0, 1)",
+            ));
+        }
+        Ok(Self {
+            rule: ZenoRule::Accumulation {
+                count,
+                ratio,
+                floor: crate::validate::positive("floor", floor)?,
+            },
+        })
+    }
+
+    /// Trips when more than `max_events` events fall within any time window of length
+    /// `window`.
     ///
     /// # Errors
     /// [`ParameterError`] unless `1 ≤ max_events ≤ 256` and `window` is finite and > 0.
-    pub fn new(max_events: usize, window: T) -> Result<Self, ParameterError> {
+    pub fn window(max_events: usize, window: T) -> Result<Self, ParameterError> {
         if max_events == 0 || max_events > Self::CAPACITY {
             return Err(ParameterError::new(
                 "max_events",
@@ -472,18 +616,30 @@ impl<T: Real> ZenoGuard<T> {
             ));
         }
         Ok(Self {
-            max_events,
-            window: crate::validate::positive("window", window)?,
+            rule: ZenoRule::Window {
+                max_events,
+                window: crate::validate::positive("window", window)?,
+            },
         })
+    }
+
+    /// Same as [`window`](Self::window) (the first-stage name).
+    ///
+    /// # Errors
+    /// As [`window`](Self::window).
+    pub fn new(max_events: usize, window: T) -> Result<Self, ParameterError> {
+        Self::window(max_events, window)
     }
 }
 
-/// Ring buffer of recent event times for the guard.
+/// What the guard remembers of recent events.
 #[derive(Debug, Clone)]
 pub(crate) struct EventHistory<T> {
     times: [T; 256],
     next: usize,
     len: usize,
+    last_interval: Option<T>,
+    shrinking: usize,
 }
 
 impl<T: Real> EventHistory<T> {
@@ -492,27 +648,58 @@ impl<T: Real> EventHistory<T> {
             times: [T::zero(); 256],
             next: 0,
             len: 0,
+            last_interval: None,
+            shrinking: 0,
         }
     }
 
     pub(crate) fn clear(&mut self) {
         self.len = 0;
         self.next = 0;
+        self.last_interval = None;
+        self.shrinking = 0;
     }
 
-    /// Records `t`; returns the count in the window if the guard is exceeded.
-    pub(crate) fn push(&mut self, t: T, guard: &ZenoGuard<T>) -> Option<usize> {
+    /// Records `t`; returns `(count, last interval)` if the guard trips.
+    pub(crate) fn push(&mut self, t: T, guard: &ZenoGuard<T>) -> Option<(usize, T)> {
+        let prev = if self.len > 0 {
+            Some(self.times[(self.next + 255) % 256])
+        } else {
+            None
+        };
         self.times[self.next] = t;
         self.next = (self.next + 1) % 256;
         self.len = (self.len + 1).min(256);
-        if self.len > guard.max_events {
-            // The (max_events+1)-th most recent event.
-            let idx = (self.next + 256 - 1 - guard.max_events) % 256;
-            if t - self.times[idx] <= guard.window {
-                return Some(guard.max_events + 1);
+        let interval = prev.map(|p| t - p);
+        match guard.rule {
+            ZenoRule::Accumulation {
+                count,
+                ratio,
+                floor,
+            } => {
+                let d = interval?;
+                if let Some(last) = self.last_interval {
+                    if d <= ratio * last {
+                        self.shrinking += 1;
+                    } else {
+                        self.shrinking = 0;
+                    }
+                }
+                self.last_interval = Some(d);
+                let floor_t = floor + lit::<T>(64.0) * T::default_epsilon() * t.abs();
+                (self.shrinking >= count && d <= floor_t).then_some((self.shrinking, d))
+            }
+            ZenoRule::Window { max_events, window } => {
+                if self.len > max_events {
+                    // The (max_events+1)-th most recent event.
+                    let idx = (self.next + 256 - 1 - max_events) % 256;
+                    if t - self.times[idx] <= window {
+                        return Some((max_events + 1, interval.unwrap_or(T::zero())));
+                    }
+                }
+                None
             }
         }
-        None
     }
 }
 
@@ -534,15 +721,49 @@ mod tests {
 
     #[test]
     fn zeno_guard_counts_in_window() {
-        let g = ZenoGuard::new(3, 1.0).unwrap();
+        let g = ZenoGuard::window(3, 1.0).unwrap();
         let mut h = EventHistory::new();
         assert!(h.push(0.0, &g).is_none());
         assert!(h.push(0.5, &g).is_none());
         assert!(h.push(2.0, &g).is_none());
         assert!(h.push(2.1, &g).is_none());
         assert!(h.push(2.2, &g).is_none());
-        assert_eq!(h.push(2.3, &g), Some(4));
+        assert_eq!(h.push(2.3, &g).map(|c| c.0), Some(4));
         assert!(ZenoGuard::new(0, 1.0).is_err());
         assert!(ZenoGuard::new(3, 0.0).is_err());
+    }
+
+    #[test]
+    fn accumulation_guard_trips_on_geometric_sequences_only() {
+        let g = ZenoGuard::<f64>::default();
+        // A geometric sequence of intervals 0.5^k from 0.1 s: trips once 16 consecutive
+        // intervals have shrunk and the last is below 1e-9 s.
+        let mut h = EventHistory::new();
+        let mut t = 0.0;
+        let mut tripped = None;
+        for k in 0..200 {
+            t += 0.1 * 0.5f64.powi(k);
+            if let Some(c) = h.push(t, &g) {
+                tripped = Some((k, c));
+                break;
+            }
+        }
+        let (k, (count, d)) = tripped.expect("geometric accumulation must trip");
+        assert!(d <= 1e-9 && count >= 16, "{k} {count} {d}");
+        assert_eq!(k, 27, "first k with 0.1·0.5^k ≤ 1e-9");
+        // A periodic pattern of 16 distinct intervals per period, some tiny, repeated 10⁵
+        // times: never trips, whatever the run length.
+        let mut h = EventHistory::new();
+        let pattern: Vec<f64> = (0..16).map(|k| 1e-12 * 2f64.powi(16 - k)).collect();
+        let mut t = 0.0;
+        for _ in 0..100_000 {
+            for &d in &pattern {
+                t += d + 1.0e-3 * (d == pattern[15]) as i32 as f64;
+                assert!(h.push(t, &g).is_none());
+            }
+        }
+        assert!(ZenoGuard::<f64>::accumulation(1, 0.5, 1e-9).is_err());
+        assert!(ZenoGuard::<f64>::accumulation(4, 1.0, 1e-9).is_err());
+        assert!(ZenoGuard::<f64>::accumulation(4, 0.5, 0.0).is_err());
     }
 }

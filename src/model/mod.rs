@@ -1,11 +1,21 @@
 //! Systems assembled from force laws and excitations.
 //!
-//! [`Oscillator`] is a one-degree-of-freedom system `m·ẍ + ΣF(x, ẋ) = f(t)` built from a
-//! mass, any [`ForceLaw`](crate::ForceLaw) (a tuple of laws is one) and any
-//! [`Excitation`](crate::excite::Excitation). The paper's impact oscillator is
-//! [`paper::PaperOscillator`], assembled from the generic parts in [`paper`].
+//! - [`Mechanical`]: an `N`-degree-of-freedom system `M q̈ + C q̇ + K q + Σ w F(w·q + o, w·q̇)
+//!   = Σ w f(t)` assembled from [`Element`]s (any [`ForceLaw`](crate::ForceLaw) acting on a
+//!   [`Coordinate`]: a degree of freedom, a relative coordinate `q_i − q_j + o`, any linear
+//!   form) and [`Load`]s (any [`Excitation`](crate::excite::Excitation) acting on a
+//!   coordinate), with the Jacobian assembled from the laws' partials and a Newton static
+//!   equilibrium.
+//! - [`Oscillator`]: the one-degree-of-freedom case `m·ẍ + ΣF(x, ẋ) = f(t)` in scalar form
+//!   (bit-identical to `Mechanical` with `N = 1`, without the vector bookkeeping).
+//!
+//! Ready-made systems — the paper's impact oscillator among them — are in
+//! [`systems`](crate::systems); [`paper`] is kept here as an alias of
+//! [`systems::paper`](crate::systems::paper).
 
+mod mechanical;
 mod oscillator;
-pub mod paper;
 
+pub use crate::systems::paper;
+pub use mechanical::{Coordinate, Element, Elements, Load, Loads, Mechanical, ModelError};
 pub use oscillator::Oscillator;

@@ -1,0 +1,930 @@
+//! N-degree-of-freedom mechanical systems assembled from elements.
+
+use nalgebra::{SMatrix, SVector};
+use thiserror::Error;
+
+use crate::error::ParameterError;
+use crate::excite::Excitation;
+use crate::linalg::Lu;
+use crate::scalar::{lit, to_f64};
+use crate::validate::finite;
+use crate::{Dynamics, ForceLaw, Real};
+
+/// Why a model could not be assembled or analysed.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum ModelError {
+    /// A degree-of-freedom index outside `0..N`.
+    #[error("degree of freedom {index} out of range: the system has {dofs} degrees of freedom")]
+    DofOutOfRange {
+        /// The index.
+        index: usize,
+        /// The number of degrees of freedom.
+        dofs: usize,
+    },
+    /// A relative coordinate `q_i − q_j` with `i == j` (identically zero).
+    #[error("relative coordinate q_{index} − q_{index} is identically zero")]
+    DegenerateCoordinate {
+        /// The repeated index.
+        index: usize,
+    },
+    /// The mass matrix is not symmetric positive definite.
+    #[error("the mass matrix is not symmetric positive definite ({reason})")]
+    MassMatrix {
+        /// What failed.
+        reason: &'static str,
+    },
+    /// A matrix entry is not finite.
+    #[error("matrix `{name}` has a non-finite entry at ({row}, {col})")]
+    NonFiniteMatrix {
+        /// The matrix.
+        name: &'static str,
+        /// Row.
+        row: usize,
+        /// Column.
+        col: usize,
+    },
+    /// Newton's method for the static equilibrium did not converge.
+    #[error(
+        "static equilibrium: Newton did not converge in {iterations} iterations (residual {residual} N); try another initial guess"
+    )]
+    EquilibriumNotConverged {
+        /// Iterations used.
+        iterations: usize,
+        /// The force residual `‖R(q)‖∞` at the last iterate.
+        residual: f64,
+    },
+    /// The tangent stiffness is singular at an iterate of the equilibrium search.
+    #[error(
+        "static equilibrium: the tangent stiffness is singular at iteration {iteration} (a free rigid-body mode, or a guess inside a gap of every element)"
+    )]
+    SingularStiffness {
+        /// The iteration.
+        iteration: usize,
+    },
+}
+
+/// A scalar coordinate of an `N`-DOF system: the linear form
+/// $$g(q) = \sum_k w_k q_k + o,$$
+/// a single degree of freedom (`w = e_i`), a relative coordinate (`w = e_i − e_j`, e.g. the
+/// gap between two masses) or any other linear combination. Its rate is `ġ = w·q̇`.
+///
+/// An element acting on `g` with force `F(g, ġ)` contributes the generalized forces
+/// `w·F` to the left-hand side (virtual work), so the sign bookkeeping of relative
+/// coordinates is done once, here.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Coordinate<T: Real, const N: usize> {
+    weights: SVector<T, N>,
+    offset: T,
+}
+
+impl<T: Real, const N: usize> Coordinate<T, N> {
+    /// The coordinate `q_i`.
+    ///
+    /// # Errors
+    /// [`ModelError::DofOutOfRange`] unless `i < N`.
+    pub fn dof(i: usize) -> Result<Self, ModelError> {
+        check_dof::<N>(i)?;
+        let mut weights = SVector::zeros();
+        weights[i] = T::one();
+        Ok(Self {
+            weights,
+            offset: T::zero(),
+        })
+    }
+
+    /// The relative coordinate `q_i − q_j` (e.g. the extension of a spring from mass `j` to
+    /// mass `i`, or the approach of mass `i` towards mass `j`).
+    ///
+    /// # Errors
+    /// [`ModelError::DofOutOfRange`] unless both indices are `< N`;
+    /// [`ModelError::DegenerateCoordinate`] if `i == j`.
+    pub fn relative(i: usize, j: usize) -> Result<Self, ModelError> {
+        check_dof::<N>(i)?;
+        check_dof::<N>(j)?;
+        if i == j {
+            return Err(ModelError::DegenerateCoordinate { index: i });
+        }
+        let mut weights = SVector::zeros();
+        weights[i] = T::one();
+        weights[j] = -T::one();
+        Ok(Self {
+            weights,
+            offset: T::zero(),
+        })
+    }
+
+    /// Any linear combination `Σ w_k q_k`.
+    ///
+    /// # Errors
+    /// [`ParameterError`] if a weight is not finite or all are zero.
+    pub fn linear(weights: [T; N]) -> Result<Self, ParameterError> {
+        let mut any = false;
+        for &w in &weights {
+            finite("weight", w)?;
+            any |= w != T::zero();
+        }
+        if !any {
+            return Err(ParameterError::new("weights", 0.0, "not all zero"));
+        }
+        Ok(Self {
+            weights: SVector::from(weights),
+            offset: T::zero(),
+        })
+    }
+
+    /// The same coordinate plus a constant offset `o` (e.g. `q_2 − q_1 + gap`).
+    ///
+    /// # Errors
+    /// [`ParameterError`] unless `offset` is finite.
+    pub fn with_offset(mut self, offset: T) -> Result<Self, ParameterError> {
+        self.offset = finite("offset", offset)?;
+        Ok(self)
+    }
+
+    /// The coordinate with its sign reversed, `−g` (e.g. to put a stop on the other side).
+    pub fn reversed(mut self) -> Self {
+        self.weights = -self.weights;
+        self.offset = -self.offset;
+        self
+    }
+
+    /// The weights `w`.
+    pub fn weights(&self) -> &SVector<T, N> {
+        &self.weights
+    }
+
+    /// The offset `o`.
+    pub fn offset(&self) -> T {
+        self.offset
+    }
+
+    /// `g(q)`.
+    #[inline(always)]
+    pub fn value(&self, q: &[T]) -> T {
+        let mut g = self.offset;
+        for k in 0..N {
+            g += self.weights[k] * q[k];
+        }
+        g
+    }
+
+    /// `ġ = w·q̇`.
+    #[inline(always)]
+    pub fn rate(&self, qd: &[T]) -> T {
+        let mut g = T::zero();
+        for k in 0..N {
+            g += self.weights[k] * qd[k];
+        }
+        g
+    }
+}
+
+fn check_dof<const N: usize>(i: usize) -> Result<(), ModelError> {
+    if i < N {
+        Ok(())
+    } else {
+        Err(ModelError::DofOutOfRange { index: i, dofs: N })
+    }
+}
+
+/// A force law acting on a [`Coordinate`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Element<T: Real, const N: usize, L> {
+    /// Where the law acts.
+    pub coordinate: Coordinate<T, N>,
+    /// The law `F(g, ġ)`.
+    pub law: L,
+}
+
+impl<T: Real, const N: usize, L: ForceLaw<T>> Element<T, N, L> {
+    /// The law `law` acting on `coordinate`.
+    pub fn new(coordinate: Coordinate<T, N>, law: L) -> Self {
+        Self { coordinate, law }
+    }
+
+    /// The law acting on DOF `i`.
+    ///
+    /// # Errors
+    /// [`ModelError::DofOutOfRange`] unless `i < N`.
+    pub fn on_dof(i: usize, law: L) -> Result<Self, ModelError> {
+        Ok(Self::new(Coordinate::dof(i)?, law))
+    }
+
+    /// The law acting on the relative coordinate `q_i − q_j`.
+    ///
+    /// # Errors
+    /// As [`Coordinate::relative`].
+    pub fn between(i: usize, j: usize, law: L) -> Result<Self, ModelError> {
+        Ok(Self::new(Coordinate::relative(i, j)?, law))
+    }
+}
+
+/// A set of elements whose generalized forces and tangent matrices add up: an [`Element`],
+/// `()`, tuples of up to twelve sets and arrays `[E; K]` of sets (e.g. the links of a
+/// chain). Implemented by value, no `dyn`.
+pub trait Elements<T: Real, const N: usize> {
+    /// Adds `Σ w·F(g, ġ)` to `out`.
+    fn add_forces(&self, q: &[T], qd: &[T], out: &mut SVector<T, N>);
+
+    /// Adds the tangent stiffness `Σ F_g·w wᵀ` to `k` and damping `Σ F_ġ·w wᵀ` to `c`.
+    fn add_tangent(&self, q: &[T], qd: &[T], k: &mut SMatrix<T, N, N>, c: &mut SMatrix<T, N, N>);
+}
+
+impl<T: Real, const N: usize> Elements<T, N> for () {
+    #[inline(always)]
+    fn add_forces(&self, _q: &[T], _qd: &[T], _out: &mut SVector<T, N>) {}
+    #[inline(always)]
+    fn add_tangent(
+        &self,
+        _q: &[T],
+        _qd: &[T],
+        _k: &mut SMatrix<T, N, N>,
+        _c: &mut SMatrix<T, N, N>,
+    ) {
+    }
+}
+
+impl<T: Real, const N: usize, L: ForceLaw<T>> Elements<T, N> for Element<T, N, L> {
+    #[inline(always)]
+    fn add_forces(&self, q: &[T], qd: &[T], out: &mut SVector<T, N>) {
+        let g = self.coordinate.value(q);
+        let gd = self.coordinate.rate(qd);
+        let f = self.law.force(g, gd);
+        for k in 0..N {
+            out[k] += self.coordinate.weights[k] * f;
+        }
+    }
+
+    fn add_tangent(&self, q: &[T], qd: &[T], k: &mut SMatrix<T, N, N>, c: &mut SMatrix<T, N, N>) {
+        let g = self.coordinate.value(q);
+        let gd = self.coordinate.rate(qd);
+        let (fg, fv) = self.law.partials(g, gd);
+        let w = &self.coordinate.weights;
+        for i in 0..N {
+            if w[i] == T::zero() {
+                continue;
+            }
+            for j in 0..N {
+                k[(i, j)] += fg * w[i] * w[j];
+                c[(i, j)] += fv * w[i] * w[j];
+            }
+        }
+    }
+}
+
+impl<T: Real, const N: usize, E: Elements<T, N>, const K: usize> Elements<T, N> for [E; K] {
+    #[inline(always)]
+    fn add_forces(&self, q: &[T], qd: &[T], out: &mut SVector<T, N>) {
+        for e in self {
+            e.add_forces(q, qd, out);
+        }
+    }
+    fn add_tangent(&self, q: &[T], qd: &[T], k: &mut SMatrix<T, N, N>, c: &mut SMatrix<T, N, N>) {
+        for e in self {
+            e.add_tangent(q, qd, k, c);
+        }
+    }
+}
+
+macro_rules! element_tuple {
+    ($($name:ident $idx:tt),+) => {
+        impl<T: Real, const N: usize, $($name: Elements<T, N>),+> Elements<T, N> for ($($name,)+) {
+            #[inline(always)]
+            fn add_forces(&self, q: &[T], qd: &[T], out: &mut SVector<T, N>) {
+                $(self.$idx.add_forces(q, qd, out);)+
+            }
+            fn add_tangent(&self, q: &[T], qd: &[T], k: &mut SMatrix<T, N, N>, c: &mut SMatrix<T, N, N>) {
+                $(self.$idx.add_tangent(q, qd, k, c);)+
+            }
+        }
+    };
+}
+
+element_tuple!(A 0);
+element_tuple!(A 0, B 1);
+element_tuple!(A 0, B 1, C 2);
+element_tuple!(A 0, B 1, C 2, D 3);
+element_tuple!(A 0, B 1, C 2, D 3, E 4);
+element_tuple!(A 0, B 1, C 2, D 3, E 4, F 5);
+element_tuple!(A 0, B 1, C 2, D 3, E 4, F 5, G 6);
+element_tuple!(A 0, B 1, C 2, D 3, E 4, F 5, G 6, H 7);
+element_tuple!(A 0, B 1, C 2, D 3, E 4, F 5, G 6, H 7, I 8);
+element_tuple!(A 0, B 1, C 2, D 3, E 4, F 5, G 6, H 7, I 8, J 9);
+element_tuple!(A 0, B 1, C 2, D 3, E 4, F 5, G 6, H 7, I 8, J 9, K 10);
+element_tuple!(A 0, B 1, C 2, D 3, E 4, F 5, G 6, H 7, I 8, J 9, K 10, L 11);
+
+/// An excitation `f(t)` applied through a [`Coordinate`]: generalized forces `w·f(t)` on
+/// the right-hand side (for a DOF, the force on that mass; for `q_i − q_j`, equal and
+/// opposite forces on the two masses).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Load<T: Real, const N: usize, E> {
+    /// Where the load acts.
+    pub coordinate: Coordinate<T, N>,
+    /// The excitation.
+    pub excitation: E,
+}
+
+impl<T: Real, const N: usize, E: Excitation<T>> Load<T, N, E> {
+    /// The excitation acting on DOF `i`.
+    ///
+    /// # Errors
+    /// [`ModelError::DofOutOfRange`] unless `i < N`.
+    pub fn on_dof(i: usize, excitation: E) -> Result<Self, ModelError> {
+        Ok(Self {
+            coordinate: Coordinate::dof(i)?,
+            excitation,
+        })
+    }
+}
+
+/// A set of loads: a [`Load`], `()`, tuples of up to eight sets and arrays `[E; K]`.
+pub trait Loads<T: Real, const N: usize> {
+    /// Adds the generalized forces `Σ w·f(t)` to `out`.
+    fn add_forces(&self, t: T, out: &mut SVector<T, N>);
+    /// Adds `Σ w·ḟ(t)` to `out`.
+    fn add_rates(&self, t: T, out: &mut SVector<T, N>);
+    /// The phase of the first periodic load (for stroboscopic sections), if any.
+    fn phase(&self, _t: T) -> Option<T> {
+        None
+    }
+}
+
+impl<T: Real, const N: usize> Loads<T, N> for () {
+    #[inline(always)]
+    fn add_forces(&self, _t: T, _out: &mut SVector<T, N>) {}
+    #[inline(always)]
+    fn add_rates(&self, _t: T, _out: &mut SVector<T, N>) {}
+}
+
+impl<T: Real, const N: usize, E: Excitation<T>> Loads<T, N> for Load<T, N, E> {
+    #[inline(always)]
+    fn add_forces(&self, t: T, out: &mut SVector<T, N>) {
+        let f = self.excitation.force(t);
+        for k in 0..N {
+            out[k] += self.coordinate.weights[k] * f;
+        }
+    }
+    #[inline(always)]
+    fn add_rates(&self, t: T, out: &mut SVector<T, N>) {
+        let f = self.excitation.force_rate(t);
+        for k in 0..N {
+            out[k] += self.coordinate.weights[k] * f;
+        }
+    }
+    fn phase(&self, t: T) -> Option<T> {
+        self.excitation.phase(t)
+    }
+}
+
+impl<T: Real, const N: usize, E: Loads<T, N>, const K: usize> Loads<T, N> for [E; K] {
+    #[inline(always)]
+    fn add_forces(&self, t: T, out: &mut SVector<T, N>) {
+        for e in self {
+            e.add_forces(t, out);
+        }
+    }
+    #[inline(always)]
+    fn add_rates(&self, t: T, out: &mut SVector<T, N>) {
+        for e in self {
+            e.add_rates(t, out);
+        }
+    }
+    fn phase(&self, t: T) -> Option<T> {
+        self.iter().find_map(|e| e.phase(t))
+    }
+}
+
+macro_rules! load_tuple {
+    ($($name:ident $idx:tt),+) => {
+        impl<T: Real, const N: usize, $($name: Loads<T, N>),+> Loads<T, N> for ($($name,)+) {
+            #[inline(always)]
+            fn add_forces(&self, t: T, out: &mut SVector<T, N>) {
+                $(self.$idx.add_forces(t, out);)+
+            }
+            #[inline(always)]
+            fn add_rates(&self, t: T, out: &mut SVector<T, N>) {
+                $(self.$idx.add_rates(t, out);)+
+            }
+            fn phase(&self, t: T) -> Option<T> {
+                None $(.or_else(|| self.$idx.phase(t)))+
+            }
+        }
+    };
+}
+
+load_tuple!(A 0);
+load_tuple!(A 0, B 1);
+load_tuple!(A 0, B 1, C 2);
+load_tuple!(A 0, B 1, C 2, D 3);
+load_tuple!(A 0, B 1, C 2, D 3, E 4);
+load_tuple!(A 0, B 1, C 2, D 3, E 4, F 5);
+load_tuple!(A 0, B 1, C 2, D 3, E 4, F 5, G 6);
+load_tuple!(A 0, B 1, C 2, D 3, E 4, F 5, G 6, H 7);
+
+/// An `N`-DOF mechanical system with state `y = (q, q̇)` of dimension `M = 2N`:
+/// $$\mathbf M\ddot q + \mathbf C\dot q + \mathbf K q + \sum_e w_e\,F_e(w_e\cdot q + o_e,\;
+///   w_e\cdot\dot q) = \sum_l w_l f_l(t).$$
+///
+/// The mass matrix `M` is symmetric positive definite (diagonal for lumped masses), `K` and
+/// `C` are optional linear stiffness and damping matrices, the elements are any
+/// [`ForceLaw`]s acting on [`Coordinate`]s (springs between masses, contacts on either
+/// side, friction pairs) and the loads are [`Excitation`]s acting on coordinates.
+///
+/// # Model
+/// The first-order form is `ẏ = (q̇, M⁻¹(f(t) − Kq − Cq̇ − Σ w F))`. The Jacobian is
+/// assembled from the laws' analytic partials:
+/// $$J = \begin{pmatrix} 0 & I \\ -\mathbf M^{-1}\mathbf K_t & -\mathbf M^{-1}\mathbf C_t
+///   \end{pmatrix},\quad \mathbf K_t = \mathbf K + \sum_e \partial_g F_e\, w_e w_e^{\mathsf T},
+///   \quad \mathbf C_t = \mathbf C + \sum_e \partial_{\dot g} F_e\, w_e w_e^{\mathsf T}.$$
+///
+/// # Dimensions
+/// `N` is inferred from the masses, and `M` from the state the system is used with; the
+/// constructor checks `M = 2N` at compile time, so a mismatch is a compile error, not a
+/// run-time panic. The 1-DOF [`Oscillator`](crate::model::Oscillator) is the same model for
+/// `N = 1` with scalar arithmetic (the two give bit-identical right-hand sides, tested).
+///
+/// # Examples
+/// A primary mass on a spring, forced, with a secondary mass attached to it hitting a Hertz
+/// stop 1 mm above its rest position:
+/// ```
+/// use nonsmooth::Dynamics;
+/// use nonsmooth::excite::Harmonic;
+/// use nonsmooth::force::{HertzContact, LinearSpring, ViscousDamper};
+/// use nonsmooth::model::{Element, Load, Mechanical};
+/// use nalgebra::SVector;
+///
+/// let model = Mechanical::with_masses([1.0, 0.2])?
+///     .with_elements((
+///         Element::on_dof(0, (LinearSpring::new(100.0)?, ViscousDamper::new(0.1)?))?,
+///         Element::between(1, 0, (LinearSpring::new(20.0)?, ViscousDamper::new(0.02)?))?,
+///         Element::on_dof(1, HertzContact::new(1e-3, 1e7)?)?,
+///     ))
+///     .with_loads(Load::on_dof(0, Harmonic::new(1.0, 9.0, 0.0)?)?);
+/// let y = SVector::<f64, 4>::new(0.0, 2e-3, 0.0, 0.0); // secondary mass 1 mm into the stop
+/// let mut dy = SVector::zeros();
+/// model.rhs(0.0, &y, &mut dy);
+/// let contact = 1e7 * (1e-3f64).powf(1.5);
+/// assert!((dy[3] - (-20.0 * 2e-3 - contact) / 0.2).abs() < 1e-9);
+/// assert!((dy[2] - 20.0 * 2e-3 / 1.0).abs() < 1e-12); // sin(0) = 0: no load yet
+/// # Ok::<(), nonsmooth::Error>(())
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Mechanical<T: Real, const N: usize, const M: usize, El = (), Ld = ()> {
+    mass: SMatrix<T, N, N>,
+    inv_mass: SMatrix<T, N, N>,
+    diagonal: bool,
+    stiffness: Option<SMatrix<T, N, N>>,
+    damping: Option<SMatrix<T, N, N>>,
+    elements: El,
+    loads: Ld,
+}
+
+impl<T: Real, const N: usize, const M: usize> Mechanical<T, N, M, (), ()> {
+    /// A system of `N` lumped masses (diagonal mass matrix), no elements, no loads.
+    ///
+    /// # Errors
+    /// [`ParameterError`] unless every mass is finite and > 0.
+    pub fn with_masses(masses: [T; N]) -> Result<Self, ParameterError> {
+        const { assert!(M == 2 * N, "the state dimension M must be 2N") };
+        let mut mass = SMatrix::zeros();
+        let mut inv_mass = SMatrix::zeros();
+        for (i, &m) in masses.iter().enumerate() {
+            let m = crate::validate::positive("mass", m)?;
+            mass[(i, i)] = m;
+            inv_mass[(i, i)] = T::one() / m;
+        }
+        Ok(Self {
+            mass,
+            inv_mass,
+            diagonal: true,
+            stiffness: None,
+            damping: None,
+            elements: (),
+            loads: (),
+        })
+    }
+
+    /// A system with a full symmetric positive-definite mass matrix.
+    ///
+    /// # Errors
+    /// [`ModelError`] if an entry is not finite, the matrix is not symmetric (to 8 ulps of
+    /// its largest entry) or not positive definite (Cholesky fails).
+    pub fn with_mass_matrix(mass: SMatrix<T, N, N>) -> Result<Self, ModelError> {
+        const { assert!(M == 2 * N, "the state dimension M must be 2N") };
+        check_finite("mass", &mass)?;
+        let scale = mass.amax();
+        for i in 0..N {
+            for j in 0..i {
+                if (mass[(i, j)] - mass[(j, i)]).abs()
+                    > lit::<T>(8.0) * T::default_epsilon() * scale
+                {
+                    return Err(ModelError::MassMatrix {
+                        reason: "not symmetric",
+                    });
+                }
+            }
+        }
+        if mass.cholesky().is_none() {
+            return Err(ModelError::MassMatrix {
+                reason: "Cholesky factorization failed",
+            });
+        }
+        let inv_mass = mass
+            .try_inverse()
+            .ok_or(ModelError::MassMatrix { reason: "singular" })?;
+        let diagonal = (0..N).all(|i| (0..N).all(|j| i == j || mass[(i, j)] == T::zero()));
+        Ok(Self {
+            mass,
+            inv_mass,
+            diagonal,
+            stiffness: None,
+            damping: None,
+            elements: (),
+            loads: (),
+        })
+    }
+}
+
+fn check_finite<T: Real, const N: usize>(
+    name: &'static str,
+    m: &SMatrix<T, N, N>,
+) -> Result<(), ModelError> {
+    for i in 0..N {
+        for j in 0..N {
+            if !m[(i, j)].is_finite() {
+                return Err(ModelError::NonFiniteMatrix {
+                    name,
+                    row: i,
+                    col: j,
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+impl<T: Real, const N: usize, const M: usize, El, Ld> Mechanical<T, N, M, El, Ld> {
+    /// Replaces the elements (a tuple or array of [`Element`]s).
+    pub fn with_elements<El2: Elements<T, N>>(self, elements: El2) -> Mechanical<T, N, M, El2, Ld> {
+        Mechanical {
+            mass: self.mass,
+            inv_mass: self.inv_mass,
+            diagonal: self.diagonal,
+            stiffness: self.stiffness,
+            damping: self.damping,
+            elements,
+            loads: self.loads,
+        }
+    }
+
+    /// Replaces the loads (a tuple or array of [`Load`]s).
+    pub fn with_loads<Ld2: Loads<T, N>>(self, loads: Ld2) -> Mechanical<T, N, M, El, Ld2> {
+        Mechanical {
+            mass: self.mass,
+            inv_mass: self.inv_mass,
+            diagonal: self.diagonal,
+            stiffness: self.stiffness,
+            damping: self.damping,
+            elements: self.elements,
+            loads,
+        }
+    }
+
+    /// Sets the linear stiffness matrix `K` (not required to be symmetric: follower forces
+    /// and gyroscopic couplings are allowed).
+    ///
+    /// # Errors
+    /// [`ModelError::NonFiniteMatrix`] if an entry is not finite.
+    pub fn with_stiffness(mut self, k: SMatrix<T, N, N>) -> Result<Self, ModelError> {
+        check_finite("stiffness", &k)?;
+        self.stiffness = Some(k);
+        Ok(self)
+    }
+
+    /// Sets the linear damping matrix `C`.
+    ///
+    /// # Errors
+    /// [`ModelError::NonFiniteMatrix`] if an entry is not finite.
+    pub fn with_damping(mut self, c: SMatrix<T, N, N>) -> Result<Self, ModelError> {
+        check_finite("damping", &c)?;
+        self.damping = Some(c);
+        Ok(self)
+    }
+
+    /// The mass matrix.
+    pub fn mass_matrix(&self) -> &SMatrix<T, N, N> {
+        &self.mass
+    }
+
+    /// The elements.
+    pub fn elements(&self) -> &El {
+        &self.elements
+    }
+
+    /// The loads.
+    pub fn loads(&self) -> &Ld {
+        &self.loads
+    }
+}
+
+impl<T: Real, const N: usize, const M: usize, El: Elements<T, N>, Ld: Loads<T, N>>
+    Mechanical<T, N, M, El, Ld>
+{
+    /// The generalized force `f(t) − Kq − Cq̇ − Σ w F` (the right-hand side before `M⁻¹`).
+    #[inline(always)]
+    pub fn generalized_force(&self, t: T, q: &[T], qd: &[T]) -> SVector<T, N> {
+        let mut f = SVector::<T, N>::zeros();
+        self.elements.add_forces(q, qd, &mut f);
+        f = -f;
+        if let Some(k) = &self.stiffness {
+            for i in 0..N {
+                for j in 0..N {
+                    f[i] -= k[(i, j)] * q[j];
+                }
+            }
+        }
+        if let Some(c) = &self.damping {
+            for i in 0..N {
+                for j in 0..N {
+                    f[i] -= c[(i, j)] * qd[j];
+                }
+            }
+        }
+        let mut load = SVector::<T, N>::zeros();
+        self.loads.add_forces(t, &mut load);
+        f + load
+    }
+
+    /// The tangent stiffness `K_t` and damping `C_t` at `(q, q̇)`.
+    pub fn tangent(&self, q: &[T], qd: &[T]) -> (SMatrix<T, N, N>, SMatrix<T, N, N>) {
+        let mut k = self.stiffness.unwrap_or_else(SMatrix::zeros);
+        let mut c = self.damping.unwrap_or_else(SMatrix::zeros);
+        self.elements.add_tangent(q, qd, &mut k, &mut c);
+        (k, c)
+    }
+
+    /// The static restoring force `R(q) = Kq + Σ w F(g, 0)` (no loads).
+    pub fn restoring_force(&self, q: &SVector<T, N>) -> SVector<T, N> {
+        let zero = SVector::<T, N>::zeros();
+        let mut r = SVector::<T, N>::zeros();
+        self.elements
+            .add_forces(q.as_slice(), zero.as_slice(), &mut r);
+        if let Some(k) = &self.stiffness {
+            r += k * q;
+        }
+        r
+    }
+
+    /// The static equilibrium `R(q) = load` by Newton's method with the assembled tangent
+    /// stiffness and a backtracking line search on `‖R − load‖₂`, from the guess `q0`
+    /// (`load` is a constant generalized force, e.g. weights; zero for none). Converged when
+    /// the Newton step is at most `4·ε_mach·‖q‖∞` (or the residual is exactly zero).
+    ///
+    /// # Errors
+    /// [`ModelError::SingularStiffness`] if the tangent stiffness is singular at an iterate,
+    /// [`ModelError::EquilibriumNotConverged`] after 100 iterations or if the residual is
+    /// not finite.
+    pub fn static_equilibrium(
+        &self,
+        q0: SVector<T, N>,
+        load: SVector<T, N>,
+    ) -> Result<SVector<T, N>, ModelError> {
+        let zero = SVector::<T, N>::zeros();
+        let residual = |q: &SVector<T, N>| self.restoring_force(q) - load;
+        let mut q = q0;
+        let mut r = residual(&q);
+        let max_iter = 100;
+        for it in 0..max_iter {
+            let rn = r.amax();
+            if !rn.is_finite() {
+                return Err(ModelError::EquilibriumNotConverged {
+                    iterations: it,
+                    residual: to_f64(rn),
+                });
+            }
+            let (k, _) = self.tangent(q.as_slice(), zero.as_slice());
+            let lu = Lu::new(k).ok_or(ModelError::SingularStiffness { iteration: it })?;
+            let dq = lu.solve(&(-r));
+            // Backtracking on the residual norm.
+            let mut lambda = T::one();
+            let mut q_new = q + dq;
+            let mut r_new = residual(&q_new);
+            let mut tries = 0;
+            while !(r_new.norm() < r.norm()) && tries < 30 {
+                lambda *= lit(0.5);
+                q_new = q + dq * lambda;
+                r_new = residual(&q_new);
+                tries += 1;
+            }
+            let step = (q_new - q).amax();
+            q = q_new;
+            r = r_new;
+            let scale = q.amax();
+            if step <= lit::<T>(4.0) * T::default_epsilon() * scale || r.amax() == T::zero() {
+                return Ok(q);
+            }
+        }
+        Err(ModelError::EquilibriumNotConverged {
+            iterations: max_iter,
+            residual: to_f64(r.amax()),
+        })
+    }
+}
+
+impl<T: Real, const N: usize, const M: usize, El: Elements<T, N>, Ld: Loads<T, N>> Dynamics<T, M>
+    for Mechanical<T, N, M, El, Ld>
+{
+    #[inline(always)]
+    fn rhs(&self, t: T, y: &SVector<T, M>, dy: &mut SVector<T, M>) {
+        let (q, qd) = y.as_slice().split_at(N);
+        let f = self.generalized_force(t, q, qd);
+        for i in 0..N {
+            dy[i] = qd[i];
+        }
+        if self.diagonal {
+            for i in 0..N {
+                dy[N + i] = f[i] * self.inv_mass[(i, i)];
+            }
+        } else {
+            let a = self.inv_mass * f;
+            for i in 0..N {
+                dy[N + i] = a[i];
+            }
+        }
+    }
+
+    fn jacobian(&self, _t: T, y: &SVector<T, M>) -> Option<SMatrix<T, M, M>> {
+        let (q, qd) = y.as_slice().split_at(N);
+        let (k, c) = self.tangent(q, qd);
+        let ak = -(self.inv_mass * k);
+        let ac = -(self.inv_mass * c);
+        let mut j = SMatrix::<T, M, M>::zeros();
+        for i in 0..N {
+            j[(i, N + i)] = T::one();
+            for l in 0..N {
+                j[(N + i, l)] = ak[(i, l)];
+                j[(N + i, N + l)] = ac[(i, l)];
+            }
+        }
+        Some(j)
+    }
+
+    fn time_derivative(&self, t: T, _y: &SVector<T, M>) -> Option<SVector<T, M>> {
+        let mut fd = SVector::<T, N>::zeros();
+        self.loads.add_rates(t, &mut fd);
+        let a = self.inv_mass * fd;
+        let mut out = SVector::<T, M>::zeros();
+        for i in 0..N {
+            out[N + i] = a[i];
+        }
+        Some(out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::excite::Harmonic;
+    use crate::force::{HertzContact, LinearSpring, ViscousDamper};
+
+    #[test]
+    fn coordinates_validate_and_evaluate() {
+        assert!(Coordinate::<f64, 2>::dof(2).is_err());
+        assert!(Coordinate::<f64, 2>::relative(1, 1).is_err());
+        assert!(Coordinate::<f64, 2>::linear([0.0, 0.0]).is_err());
+        assert!(Coordinate::<f64, 2>::linear([f64::NAN, 1.0]).is_err());
+        let g = Coordinate::<f64, 3>::relative(2, 0)
+            .unwrap()
+            .with_offset(0.5)
+            .unwrap();
+        assert_eq!(g.value(&[1.0, 7.0, 4.0]), 3.5);
+        assert_eq!(g.rate(&[1.0, 7.0, 4.0]), 3.0);
+        assert_eq!(g.reversed().value(&[1.0, 7.0, 4.0]), -3.5);
+    }
+
+    #[test]
+    fn jacobian_matches_finite_differences() {
+        let model = Mechanical::<f64, 2, 4>::with_masses([1.5, 0.5])
+            .unwrap()
+            .with_elements((
+                Element::on_dof(
+                    0,
+                    (
+                        LinearSpring::new(100.0).unwrap(),
+                        ViscousDamper::new(0.3).unwrap(),
+                    ),
+                )
+                .unwrap(),
+                Element::between(1, 0, LinearSpring::new(40.0).unwrap()).unwrap(),
+                Element::on_dof(
+                    1,
+                    HertzContact::new(1e-3, 1e6)
+                        .unwrap()
+                        .with_damping(0.5, 1.5, 1.0)
+                        .unwrap(),
+                )
+                .unwrap(),
+            ))
+            .with_loads(Load::on_dof(0, Harmonic::new(1.0, 3.0, 0.2).unwrap()).unwrap());
+        let y = SVector::<f64, 4>::new(1e-4, 1.8e-3, 0.02, -0.05);
+        let j = model.jacobian(0.3, &y).unwrap();
+        for col in 0..4 {
+            let h = 1e-7 * y[col].abs().max(1e-6);
+            let (mut yp, mut ym) = (y, y);
+            yp[col] += h;
+            ym[col] -= h;
+            let (mut fp, mut fm) = (SVector::zeros(), SVector::zeros());
+            model.rhs(0.3, &yp, &mut fp);
+            model.rhs(0.3, &ym, &mut fm);
+            let fd = (fp - fm) / (2.0 * h);
+            for row in 0..4 {
+                let scale = j[(row, col)].abs().max(1.0);
+                assert!(
+                    (fd[row] - j[(row, col)]).abs() < 1e-5 * scale,
+                    "J[{row},{col}] = {} vs FD {}",
+                    j[(row, col)],
+                    fd[row]
+                );
+            }
+        }
+        // ∂f/∂t from the loads.
+        let dt = model.time_derivative(0.3, &y).unwrap();
+        let (mut fp, mut fm) = (SVector::zeros(), SVector::zeros());
+        model.rhs(0.3 + 1e-6, &y, &mut fp);
+        model.rhs(0.3 - 1e-6, &y, &mut fm);
+        assert!(((fp[2] - fm[2]) / 2e-6 - dt[2]).abs() < 1e-6);
+    }
+
+    #[test]
+    fn full_mass_matrix_equals_lumped_when_diagonal() {
+        let lumped = Mechanical::<f64, 2, 4>::with_masses([2.0, 3.0])
+            .unwrap()
+            .with_elements(Element::between(0, 1, LinearSpring::new(5.0).unwrap()).unwrap());
+        let full = Mechanical::<f64, 2, 4>::with_mass_matrix(SMatrix::<f64, 2, 2>::new(
+            2.0, 0.0, 0.0, 3.0,
+        ))
+        .unwrap()
+        .with_elements(Element::between(0, 1, LinearSpring::new(5.0).unwrap()).unwrap());
+        let y = SVector::<f64, 4>::new(0.1, -0.2, 0.3, 0.4);
+        let (mut a, mut b) = (SVector::zeros(), SVector::zeros());
+        lumped.rhs(0.0, &y, &mut a);
+        full.rhs(0.0, &y, &mut b);
+        assert_eq!(a, b);
+        // Coupled mass matrix: M·ÿ must equal the force.
+        let m = SMatrix::<f64, 2, 2>::new(2.0, 0.5, 0.5, 3.0);
+        let coupled = Mechanical::<f64, 2, 4>::with_mass_matrix(m)
+            .unwrap()
+            .with_elements(Element::between(0, 1, LinearSpring::new(5.0).unwrap()).unwrap());
+        coupled.rhs(0.0, &y, &mut b);
+        let acc = nalgebra::Vector2::new(b[2], b[3]);
+        let force = nalgebra::Vector2::new(-5.0 * 0.3, 5.0 * 0.3);
+        assert!((m * acc - force).amax() < 1e-15);
+        assert!(
+            Mechanical::<f64, 2, 4>::with_mass_matrix(SMatrix::<f64, 2, 2>::new(
+                1.0, 2.0, 2.0, 1.0
+            ))
+            .is_err()
+        );
+        assert!(
+            Mechanical::<f64, 2, 4>::with_mass_matrix(SMatrix::<f64, 2, 2>::new(
+                1.0, 0.1, 0.0, 1.0
+            ))
+            .is_err()
+        );
+        assert!(Mechanical::<f64, 2, 4>::with_masses([1.0, 0.0]).is_err());
+    }
+
+    #[test]
+    fn static_equilibrium_of_a_two_mass_chain() {
+        // Wall — k1 — m1 — k2 — m2, weights w1, w2 pulling along +q: exact q1 = (w1+w2)/k1,
+        // q2 = q1 + w2/k2.
+        let (k1, k2, w1, w2) = (100.0, 50.0, 3.0, 2.0);
+        let model = Mechanical::<f64, 2, 4>::with_masses([1.0, 1.0])
+            .unwrap()
+            .with_elements((
+                Element::on_dof(0, LinearSpring::new(k1).unwrap()).unwrap(),
+                Element::between(1, 0, LinearSpring::new(k2).unwrap()).unwrap(),
+            ));
+        let q = model
+            .static_equilibrium(SVector::zeros(), SVector::<f64, 2>::new(w1, w2))
+            .unwrap();
+        let q1 = (w1 + w2) / k1;
+        assert!((q[0] - q1).abs() < 1e-15);
+        assert!((q[1] - (q1 + w2 / k2)).abs() < 1e-15);
+        // Nonlinear: a Hertz stop pressed by a weight: k_c·δ^{3/2} = w.
+        let stop = Mechanical::<f64, 1, 2>::with_masses([1.0])
+            .unwrap()
+            .with_elements(Element::on_dof(0, HertzContact::new(0.0, 1e6).unwrap()).unwrap());
+        let q = stop
+            .static_equilibrium(SVector::from([1e-4]), SVector::from([10.0]))
+            .unwrap();
+        assert!((q[0] - (10.0f64 / 1e6).powf(2.0 / 3.0)).abs() < 1e-15);
+        // A free mass has no equilibrium under a load: singular stiffness.
+        let free = Mechanical::<f64, 1, 2>::with_masses([1.0]).unwrap();
+        assert!(matches!(
+            free.static_equilibrium(SVector::zeros(), SVector::from([1.0])),
+            Err(ModelError::SingularStiffness { .. })
+        ));
+    }
+}

@@ -1,0 +1,12 @@
+//! A catalogue of ready systems, each assembled from the crate's parts, with its source and
+//! validated parameters.
+//!
+//! | system | equation | module |
+//! |---|---|---|
+//! | the paper's cart | `m·ẍ + kx + cẋ + T·ẋ/√(ẋ²+ε²) + F_I(x, ẋ) = m₀eω² sin ωt` | [`paper`] |
+//!
+//! Every entry is an ordinary [`Oscillator`](crate::model::Oscillator) or
+//! [`Mechanical`](crate::model::Mechanical) model: nothing in the engine knows about any of
+//! them.
+
+pub mod paper;
