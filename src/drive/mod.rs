@@ -128,6 +128,16 @@ pub struct Outcome<T: Real, const N: usize> {
 /// }
 /// ```
 pub trait Observer<T: Real, const N: usize> {
+    /// Checks the observer's configuration against the state dimension `N` (e.g. component
+    /// indices) before a run starts; an error stops the run before its first step.
+    /// Default: `Ok`.
+    ///
+    /// # Errors
+    /// Whatever the observer finds wrong (typically [`EventError::IndexOutOfRange`]).
+    fn check(&self) -> Result<()> {
+        Ok(())
+    }
+
     /// Called once before the first step.
     fn on_start(&mut self, _t0: T, _y0: &SVector<T, N>) {}
 
@@ -148,6 +158,9 @@ pub trait Observer<T: Real, const N: usize> {
 impl<T: Real, const N: usize> Observer<T, N> for () {}
 
 impl<T: Real, const N: usize, O: Observer<T, N> + ?Sized> Observer<T, N> for &mut O {
+    fn check(&self) -> Result<()> {
+        (**self).check()
+    }
     fn on_start(&mut self, t0: T, y0: &SVector<T, N>) {
         (**self).on_start(t0, y0)
     }
@@ -166,6 +179,10 @@ impl<T: Real, const N: usize, O: Observer<T, N> + ?Sized> Observer<T, N> for &mu
 macro_rules! observer_tuple {
     ($($name:ident $idx:tt),+) => {
         impl<T: Real, const N: usize, $($name: Observer<T, N>),+> Observer<T, N> for ($($name,)+) {
+            fn check(&self) -> Result<()> {
+                $(self.$idx.check()?;)+
+                Ok(())
+            }
             fn on_start(&mut self, t0: T, y0: &SVector<T, N>) {
                 $(self.$idx.on_start(t0, y0);)+
             }
@@ -185,6 +202,36 @@ macro_rules! observer_tuple {
             }
         }
     };
+}
+
+/// An optional observer: `None` observes nothing.
+impl<T: Real, const N: usize, O: Observer<T, N>> Observer<T, N> for Option<O> {
+    fn check(&self) -> Result<()> {
+        self.as_ref().map_or(Ok(()), |o| o.check())
+    }
+    fn on_start(&mut self, t0: T, y0: &SVector<T, N>) {
+        if let Some(o) = self {
+            o.on_start(t0, y0)
+        }
+    }
+    #[inline(always)]
+    fn on_step<D: DenseOutput<T, N>>(&mut self, step: &StepView<'_, T, N, D>) -> Control {
+        match self {
+            Some(o) => o.on_step(step),
+            None => Control::Continue,
+        }
+    }
+    fn on_event(&mut self, event: &EventRecord<T, N>) -> Control {
+        match self {
+            Some(o) => o.on_event(event),
+            None => Control::Continue,
+        }
+    }
+    fn on_finish(&mut self, outcome: &Outcome<T, N>) {
+        if let Some(o) = self {
+            o.on_finish(outcome)
+        }
+    }
 }
 
 observer_tuple!(A 0);
@@ -336,6 +383,7 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
         }
         check_state(&y0)?;
         self.events.check()?;
+        observer.check()?;
         self.stepper.reset_state(t0, y0);
         self.history.clear();
         observer.on_start(t0, &y0);
@@ -362,6 +410,7 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
             .into());
         }
         self.events.check()?;
+        observer.check()?;
         observer.on_start(t0, &y0);
         self.advance(t_end, observer)
     }

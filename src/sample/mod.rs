@@ -3,7 +3,7 @@
 //! | sampler | records | paper |
 //! |---|---|---|
 //! | [`Stroboscopic`] | states at the section times `t_i` (`2πi/ω`, or phase `2πi` of a ramped rotor) | Figs. 2a, 2c, 3a, 4a |
-//! | [`ImpactSequence`] | impact times, intervals `T_j`, impact velocities, maximum penetration | Figs. 2b, 2d, 3b, 4b, 6 |
+//! | [`ImpactSequence`] | impacts on any contact [`Surface`] (fixed or moving, any coordinate): times, intervals `T_j`, velocities, maximum penetration | Figs. 2b, 2d, 3b, 4b, 6 |
 //! | [`PeriodSummary`] | per forcing period: impacts, extrema of `x`, grazing margin | Fig. 8 |
 //! | [`Section`] | crossings of a general event function (a Poincaré section) | |
 //! | [`Trajectory`] | the state on a uniform grid `t0 + i·dt` | Figs. 8, 9, 10 |
@@ -17,9 +17,11 @@
 
 mod period;
 mod samplers;
+mod surface;
 
 pub use period::{Regime, detect_period};
 pub use samplers::{
     Impact, ImpactSequence, PeriodRecord, PeriodSummary, Periodic, PhaseClock, Section,
     SectionClock, SectionPoint, Stroboscopic, Trajectory,
 };
+pub use surface::Surface;

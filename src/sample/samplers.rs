@@ -3,10 +3,11 @@ use nalgebra::SVector;
 
 use crate::drive::{Control, EventRecord, Observer, StepView};
 use crate::error::ParameterError;
-use crate::event::{Direction, EventFunction, locate};
+use crate::event::{Direction, EventFunction, Stop, locate};
 use crate::excite::Excitation;
 use crate::integrate::DenseOutput;
 use crate::roots::golden_max;
+use crate::sample::Surface;
 use crate::scalar::lit;
 use crate::validate::{finite, positive};
 
@@ -229,7 +230,8 @@ impl<T: Real, const N: usize, C: SectionClock<T>> Observer<T, N> for Stroboscopi
 pub struct Impact<T> {
     /// Impact time.
     pub t: T,
-    /// Velocity at impact.
+    /// Velocity at impact: the surface's penetration rate `ġ` (for a [`Stop`], the
+    /// velocity component).
     pub velocity: T,
     /// Interval since the previous impact (`T_j`); `None` for the first.
     pub interval: Option<T>,
@@ -238,17 +240,18 @@ pub struct Impact<T> {
     pub max_penetration: Option<T>,
 }
 
-/// The impact sequence: upward crossings of a level by `y[position]`, reported by an event
-/// of the simulation (e.g. `Event::new(Level::new(0, x_I)?, Direction::Rising)`), with
-/// the inter-impact intervals `T_j`, impact velocities and the maximum penetration of each
-/// contact (the maximum of `y[position] − level` until the trajectory is back below the
-/// level at a step end; interior maxima are found on the dense output).
+/// The impact sequence on a contact [`Surface`]: the rising crossings of its penetration
+/// `g` reported by event `event` of the simulation (built on the same surface, e.g.
+/// `Event::new(Stop { position: 0, velocity: 1, level: x_I }, Direction::Rising)` or a
+/// [`Gap`](crate::event::Gap) of an `N`-DOF system against a moving surface), with the
+/// inter-impact intervals `T_j`, the impact velocities `ġ` and the maximum penetration of
+/// each contact (the maximum of `g` until it is negative again at a step end; interior
+/// maxima are found on the dense output). Several surfaces: one sequence per surface, each
+/// listening to its own event index.
 #[derive(Debug, Clone)]
-pub struct ImpactSequence<T: Real> {
+pub struct ImpactSequence<T: Real, G = Stop<T>> {
     event: usize,
-    position: usize,
-    velocity: usize,
-    level: T,
+    surface: G,
     record_from: T,
     last_t: Option<T>,
     in_contact: bool,
@@ -257,12 +260,13 @@ pub struct ImpactSequence<T: Real> {
     count: u64,
 }
 
-impl<T: Real> ImpactSequence<T> {
+impl<T: Real> ImpactSequence<T, Stop<T>> {
     /// Impacts reported by event `event`, on `y[position]` crossing `level` upwards, with the
     /// velocity in `y[velocity]`; recorded from `record_from` on, at most `capacity`.
     ///
     /// # Errors
-    /// [`ParameterError`] if `level` or `record_from` is not finite.
+    /// [`ParameterError`] if `level` or `record_from` is not finite. Indices outside the
+    /// state are reported when the run starts.
     pub fn new(
         event: usize,
         position: usize,
@@ -271,11 +275,34 @@ impl<T: Real> ImpactSequence<T> {
         record_from: T,
         capacity: usize,
     ) -> Result<Self, ParameterError> {
+        Self::on_surface(
+            event,
+            Stop {
+                position,
+                velocity,
+                level: finite("level", level)?,
+            },
+            record_from,
+            capacity,
+        )
+    }
+}
+
+impl<T: Real, G> ImpactSequence<T, G> {
+    /// Impacts on `surface` reported by event `event`; recorded from `record_from` on, at
+    /// most `capacity`.
+    ///
+    /// # Errors
+    /// [`ParameterError`] if `record_from` is not finite.
+    pub fn on_surface(
+        event: usize,
+        surface: G,
+        record_from: T,
+        capacity: usize,
+    ) -> Result<Self, ParameterError> {
         Ok(Self {
             event,
-            position,
-            velocity,
-            level: finite("level", level)?,
+            surface,
             record_from: finite("record_from", record_from)?,
             last_t: None,
             in_contact: false,
@@ -283,6 +310,11 @@ impl<T: Real> ImpactSequence<T> {
             store: Store::new(capacity),
             count: 0,
         })
+    }
+
+    /// The surface.
+    pub fn surface(&self) -> &G {
+        &self.surface
     }
 
     /// The recorded impacts.
@@ -300,6 +332,11 @@ impl<T: Real> ImpactSequence<T> {
         self.count
     }
 
+    /// Records dropped because the capacity was reached.
+    pub fn dropped(&self) -> u64 {
+        self.store.dropped
+    }
+
     /// Records from `t` on.
     pub fn set_record_from(&mut self, t: T) {
         self.record_from = t;
@@ -313,11 +350,15 @@ impl<T: Real> ImpactSequence<T> {
     }
 }
 
-impl<T: Real, const N: usize> Observer<T, N> for ImpactSequence<T> {
+impl<T: Real, const N: usize, G: Surface<T, N>> Observer<T, N> for ImpactSequence<T, G> {
+    fn check(&self) -> crate::Result<()> {
+        Ok(self.surface.check()?)
+    }
+
     fn on_start(&mut self, t0: T, y0: &SVector<T, N>) {
-        let _ = t0;
-        self.in_contact = y0[self.position] >= self.level;
-        self.current_max = y0[self.position] - self.level;
+        let g = self.surface.gap(t0, y0);
+        self.in_contact = g >= T::zero();
+        self.current_max = g;
     }
 
     #[inline]
@@ -325,11 +366,11 @@ impl<T: Real, const N: usize> Observer<T, N> for ImpactSequence<T> {
         if !self.in_contact {
             return Control::Continue;
         }
-        let m = component_max(s, self.position, self.velocity) - self.level;
+        let m = self.surface.max_gap(s);
         if m > self.current_max {
             self.current_max = m;
         }
-        if s.y1[self.position] < self.level {
+        if self.surface.gap(s.t1, &s.y1) < T::zero() {
             self.in_contact = false;
             if let Some(last) = self.store.items.last_mut() {
                 if last.max_penetration.is_none() && Some(last.t) == self.last_t {
@@ -352,7 +393,7 @@ impl<T: Real, const N: usize> Observer<T, N> for ImpactSequence<T> {
             self.count += 1;
             self.store.push(Impact {
                 t: e.t,
-                velocity: e.y[self.velocity],
+                velocity: self.surface.gap_rate(e.t, &e.y),
                 interval,
                 max_penetration: None,
             });
@@ -364,7 +405,7 @@ impl<T: Real, const N: usize> Observer<T, N> for ImpactSequence<T> {
 /// The maximum of `y[pos]` over a step view, using the ends and, when `y[vel]` changes sign
 /// from + to −, the interior maximum of the interpolant (golden section).
 #[inline]
-fn component_max<T: Real, const N: usize, D: DenseOutput<T, N>>(
+pub(super) fn component_max<T: Real, const N: usize, D: DenseOutput<T, N>>(
     s: &StepView<'_, T, N, D>,
     pos: usize,
     vel: usize,
@@ -425,18 +466,22 @@ pub struct PeriodRecord<T> {
     pub x_min: T,
     /// Maximum of `y[position]`.
     pub x_max: T,
-    /// Grazing margin `level − x_max`: positive when the stop was not reached.
+    /// Grazing margin `−max g` over the period (for a [`Stop`], `level − x_max`): positive
+    /// when the surface was not reached.
     pub margin: T,
 }
 
-/// Per-period summaries: impacts, extrema and the grazing margin to a stop at `level`.
+/// Per-period summaries: impacts, extrema of one component and the grazing margin to a
+/// contact [`Surface`] (by default the stop `y[position] = level`; any other with
+/// [`with_surface`](PeriodSummary::with_surface)).
 #[derive(Debug, Clone)]
-pub struct PeriodSummary<T: Real, C = Periodic<T>> {
+pub struct PeriodSummary<T: Real, C = Periodic<T>, G = Stop<T>> {
     clock: C,
     event: usize,
     position: usize,
     velocity: usize,
-    level: T,
+    surface: G,
+    g_max: T,
     record_from: T,
     current: Option<(u64, T, T)>, // (index, start, end)
     /// The current period has not begun yet (the run started inside an earlier one).
@@ -469,7 +514,12 @@ impl<T: Real> PeriodSummary<T, Periodic<T>> {
             event,
             position,
             velocity,
-            level: finite("level", level)?,
+            surface: Stop {
+                position,
+                velocity,
+                level: finite("level", level)?,
+            },
+            g_max: T::zero(),
             record_from: finite("record_from", record_from)?,
             current: None,
             pending: false,
@@ -481,13 +531,32 @@ impl<T: Real> PeriodSummary<T, Periodic<T>> {
     }
 }
 
-impl<T: Real, C: SectionClock<T>> PeriodSummary<T, C> {
+impl<T: Real, C: SectionClock<T>, G> PeriodSummary<T, C, G> {
     /// The completed periods.
     pub fn periods(&self) -> &[PeriodRecord<T>] {
         &self.store.items
     }
 
-    fn open(&mut self, i: u64, x: T) {
+    /// Margins (and impacts, from event `event`) on another contact surface.
+    pub fn with_surface<G2>(self, surface: G2) -> PeriodSummary<T, C, G2> {
+        PeriodSummary {
+            clock: self.clock,
+            event: self.event,
+            position: self.position,
+            velocity: self.velocity,
+            surface,
+            g_max: self.g_max,
+            record_from: self.record_from,
+            current: self.current,
+            pending: self.pending,
+            impacts: self.impacts,
+            x_min: self.x_min,
+            x_max: self.x_max,
+            store: self.store,
+        }
+    }
+
+    fn open(&mut self, i: u64, x: T, g: T) {
         self.current = match (self.clock.section_time(i), self.clock.section_time(i + 1)) {
             (Some(a), Some(b)) => Some((i, a, b)),
             _ => None,
@@ -495,6 +564,7 @@ impl<T: Real, C: SectionClock<T>> PeriodSummary<T, C> {
         self.impacts = 0;
         self.x_min = x;
         self.x_max = x;
+        self.g_max = g;
     }
 
     fn close(&mut self) {
@@ -506,18 +576,26 @@ impl<T: Real, C: SectionClock<T>> PeriodSummary<T, C> {
                     impacts: self.impacts,
                     x_min: self.x_min,
                     x_max: self.x_max,
-                    margin: self.level - self.x_max,
+                    margin: -self.g_max,
                 });
             }
         }
     }
 }
 
-impl<T: Real, const N: usize, C: SectionClock<T>> Observer<T, N> for PeriodSummary<T, C> {
+impl<T: Real, const N: usize, C: SectionClock<T>, G: Surface<T, N>> Observer<T, N>
+    for PeriodSummary<T, C, G>
+{
+    fn check(&self) -> crate::Result<()> {
+        crate::event::check_index(self.position, N)?;
+        crate::event::check_index(self.velocity, N)?;
+        Ok(self.surface.check()?)
+    }
+
     fn on_start(&mut self, t0: T, y0: &SVector<T, N>) {
         // Periods that began before t0 are incomplete: start with the first at or after t0.
         let i = self.clock.first_index_from(t0);
-        self.open(i, y0[self.position]);
+        self.open(i, y0[self.position], self.surface.gap(t0, y0));
         self.pending = self.current.is_some_and(|(_, a, _)| a > t0);
     }
 
@@ -530,8 +608,9 @@ impl<T: Real, const N: usize, C: SectionClock<T>> Observer<T, N> for PeriodSumma
                     return Control::Continue;
                 }
                 let mut y = SVector::zeros();
-                s.state_at(a.max(s.t0), &mut y);
-                self.open(i, y[self.position]);
+                let ta = a.max(s.t0);
+                s.state_at(ta, &mut y);
+                self.open(i, y[self.position], self.surface.gap(ta, &y));
                 self.pending = false;
                 t_lo = a.max(s.t0);
                 continue;
@@ -554,9 +633,10 @@ impl<T: Real, const N: usize, C: SectionClock<T>> Observer<T, N> for PeriodSumma
             self.x_min = self
                 .x_min
                 .min(component_min(&part, self.position, self.velocity));
+            self.g_max = self.g_max.max(self.surface.max_gap(&part));
             if b <= s.t1 {
                 self.close();
-                self.open(i + 1, yb[self.position]);
+                self.open(i + 1, yb[self.position], self.surface.gap(end, &yb));
                 t_lo = b;
                 if b == s.t1 {
                     break;

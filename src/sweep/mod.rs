@@ -29,7 +29,7 @@ use crate::Dynamics;
 use crate::drive::Simulation;
 use crate::event::{Direction, Event, EventFunction};
 use crate::integrate::Stepper;
-use crate::sample::{ImpactSequence, PeriodSummary, Regime, Stroboscopic, detect_period};
+use crate::sample::{ImpactSequence, PeriodSummary, Regime, Stroboscopic, Surface, detect_period};
 
 /// Sweep errors.
 #[derive(Debug, Clone, Error)]
@@ -81,8 +81,57 @@ pub enum SweepError {
         /// Parameter value.
         param: f64,
         /// What failed.
-        source: Box<crate::Error>,
+        source: RunFailure,
     },
+}
+
+impl SweepError {
+    /// A run at `param` failed with `error`.
+    pub fn failed(param: f64, error: crate::Error) -> Self {
+        Self::Failed {
+            param,
+            source: error.into(),
+        }
+    }
+}
+
+/// Why a run inside a sweep failed: the module error that stopped it (not the crate
+/// [`Error`](crate::Error), which contains [`SweepError`]: the error types stay
+/// non-recursive).
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum RunFailure {
+    /// A constructor rejected a parameter.
+    #[error(transparent)]
+    Parameter(#[from] crate::ParameterError),
+    /// A model could not be assembled.
+    #[error(transparent)]
+    Model(#[from] crate::model::ModelError),
+    /// A root search failed.
+    #[error(transparent)]
+    Root(#[from] crate::roots::RootError),
+    /// Time integration failed.
+    #[error(transparent)]
+    Integrate(#[from] crate::integrate::IntegrateError),
+    /// Event handling failed (e.g. an accumulation of events).
+    #[error(transparent)]
+    Event(#[from] crate::event::EventError),
+    /// Any other error, by its message.
+    #[error("{0}")]
+    Other(String),
+}
+
+impl From<crate::Error> for RunFailure {
+    fn from(e: crate::Error) -> Self {
+        match e {
+            crate::Error::Parameter(e) => Self::Parameter(e),
+            crate::Error::Model(e) => Self::Model(e),
+            crate::Error::Root(e) => Self::Root(e),
+            crate::Error::Integrate(e) => Self::Integrate(e),
+            crate::Error::Event(e) => Self::Event(e),
+            other => Self::Other(other.to_string()),
+        }
+    }
 }
 
 /// Which way a sweep goes.
@@ -227,26 +276,20 @@ impl SweepConfig {
 
 /// A system at one parameter value, as the sweep needs it.
 #[derive(Debug, Clone)]
-pub struct SweepSystem<S> {
+pub struct SweepSystem<S, G = Stop> {
     /// The system.
     pub system: S,
     /// Its forcing period (sections at `t = i·period`).
     pub period: f64,
-    /// The impact surface `y[position] = level` (upward crossings are impacts), with the
-    /// velocity component; `None` for a system without impacts.
-    pub stop: Option<Stop>,
+    /// The contact surface whose impacts are recorded (rising crossings of its penetration:
+    /// a [`Stop`] `y[position] = level`, a [`Gap`](crate::event::Gap) of an `N`-DOF system,
+    /// fixed or moving, or any [`Surface`]); `None` for a system without impacts.
+    pub stop: Option<G>,
 }
 
-/// An impact surface `y[position] = level`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Stop {
-    /// Position component.
-    pub position: usize,
-    /// Velocity component.
-    pub velocity: usize,
-    /// Level.
-    pub level: f64,
-}
+/// An impact surface `y[position] = level` (the first stage's sweep stop, now the generic
+/// [`event::Stop`](crate::event::Stop) in `f64`).
+pub type Stop = crate::event::Stop<f64>;
 
 /// What was recorded at one parameter value.
 #[derive(Debug, Clone, PartialEq)]
@@ -288,6 +331,30 @@ pub struct SweepResult<const N: usize> {
     pub branches: Vec<Branch<N>>,
 }
 
+/// An event function that is either a surface's penetration or never zero.
+#[derive(Debug, Clone, Copy)]
+struct SurfaceEvent<G>(Option<G>);
+
+impl<const N: usize, G: Surface<f64, N>> EventFunction<f64, N> for SurfaceEvent<G> {
+    #[inline(always)]
+    fn value(&self, t: f64, y: &SVector<f64, N>) -> f64 {
+        match &self.0 {
+            Some(s) => s.value(t, y),
+            None => -1.0,
+        }
+    }
+    #[inline(always)]
+    fn rate(&self, t: f64, y: &SVector<f64, N>, dy: &SVector<f64, N>) -> Option<f64> {
+        match &self.0 {
+            Some(s) => s.rate(t, y, dy),
+            None => Some(0.0),
+        }
+    }
+    fn check(&self) -> Result<(), crate::event::EventError> {
+        self.0.as_ref().map_or(Ok(()), |s| s.check())
+    }
+}
+
 /// An event function that is either a level or never zero.
 #[derive(Debug, Clone, Copy)]
 struct StopEvent(Option<Stop>);
@@ -313,10 +380,10 @@ impl<const N: usize> EventFunction<f64, N> for StopEvent {
 ///
 /// # Errors
 /// [`SweepError::Failed`] wrapping the simulation's error, [`SweepError::InvalidPeriod`].
-pub fn run_point<const N: usize, S, St>(
+pub fn run_point<const N: usize, S, St, G>(
     config: &SweepConfig,
     param: f64,
-    sys: SweepSystem<S>,
+    sys: SweepSystem<S, G>,
     stepper: St,
     y0: SVector<f64, N>,
     transient: u32,
@@ -324,11 +391,9 @@ pub fn run_point<const N: usize, S, St>(
 where
     S: Dynamics<f64, N>,
     St: Stepper<f64, N>,
+    G: Surface<f64, N> + Clone,
 {
-    let fail = |e: crate::Error| SweepError::Failed {
-        param,
-        source: Box::new(e),
-    };
+    let fail = |e: crate::Error| SweepError::failed(param, e);
     let period = sys.period;
     if !(period.is_finite() && period > 0.0) {
         return Err(SweepError::InvalidPeriod { param, period });
@@ -336,7 +401,7 @@ where
     let stop = sys.stop;
     let t_rec = transient as f64 * period;
     let t_end = (transient + config.record) as f64 * period;
-    let ev = Event::new(StopEvent(stop), Direction::Rising);
+    let ev = Event::new(SurfaceEvent(stop.clone()), Direction::Rising);
     let mut sim = Simulation::new(sys.system, stepper)
         .with_events(ev)
         .landing_grid(Some((0.0, period)))
@@ -347,18 +412,26 @@ where
     // Sections at i·period for i = transient+1 ..= transient+record.
     let mut strobe = Stroboscopic::<f64, N>::periodic(0.0, period, t_rec + 0.5 * period, cap)
         .map_err(|e| fail(e.into()))?;
-    let s = stop.unwrap_or(Stop {
-        position: 0,
-        velocity: N.min(2) - 1,
-        level: f64::MAX,
-    });
-    let mut impacts = ImpactSequence::new(0, s.position, s.velocity, s.level, t_rec, cap)
-        .map_err(|e| fail(e.into()))?;
-    let mut periods =
-        PeriodSummary::periodic(0.0, period, 0, s.position, s.velocity, s.level, t_rec, cap)
-            .map_err(|e| fail(e.into()))?;
+    // Impacts and per-period margins on the surface (none without one). Extrema are kept
+    // of component 0 (the first position of a mechanical state); only margins are used.
+    let (mut impacts, mut periods) = match stop.clone() {
+        Some(g) => (
+            Some(ImpactSequence::on_surface(0, g.clone(), t_rec, cap).map_err(|e| fail(e.into()))?),
+            Some(
+                PeriodSummary::periodic(0.0, period, 0, 0, N / 2, 0.0, t_rec, cap)
+                    .map_err(|e| fail(e.into()))?
+                    .with_surface(g),
+            ),
+        ),
+        None => (None, None),
+    };
     let mut obs = (&mut strobe, &mut impacts, &mut periods);
     let out = sim.run(0.0, y0, t_end, &mut obs).map_err(fail)?;
+    let no_impacts: &[crate::sample::Impact<f64>] = &[];
+    let no_periods: &[crate::sample::PeriodRecord<f64>] = &[];
+    let impact_list = impacts.as_ref().map_or(no_impacts, |i| i.impacts());
+    let period_list = periods.as_ref().map_or(no_periods, |p| p.periods());
+    let impact_count = impacts.as_ref().map_or(0, |i| i.count());
     let poincare: Vec<SVector<f64, N>> = strobe.points().iter().map(|p| p.y).collect();
     let mut scale = SVector::<f64, N>::zeros();
     for p in &poincare {
@@ -367,30 +440,19 @@ where
         }
     }
     let regime = detect_period(&poincare, &scale, config.period_tol, config.max_period);
-    let imp = impacts.impacts();
-    let intervals: Vec<f64> = imp.iter().filter_map(|i| i.interval).collect();
-    let impact_velocities = imp.iter().map(|i| i.velocity).collect();
-    let grazing_margin = if stop.is_some() {
-        periods
-            .periods()
-            .iter()
-            .map(|p| p.margin)
-            .fold(f64::INFINITY, f64::min)
-    } else {
-        f64::INFINITY
-    };
+    let intervals: Vec<f64> = impact_list.iter().filter_map(|i| i.interval).collect();
+    let impact_velocities = impact_list.iter().map(|i| i.velocity).collect();
+    let grazing_margin = period_list
+        .iter()
+        .map(|p| p.margin)
+        .fold(f64::INFINITY, f64::min);
     Ok(SweepPoint {
         param,
         poincare,
         intervals,
         impact_velocities,
-        impacts: impacts.count(),
-        impacts_per_period: impacts_per_period(
-            periods.periods(),
-            regime,
-            impacts.count(),
-            config.record,
-        ),
+        impacts: impact_count,
+        impacts_per_period: impacts_per_period(period_list, regime, impact_count, config.record),
         regime,
         grazing_margin,
         end_state: out.y,
@@ -450,7 +512,7 @@ fn impacts_per_period(
 /// assert_eq!(res.branches[0].points.len(), 3);
 /// # Ok::<(), nonsmooth::Error>(())
 /// ```
-pub fn sweep<const N: usize, S, St, F, G>(
+pub fn sweep<const N: usize, S, St, F, G, Sf>(
     config: &SweepConfig,
     make: F,
     stepper: G,
@@ -459,8 +521,9 @@ pub fn sweep<const N: usize, S, St, F, G>(
 where
     S: Dynamics<f64, N> + Send,
     St: Stepper<f64, N>,
-    F: Fn(f64) -> crate::Result<SweepSystem<S>> + Sync,
+    F: Fn(f64) -> crate::Result<SweepSystem<S, Sf>> + Sync,
     G: Fn() -> St + Sync,
+    Sf: Surface<f64, N> + Clone + Send,
 {
     let branch = |dir: SweepDirection| -> Result<Branch<N>, SweepError> {
         let mut vals: Vec<f64> = config.values.clone();
@@ -471,10 +534,7 @@ where
             let mut y = y0;
             let mut points = Vec::with_capacity(vals.len());
             for (k, &p) in vals.iter().enumerate() {
-                let sys = make(p).map_err(|e| SweepError::Failed {
-                    param: p,
-                    source: Box::new(e),
-                })?;
+                let sys = make(p).map_err(|e| SweepError::failed(p, e))?;
                 let tr = if k == 0 {
                     config.transient_first
                 } else {
@@ -490,10 +550,7 @@ where
             })
         } else {
             let one = |&p: &f64| -> Result<SweepPoint<N>, SweepError> {
-                let sys = make(p).map_err(|e| SweepError::Failed {
-                    param: p,
-                    source: Box::new(e),
-                })?;
+                let sys = make(p).map_err(|e| SweepError::failed(p, e))?;
                 run_point(config, p, sys, stepper(), y0, config.transient_first)
             };
             #[cfg(feature = "parallel")]

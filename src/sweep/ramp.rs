@@ -65,10 +65,7 @@ where
     St: Stepper<f64, N>,
     E: Excitation<f64> + Clone,
 {
-    let fail = |e: crate::Error| SweepError::Failed {
-        param: f64::NAN,
-        source: Box::new(e),
-    };
+    let fail = |e: crate::Error| SweepError::failed(f64::NAN, e);
     let ev = Event::new(StopEvent(Some(stop)), Direction::Rising);
     let mut sim = Simulation::new(system, stepper)
         .with_events(ev)
