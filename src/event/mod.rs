@@ -453,7 +453,20 @@ impl<G, R> Event<G, R> {
 /// tuples of up to eight sets — nested tuples too. Indices are flat: in `((a, b), c)`, `a`
 /// is 0, `b` is 1 and `c` is 2 (a tuple's [`LEN`](EventSet::LEN) is the sum of its
 /// members'). A simulation takes at most [`MAX_EVENTS`] events; a larger set is a compile
-/// error at the `Simulation::with_events` call, never a silently unchecked event.
+/// error at the `Simulation::with_events` call, never a silently unchecked event:
+///
+/// ```compile_fail
+/// use nonsmooth::drive::Simulation;
+/// use nonsmooth::event::{Direction, Event, Level};
+/// use nonsmooth::integrate::{Dopri5, Tolerances};
+/// use nonsmooth::testing::HarmonicOscillator;
+///
+/// let e = Event::new(Level::new(0, 0.0).unwrap(), Direction::Rising);
+/// let tol = Tolerances::<f64, 2>::new(1e-8, 1e-10).unwrap();
+/// // Nine events: does not compile.
+/// let sim = Simulation::new(HarmonicOscillator::new(1.0).unwrap(), Dopri5::new(tol))
+///     .with_events(((e, e, e, e, e, e, e, e), e));
+/// ```
 pub trait EventSet<T: Real, const N: usize> {
     /// The number of events.
     const LEN: usize;
