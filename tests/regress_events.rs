@@ -225,7 +225,10 @@ fn impacts_on_a_moving_surface_of_a_two_dof_system() {
     ));
     let motion = Harmonic::new(0.1, 3.0, 0.0).unwrap();
     let surface = Gap::below(
-        Coordinate::<f64, 2>::dof(1).unwrap().with_offset(-0.5).unwrap(),
+        Coordinate::<f64, 2>::dof(1)
+            .unwrap()
+            .with_offset(-0.5)
+            .unwrap(),
         motion,
     );
     let mut imp = ImpactSequence::on_surface(0, surface, 0.0, 100).unwrap();

@@ -16,7 +16,7 @@ use crate::Real;
 use crate::error::{ParameterError, Result};
 use crate::excite::{Excitation, RampedRotor, UnbalancedRotor};
 use crate::force::{DryFriction, HertzContact, LinearSpring, ViscousDamper};
-use crate::model::Oscillator;
+use crate::model::{Element, Load, Mechanical, Oscillator};
 use crate::scalar::lit;
 
 /// The force laws of the paper's model, summed as a tuple.
@@ -29,6 +29,11 @@ pub type PaperLaws<T> = (
 
 /// The paper's oscillator at a fixed forcing frequency.
 pub type PaperOscillator<T> = Oscillator<T, PaperLaws<T>, UnbalancedRotor<T>>;
+
+/// The paper's model as a 1-DOF [`Mechanical`] system (the same right-hand side as
+/// [`PaperOscillator`], bit for bit; the form to extend with further degrees of freedom).
+pub type PaperMechanical<T> =
+    Mechanical<T, 1, 2, Element<T, 1, PaperLaws<T>>, Load<T, 1, UnbalancedRotor<T>>>;
 
 /// The paper's oscillator with a linearly ramped forcing frequency (the experiment's sweep).
 pub type RampedPaperOscillator<T> = Oscillator<T, PaperLaws<T>, RampedRotor<T>>;
@@ -122,6 +127,19 @@ impl PaperParameters {
             self.laws()?,
             UnbalancedRotor::new(lit(self.m0e), omega)?,
         )
+    }
+
+    /// The same model as a 1-DOF [`Mechanical`] system forced at `omega`.
+    ///
+    /// # Errors
+    /// [`Error::Parameter`](crate::Error::Parameter) if any parameter or `omega` is invalid.
+    pub fn mechanical<T: Real>(&self, omega: T) -> Result<PaperMechanical<T>> {
+        Ok(Mechanical::with_masses([lit(self.m)])?
+            .with_elements(Element::on_dof(0, self.laws()?)?)
+            .with_loads(Load::on_dof(
+                0,
+                UnbalancedRotor::new(lit(self.m0e), omega)?,
+            )?))
     }
 
     /// The oscillator with `ω(t) = omega0 + rate·t` (the experiment's continuous sweep).

@@ -66,7 +66,7 @@ pub struct TwoDofImpact {
 }
 
 impl Default for TwoDofImpact {
-    /// `m1 = 1, m2 = 0.5, k1 = 1, k2 = 0.5, c1 = c2 = 0.02, F = 0.1, d = 0.2,
+    /// `m1 = 1, m2 = 0.5, k1 = 1, k2 = 0.5, c1 = c2 = 0.05, F = 0.1, d = 0.2,
     /// k_c = 10³, b = 0.2`: a primary resonance near ω ≈ 0.7 and impacts of the secondary
     /// mass on a band of forcing frequencies around it.
     fn default() -> Self {
@@ -75,8 +75,8 @@ impl Default for TwoDofImpact {
             m2: 0.5,
             k1: 1.0,
             k2: 0.5,
-            c1: 0.02,
-            c2: 0.02,
+            c1: 0.05,
+            c2: 0.05,
             force: 0.1,
             gap: 0.2,
             k_contact: 1e3,
