@@ -46,24 +46,18 @@ fn paper_model_as_mechanical_system_is_bit_identical() {
             .with_events(Event::new(stop, Direction::Rising))
             .run(0.0, Vector2::new(x0, 0.0), 10.0, &mut imp)
             .unwrap();
-        (
-            out.y,
-            out.stats,
-            imp.impacts().iter().map(|i| i.t).collect(),
-        )
-    });
+        let times: Vec<f64> = imp.impacts().iter().map(|i| i.t).collect();
+        (out.y, out.stats, times)
+    };
     let b = {
         let mut imp = ImpactSequence::new(0, 0, 1, PAPER.x_i, 0.0, 1000).unwrap();
         let out = Simulation::new(mech, Dopri5::new(tol))
             .with_events(Event::new(stop, Direction::Rising))
             .run(0.0, Vector2::new(x0, 0.0), 10.0, &mut imp)
             .unwrap();
-        (
-            out.y,
-            out.stats,
-            imp.impacts().iter().map(|i| i.t).collect(),
-        )
-    });
+        let times: Vec<f64> = imp.impacts().iter().map(|i| i.t).collect();
+        (out.y, out.stats, times)
+    };
     assert!(a.2.len() > 20, "{} impacts", a.2.len());
     assert_eq!(a, b);
 }
