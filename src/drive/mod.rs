@@ -475,6 +475,11 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
                 }
                 None => t_end,
             };
+            // Events with a time scale (moving surfaces) bound the step.
+            let limit = match self.events.max_step(t_now) {
+                Some(h) => limit.min(t_now + h),
+                None => limit,
+            };
             self.stepper.step(&self.system, limit)?;
             steps += 1;
             let dense = self.stepper.dense();
@@ -647,6 +652,56 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
                 }
                 t_lo = tc;
                 y_lo = yc;
+            }
+            // Sticking: an event disarmed after a reset, still on the far side at the step
+            // end and moving deeper again, never left the surface: the reset could not
+            // separate the trajectory from it. Never silence: stop where it turned (the
+            // extremum of g on the dense output), with the state to go on from.
+            for i in 0..n_ev {
+                if !armed[i]
+                    && g_end[i] != T::zero()
+                    && r_end[i].is_some_and(|r| r != T::zero() && sign_of(r) == sign_of(g_end[i]))
+                {
+                    let dense = self.stepper.dense();
+                    let tol = self
+                        .event_tol
+                        .max(lit::<T>(4.0) * T::default_epsilon() * ts1.abs());
+                    let sg = if g_end[i] > T::zero() {
+                        T::one()
+                    } else {
+                        -T::one()
+                    };
+                    let events = &self.events;
+                    let (te, _) = crate::roots::golden_max(
+                        |t| {
+                            let mut y = SVector::<T, N>::zeros();
+                            dense.interpolate_unchecked(t, &mut y);
+                            -sg * events.value(i, t, &y)
+                        },
+                        t_lo,
+                        ts1,
+                        tol,
+                    );
+                    let mut ye = SVector::zeros();
+                    dense.interpolate_unchecked(te, &mut ye);
+                    let view = StepView {
+                        t0: t_lo,
+                        t1: te,
+                        y0: y_lo,
+                        y1: ye,
+                        dense,
+                    };
+                    observer.on_step(&view);
+                    let depth = self.events.value(i, te, &ye).abs();
+                    self.stepper.reset_state(te, ye);
+                    return Err(EventError::Sticking {
+                        index: i,
+                        t: to_f64(te),
+                        depth: to_f64(depth),
+                        state: ye.iter().map(|&v| to_f64(v)).collect(),
+                    }
+                    .into());
+                }
             }
             let dense = self.stepper.dense();
             let view = StepView {

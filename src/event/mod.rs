@@ -22,6 +22,30 @@
 //! - Without a reset (a pure detection, e.g. an impact with compliant contact) nothing is
 //!   rewound: the step is split at the event for the observers, and integration goes on
 //!   unchanged.
+//!
+//! # The contract, stated once
+//! - **What is found.** Every sign change of `g` between the ends of a step, and every
+//!   excursion past zero inside a step while `g` has at most one interior extremum there
+//!   (grazing pairs; from the rate, or from `k` interior samples without one). Events are
+//!   located to `max(tol_t, 4·ε_mach·|t|)` on the dense output.
+//! - **Moving surfaces.** An event function with explicit time dependence declares its
+//!   [`time_scale`](EventFunction::time_scale) (a [`Gap`] on a harmonically moving surface:
+//!   `T_surface/16`), or the event a [`max_step`](Event::with_max_step); no step is longer
+//!   while the event is in the set. So a step never spans more than a sixteenth of the
+//!   surface's period, however smooth the free flight (where an error estimate alone lets
+//!   the step grow without bound).
+//! - **Start on the surface.** A trajectory that starts exactly on a surface (`g(t₀) = 0`)
+//!   has not crossed it: no event at `t₀` in either direction; the side is the one it moves
+//!   to (from the rate, or from the end of the first step).
+//! - **Non-finite values.** `g` = NaN or ±∞ at a step end stops the run with
+//!   [`EventError::NonFinite`]; interior samples that are not finite are not crossings.
+//! - **Indices.** Event functions, resets and observers check their component indices
+//!   against the state before the first step ([`EventError::IndexOutOfRange`]).
+//! - **Sticking.** After a reset, an event is disarmed until the trajectory leaves the far
+//!   side; if it turns back deeper instead (the reset cannot separate it from the surface),
+//!   the run stops with [`EventError::Sticking`] and its state, never silently.
+//! - **Accumulation.** The [`ZenoGuard`] stops a geometric accumulation of events below its
+//!   time floor, whatever the run's span, and leaves the simulation at the last event.
 
 use nalgebra::SVector;
 use thiserror::Error;
@@ -50,6 +74,23 @@ pub enum EventError {
         /// The last inter-event interval.
         last_interval: f64,
         /// The state after the last event (after its reset, if any), to restart from.
+        state: Vec<f64>,
+    },
+    /// After a reset the trajectory stayed on the far side of the surface and turned
+    /// deeper again instead of leaving it: the reset cannot separate it (the body sticks to
+    /// the surface, e.g. a ball caught by a table accelerating upwards). The simulation is
+    /// left at `t`, `state`; continue with a constrained (sticking) model.
+    #[error(
+        "event {index}: after its reset the trajectory turned back into the surface at t = {t} (depth {depth}): sticking; continue with a constrained model from this state"
+    )]
+    Sticking {
+        /// The event's index.
+        index: usize,
+        /// Time (a step end).
+        t: f64,
+        /// `|g|` there.
+        depth: f64,
+        /// The state there.
         state: Vec<f64>,
     },
     /// An event or reset index outside the state vector.
@@ -114,6 +155,15 @@ pub trait EventFunction<T: Real, const N: usize> {
     /// `dg/dt` along the trajectory, given `dy = f(t, y)`, if known. Enables grazing
     /// detection from the step's end derivatives.
     fn rate(&self, _t: T, _y: &SVector<T, N>, _dy: &SVector<T, N>) -> Option<T> {
+        None
+    }
+
+    /// The shortest time over which the function's explicit dependence on `t` can turn
+    /// around near `t` (e.g. a fraction of a moving surface's period), if it has one. While
+    /// the event is in a simulation, no step is longer than this, so that a moving surface
+    /// cannot be stepped over (see the module docs). Default: `None` (no explicit time
+    /// dependence).
+    fn time_scale(&self, _t: T) -> Option<T> {
         None
     }
 
@@ -308,6 +358,13 @@ impl<T: Real, const N: usize, const M: usize, S: crate::excite::Excitation<T>> E
         }
         Some(self.penetration_rate(t, &y.as_slice()[N..]))
     }
+    /// `2π/(16ω)` for a surface moving with angular frequency `ω`: sixteen steps per
+    /// surface period at least.
+    fn time_scale(&self, t: T) -> Option<T> {
+        self.motion
+            .angular_frequency(t)
+            .map(|w| T::two_pi() / (lit::<T>(16.0) * w))
+    }
     fn check(&self) -> Result<(), EventError> {
         if M != 2 * N {
             return Err(EventError::IndexOutOfRange {
@@ -383,6 +440,108 @@ impl<T: Real, const N: usize> ResetMap<T, N> for Restitution<T> {
     }
 }
 
+/// Newton's restitution law on a contact [`Gap`] of an `N`-DOF mechanical system, fixed or
+/// moving: the normal relative velocity reverses, scaled by `e`,
+/// $$\dot g^+ = -e\,\dot g^-,\qquad \dot q^+ = \dot q^- - (1+e)\,
+///   \frac{w\cdot\dot q^- - \dot s(t)}{w^{\mathsf T}\mathbf M^{-1}w}\,\mathbf M^{-1}w,$$
+/// an impulse along the surface's gradient `w` (the coordinate's weights) that leaves the
+/// positions and every velocity component orthogonal (in the mass metric) unchanged. For a
+/// single mass against a surface moving with velocity `ṡ` this is `v⁺ = ṡ − e·(v⁻ − ṡ)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NewtonImpact<T: Real, const N: usize, S = ()> {
+    gap: Gap<T, N, S>,
+    e: T,
+    /// `M⁻¹w / (wᵀM⁻¹w)`.
+    direction: SVector<T, N>,
+}
+
+impl<T: Real, const N: usize, S: crate::excite::Excitation<T>> NewtonImpact<T, N, S> {
+    /// Restitution `e ∈ [0, 1]` on `gap` for a system with mass matrix `mass` (e.g.
+    /// [`Mechanical::mass_matrix`](crate::model::Mechanical::mass_matrix)).
+    ///
+    /// # Errors
+    /// [`ParameterError`] unless `0 ≤ e ≤ 1`, or if `mass` is singular or not positive along
+    /// the gap's gradient (`wᵀM⁻¹w ≤ 0`).
+    pub fn new(
+        gap: Gap<T, N, S>,
+        e: T,
+        mass: &nalgebra::SMatrix<T, N, N>,
+    ) -> Result<Self, ParameterError> {
+        if !(e >= T::zero() && e <= T::one()) {
+            return Err(ParameterError::new(
+                "e",
+                crate::scalar::to_f64(e),
+                "in [0, 1]",
+            ));
+        }
+        let inv = mass
+            .try_inverse()
+            .ok_or(ParameterError::new("mass", f64::NAN, "invertible"))?;
+        let w = gap.coordinate().weights();
+        let m_w = inv * w;
+        let denom = w.dot(&m_w);
+        if !(denom > T::zero() && denom.is_finite()) {
+            return Err(ParameterError::new(
+                "mass",
+                crate::scalar::to_f64(denom),
+                "positive definite along the gap (wᵀM⁻¹w > 0)",
+            ));
+        }
+        Ok(Self {
+            gap,
+            e,
+            direction: m_w / denom,
+        })
+    }
+
+    /// For unit masses (`M = I`): `q̇⁺ = q̇⁻ − (1+e)(w·q̇⁻ − ṡ)·w/|w|²`.
+    ///
+    /// # Errors
+    /// As [`new`](Self::new).
+    pub fn unit_mass(gap: Gap<T, N, S>, e: T) -> Result<Self, ParameterError> {
+        Self::new(gap, e, &nalgebra::SMatrix::identity())
+    }
+
+    /// The gap.
+    pub fn gap(&self) -> &Gap<T, N, S> {
+        &self.gap
+    }
+
+    /// The restitution coefficient.
+    pub fn restitution(&self) -> T {
+        self.e
+    }
+}
+
+impl<T: Real, const N: usize, const M: usize, S: crate::excite::Excitation<T>> ResetMap<T, M>
+    for NewtonImpact<T, N, S>
+{
+    fn apply(&self, t: T, y: &mut SVector<T, M>) {
+        if M != 2 * N {
+            return;
+        }
+        let w = self.gap.coordinate().weights();
+        let (_, sdot) = self.gap.surface(t);
+        let mut vn = -sdot;
+        for k in 0..N {
+            vn += w[k] * y[N + k];
+        }
+        let scale = (T::one() + self.e) * vn;
+        for k in 0..N {
+            y[N + k] -= scale * self.direction[k];
+        }
+    }
+    fn check(&self) -> Result<(), EventError> {
+        if M != 2 * N {
+            return Err(EventError::IndexOutOfRange {
+                index: 2 * N - 1,
+                len: M,
+            });
+        }
+        Ok(())
+    }
+}
+
 /// An event: a function, a direction, an optional reset, terminal or not.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Event<G, R = ()> {
@@ -398,6 +557,9 @@ pub struct Event<G, R = ()> {
     pub interior_samples: usize,
     /// Whether the stepper restarts at the event (a switching point of the dynamics).
     pub restart: bool,
+    /// The longest step the driver takes while this event is in the set (s), besides the
+    /// function's own [`time_scale`](EventFunction::time_scale); `None` for no bound.
+    pub max_step: Option<f64>,
 }
 
 impl<G> Event<G, ()> {
@@ -410,6 +572,7 @@ impl<G> Event<G, ()> {
             terminal: false,
             interior_samples: 0,
             restart: false,
+            max_step: None,
         }
     }
 }
@@ -424,6 +587,7 @@ impl<G, R> Event<G, R> {
             terminal: self.terminal,
             interior_samples: self.interior_samples,
             restart: self.restart,
+            max_step: self.max_step,
         }
     }
 
@@ -437,6 +601,17 @@ impl<G, R> Event<G, R> {
     pub fn with_interior_samples(mut self, k: usize) -> Self {
         self.interior_samples = k;
         self
+    }
+
+    /// Bounds the step length while this event is in the set (for an event function with
+    /// fast explicit time dependence that does not declare its
+    /// [`time_scale`](EventFunction::time_scale)).
+    ///
+    /// # Errors
+    /// [`ParameterError`] unless `h` is finite and > 0.
+    pub fn with_max_step(mut self, h: f64) -> Result<Self, ParameterError> {
+        self.max_step = Some(crate::validate::positive("max_step", h)?);
+        Ok(self)
     }
 
     /// Restarts the stepper at the event (for a switching surface where the right-hand side
@@ -494,6 +669,21 @@ pub trait EventSet<T: Real, const N: usize> {
     /// [`EventError::IndexOutOfRange`] for an index `≥ N`.
     fn check(&self) -> Result<(), EventError> {
         Ok(())
+    }
+    /// The longest step the set allows near `t` (the smallest declared time scale or
+    /// `max_step` of its events), if any.
+    #[inline(always)]
+    fn max_step(&self, _t: T) -> Option<T> {
+        None
+    }
+}
+
+#[inline(always)]
+fn min_option<T: Real>(a: Option<T>, b: Option<T>) -> Option<T> {
+    match (a, b) {
+        (Some(a), Some(b)) => Some(a.min(b)),
+        (a, None) => a,
+        (None, b) => b,
     }
 }
 
@@ -558,6 +748,10 @@ impl<T: Real, const N: usize, G: EventFunction<T, N>, R: ResetMap<T, N>> EventSe
         self.function.check()?;
         self.reset.check()
     }
+    #[inline(always)]
+    fn max_step(&self, t: T) -> Option<T> {
+        min_option(self.function.time_scale(t), self.max_step.map(lit))
+    }
 }
 
 /// Dispatches flat index `$i` to the member that holds it (members are visited in order;
@@ -610,6 +804,12 @@ macro_rules! event_tuple {
             fn check(&self) -> Result<(), EventError> {
                 $(self.$idx.check()?;)+
                 Ok(())
+            }
+            #[inline(always)]
+            fn max_step(&self, t: T) -> Option<T> {
+                let m = None;
+                $(let m = min_option(m, self.$idx.max_step(t));)+
+                m
             }
         }
     };

@@ -4,13 +4,16 @@
 //! | system | equation | module |
 //! |---|---|---|
 //! | the paper's cart | `m·ẍ + kx + cẋ + T·ẋ/√(ẋ²+ε²) + F_I(x, ẋ) = m₀eω² sin ωt` | [`paper`] |
+//! | ball on a vibrating table | `ÿ = −g` above `s = A sin ωt`, Newton restitution `e` (rigid) | [`bouncing_ball`] |
 //! | 2-DOF impact oscillator | primary mass, coupled secondary mass hitting a Hertz stop | [`two_dof`] |
 //!
 //! Every entry is an ordinary [`Oscillator`](crate::model::Oscillator) or
 //! [`Mechanical`](crate::model::Mechanical) model: nothing in the engine knows about any of
 //! them.
 
+pub mod bouncing_ball;
 pub mod paper;
 pub mod two_dof;
 
+pub use bouncing_ball::BouncingBallTable;
 pub use two_dof::TwoDofImpact;

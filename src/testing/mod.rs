@@ -119,17 +119,20 @@
 //! | [`BouncingBall`] | 2 | impact times, speeds, Zeno time ([`BallDrop`]) |
 //! | [`HarmonicZeroCrossings`] | 2 | zero crossings of `A cos(ωt + φ)` |
 //! | [`NearGrazing`] | 2 | a crossing pair of width `≈ 2√(2δ/L)/ω` |
+//! | [`BallOnTableExact`] | — | the exact impact map of a ball on a vibrating table |
 //! | [`TwoDofImpactByHand`] | 4 | none; the catalogue's 2-DOF impact oscillator written out by hand |
 //!
 //! Order tests of integrators should use a non-autonomous problem: a tableau with a wrong
 //! node `c_i` is exact on autonomous ones. [`convergence_order`] fits the observed order.
 
+mod ball_table;
 mod convergence;
 mod hand_written;
 mod impacts;
 mod law_check;
 mod problems;
 
+pub use ball_table::{BallOnTableExact, TableImpact};
 pub use convergence::{ConvergenceFit, convergence_fit, convergence_order};
 pub use hand_written::TwoDofImpactByHand;
 pub use impacts::{BallDrop, BouncingBall, Crossing, HarmonicZeroCrossings, NearGrazing};
