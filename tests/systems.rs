@@ -136,3 +136,51 @@ fn two_dof_impact_oscillator_matches_the_hand_written_model() {
         other => panic!("{other:?}"),
     }
 }
+
+#[test]
+fn sweeps_run_over_any_parameter() {
+    // The 2-DOF oscillator at ω = 0.6 swept in its gap d: impacts stop once the gap exceeds
+    // the secondary mass's steady amplitude A without contact (measured 0.431).
+    let omega = 0.6;
+    let config = SweepConfig::grid(0.1, 0.9, 0.2)
+        .unwrap()
+        .direction(SweepDirection::Up)
+        .continuation(false)
+        .transients(200, 0)
+        .record(10)
+        .unwrap();
+    let tol = Tolerances::per_component(1e-9, [1e-11; 4]).unwrap();
+    let res = sweep(
+        &config,
+        |gap: f64| -> nonsmooth::Result<SweepSystem<_, _>> {
+            let p = TwoDofImpact {
+                gap,
+                ..TwoDofImpact::default()
+            };
+            Ok(SweepSystem {
+                system: p.model::<f64>(omega)?,
+                period: TwoDofImpact::period(omega),
+                stop: Some(p.stop::<f64>()?),
+            })
+        },
+        || Dopri5::new(tol),
+        SVector::zeros(),
+    )
+    .unwrap();
+    let impacts: Vec<u64> = res.branches[0].points.iter().map(|q| q.impacts).collect();
+    let gaps: Vec<f64> = res.branches[0].points.iter().map(|q| q.param).collect();
+    assert_eq!(gaps.len(), 5);
+    assert_eq!(impacts, vec![10, 5, 0, 0, 0], "{gaps:?}: {impacts:?}");
+    // Without contact the response does not depend on the gap, so the grazing margin is
+    // d − A at every non-impacting gap.
+    let pts = &res.branches[0].points;
+    let amplitude = pts[4].param - pts[4].grazing_margin;
+    assert!((amplitude - 0.431).abs() < 1e-3, "{amplitude}");
+    for p in &pts[2..] {
+        assert!(
+            (p.param - p.grazing_margin - amplitude).abs() < 1e-7,
+            "{}",
+            p.param
+        );
+    }
+}
