@@ -163,8 +163,8 @@ impl<T: Real, const N: usize> Coordinate<T, N> {
     #[inline(always)]
     pub fn value(&self, q: &[T]) -> T {
         let mut g = self.offset;
-        for k in 0..N {
-            g += self.weights[k] * q[k];
+        for (w, x) in self.weights.iter().zip(q) {
+            g += *w * *x;
         }
         g
     }
@@ -173,8 +173,8 @@ impl<T: Real, const N: usize> Coordinate<T, N> {
     #[inline(always)]
     pub fn rate(&self, qd: &[T]) -> T {
         let mut g = T::zero();
-        for k in 0..N {
-            g += self.weights[k] * qd[k];
+        for (w, v) in self.weights.iter().zip(qd) {
+            g += *w * *v;
         }
         g
     }
