@@ -125,10 +125,12 @@
 //! (1985); the paper, Sect. 4 and Fig. 5.
 
 mod diagram;
+mod hybrid;
 mod tangent;
 mod two_trajectory;
 
 pub use diagram::{Branch, Diagram, DiagramPoint, DiagramSettings, IntervalRule, tle_diagram};
+pub use hybrid::{HybridTangentSpace, HybridTwoTrajectory, Saltation};
 pub use tangent::{Spectrum, TangentSpace, Variational, tangent_tolerances};
 pub use two_trajectory::{
     PerturbedPair, SeparationPoint, TwoTrajectory, decades, pair_tolerances, separation_study,

@@ -113,4 +113,44 @@ impl BallOnTableExact {
         }
         out
     }
+
+    /// The top Lyapunov exponent per unit time from the exact impact map
+    /// `(t_k, v_k) ↦ (t_{k+1}, v_{k+1})` (`v_k` the ball's velocity after impact `k`) and its
+    /// Jacobian in closed form: with `Δ = t_{k+1} − t_k`, `u = v_k − gΔ` and
+    /// `F = s(t_k) + v_kΔ − gΔ²/2 − s(t_{k+1}) = 0`,
+    /// $$\frac{\partial t_{k+1}}{\partial(t_k, v_k)} = -\frac{(\dot s_k - v_k + g\Delta,\;
+    ///   \Delta)}{u - \dot s_{k+1}},\qquad v_{k+1} = (1+e)\dot s(t_{k+1}) - e\,u .$$
+    /// The product of `impacts` Jacobians (after `transient` impacts) is renormalized at each
+    /// step; the exponent is `Σ ln‖J_k ξ_k‖ / (t_end − t_start)`. Returns `None` if the
+    /// sequence ends (chattering) before `transient + impacts` impacts.
+    pub fn lyapunov(&self, t0: f64, v0: f64, transient: usize, impacts: usize) -> Option<f64> {
+        let seq = self.impacts(t0, v0, transient + impacts + 1);
+        if seq.len() < transient + impacts + 1 {
+            return None;
+        }
+        let p = &self.params;
+        let accel = |t: f64| -p.amplitude * p.omega * p.omega * (p.omega * t).sin();
+        let mut xi = [1.0f64, 0.0];
+        let mut log_sum = 0.0;
+        for k in transient..transient + impacts {
+            let (a, b) = (&seq[k], &seq[k + 1]);
+            let d = b.t - a.t;
+            let sd_k = p.table_motion(a.t).1;
+            let sd_1 = p.table_motion(b.t).1;
+            let u = a.v_after - p.g * d;
+            let f_t1 = u - sd_1;
+            let dt_dt = -(sd_k - a.v_after + p.g * d) / f_t1;
+            let dt_dv = -d / f_t1;
+            let du_dt = -p.g * (dt_dt - 1.0);
+            let du_dv = 1.0 - p.g * dt_dv;
+            let s2 = accel(b.t);
+            let dv_dt = (1.0 + p.e) * s2 * dt_dt - p.e * du_dt;
+            let dv_dv = (1.0 + p.e) * s2 * dt_dv - p.e * du_dv;
+            let next = [dt_dt * xi[0] + dt_dv * xi[1], dv_dt * xi[0] + dv_dv * xi[1]];
+            let n = next[0].hypot(next[1]);
+            log_sum += n.ln();
+            xi = [next[0] / n, next[1] / n];
+        }
+        Some(log_sum / (seq[transient + impacts].t - seq[transient].t))
+    }
 }
