@@ -125,7 +125,7 @@
 //! (1985); the paper, Sect. 4 and Fig. 5.
 
 mod diagram;
-mod hybrid;
+pub mod hybrid;
 mod tangent;
 mod two_trajectory;
 
