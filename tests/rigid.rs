@@ -112,3 +112,83 @@ fn ball_on_a_fast_table_is_never_lost_with_default_options() {
         assert!(r.deepest < 1e-9, "Γ = {gamma}, e = {e}: {r:?}");
     }
 }
+
+/// Runs the ball with chattering → sticking → release to `t_end`; returns the final state,
+/// the mode log and the deepest penetration at a step end.
+fn run_modes(
+    gamma: f64,
+    e: f64,
+    t_end: f64,
+) -> (f64, SVector<f64, 2>, nonsmooth::drive::ModeLog<f64>, f64) {
+    let p = BouncingBallTable::with_gamma(gamma, e).unwrap();
+    let table = p.table::<f64>().unwrap();
+    let v0 = p.table_motion(0.0).1 + 2.0;
+    let mut watch = Watch {
+        table,
+        times: Vec::new(),
+        deepest: f64::NEG_INFINITY,
+    };
+    let tol = Tolerances::new(1e-10, 1e-12).unwrap();
+    let (out, log) = nonsmooth::drive::run_with_sticking(
+        &p.model::<f64>().unwrap(),
+        &p.impact::<f64>().unwrap(),
+        || Dopri5::new(tol),
+        0.0,
+        SVector::<f64, 2>::new(0.0, v0),
+        t_end,
+        10_000,
+        &mut watch,
+    )
+    .unwrap();
+    (out.t, out.y, log, watch.deepest)
+}
+
+#[test]
+fn chattering_ends_in_sticking_and_releases_where_the_table_lets_go() {
+    // Γ = 1.2, e = 0.5: the chatter accumulates at t ≈ 1.8704 s; the ball then rides the
+    // table until its acceleration drops below −g: sin ωt = 1/Γ with the table
+    // decelerating, ωt_r = asin(1/Γ) + 2πk.
+    let (t, _, log, deepest) = run_modes(1.2, 0.5, 6.0);
+    assert_eq!(t, 6.0);
+    assert!(!log.stick.is_empty() && !log.release.is_empty(), "{log:?}");
+    assert!((log.stick[0] - 1.8704305831).abs() < 1e-8, "{log:?}");
+    let omega = std::f64::consts::TAU;
+    for &tr in &log.release {
+        let phase = (omega * tr).rem_euclid(std::f64::consts::TAU);
+        assert!(
+            (phase - (1.0f64 / 1.2).asin()).abs() < 1e-7,
+            "release at {tr}: phase {phase}"
+        );
+    }
+    assert!(deepest < 1e-9, "{deepest}");
+}
+
+#[test]
+fn a_ball_at_rest_on_a_slow_table_stays_on_it_whatever_t_end() {
+    // Γ = 0.8 < 1: the table never accelerates down faster than g, so after the chatter the
+    // ball rides it for good (before: it fell through the table at every t_end).
+    let p = BouncingBallTable::with_gamma(0.8, 0.5).unwrap();
+    let mut logs = Vec::new();
+    for t_end in [0.2, 1.0, 2.0, 10.0] {
+        let (t, y, log, deepest) = run_modes(0.8, 0.5, t_end);
+        assert_eq!(t, t_end);
+        assert!(deepest < 1e-9, "t_end = {t_end}: {deepest}");
+        let (s, sd) = p.table_motion(t);
+        if log.stick.first().is_some_and(|&ts| ts < t_end) {
+            assert!(
+                (y[0] - s).abs() < 1e-9 && (y[1] - sd).abs() < 1e-7,
+                "{y:?} vs {s}, {sd}"
+            );
+            assert!(log.release.is_empty(), "{log:?}");
+        }
+        logs.push(log);
+    }
+    // The same modes at the same times, whatever t_end (a shorter run is a prefix), and
+    // one sticking phase for good (measured: from t = 1.3896 s).
+    let long = &logs[3];
+    assert!(long.stick.len() == 1 && long.release.is_empty(), "{long:?}");
+    for (log, t_end) in logs.iter().zip([0.2, 1.0, 2.0]) {
+        let prefix: Vec<f64> = long.stick.iter().copied().filter(|&t| t < t_end).collect();
+        assert_eq!(log.stick, prefix, "t_end = {t_end}");
+    }
+}

@@ -25,6 +25,10 @@
 
 use nalgebra::SVector;
 
+mod sticking;
+
+pub use sticking::{Constrained, ModeLog, run_with_sticking};
+
 use crate::error::Result;
 use crate::event::{Direction, EventError, EventHistory, EventSet, MAX_EVENTS, ZenoGuard, locate};
 use crate::integrate::{DenseOutput, IntegrateError, Stats, Stepper, check_state};
@@ -653,12 +657,24 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
                 t_lo = tc;
                 y_lo = yc;
             }
-            // Sticking: an event disarmed after a reset, still on the far side at the step
-            // end and moving deeper again, never left the surface: the reset could not
-            // separate the trajectory from it. Never silence: stop where it turned (the
+            // Sticking: an event disarmed after a reset (or an impact event on its far side),
+            // still on the far side at the step end and moving deeper again, never left the
+            // surface: the reset could not separate the trajectory from it. Never silence: stop where it turned (the
             // extremum of g on the dense output), with the state to go on from.
             for i in 0..n_ev {
-                if !armed[i]
+                // For an impact (a resetting event with a direction) the far side is the
+                // wrong side at any step end: its crossings are reset away from it.
+                let wrong_side = match self.events.direction(i) {
+                    Direction::Rising => 1,
+                    Direction::Falling => -1,
+                    Direction::Either => 0,
+                };
+                let stuck = if !armed[i] {
+                    true
+                } else {
+                    self.events.resets(i) && sign_of(g_end[i]) == wrong_side
+                };
+                if stuck
                     && g_end[i] != T::zero()
                     && r_end[i].is_some_and(|r| r != T::zero() && sign_of(r) == sign_of(g_end[i]))
                 {

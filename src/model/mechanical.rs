@@ -617,6 +617,11 @@ impl<T: Real, const N: usize, const M: usize, El, Ld> Mechanical<T, N, M, El, Ld
         &self.mass
     }
 
+    /// The inverse mass matrix `M⁻¹`.
+    pub fn inverse_mass_matrix(&self) -> &SMatrix<T, N, N> {
+        &self.inv_mass
+    }
+
     /// The elements.
     pub fn elements(&self) -> &El {
         &self.elements
