@@ -11,7 +11,7 @@
 //! - [`HybridTangentSpace`]: the variational equations with `K` tangent vectors, mapped
 //!   across every reset by the **saltation matrix**
 //!   $$S = R_y + \frac{\bigl(f^+ - R_y f^- - R_t\bigr)\,\nabla g^{\mathsf T}}
-//!     {\nabla g\cdot f^- + \partial_t g},$$
+//!   {\nabla g\cdot f^- + \partial_t g},$$
 //!   with `R` the reset, `g` the event function, `f^∓` the vector field before and after.
 //!   `R_y`, `R_t`, `∇g` and `∂_t g` are central finite differences of the reset map and the
 //!   event function (relative step `ε^{1/3}`, accurate to about `10⁻¹⁰` relative for smooth
