@@ -25,7 +25,7 @@
 
 use nalgebra::SVector;
 
-mod sticking;
+pub mod sticking;
 
 pub use sticking::{Constrained, ModeLog, run_with_sticking};
 
