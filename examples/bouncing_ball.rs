@@ -126,7 +126,11 @@ fn main() -> nonsmooth::Result<()> {
     // Bifurcation diagram: impact phases over Γ.
     let n = if quick { 160 } else { 640 };
     let (lo, hi) = (0.8, 4.0);
-    let (transient, record) = if quick { (150.0, 100.0) } else { (300.0, 300.0) };
+    let (transient, record) = if quick {
+        (150.0, 100.0)
+    } else {
+        (300.0, 300.0)
+    };
     let mut rows = Vec::new();
     let mut sticking_at = Vec::new();
     for k in 0..=n {
