@@ -41,17 +41,19 @@ impl Observer<f64, 2> for Phases {
     }
 }
 
+/// Impact points `(Γ or t, phase)` and the sticking/release log of one run.
+type PhaseRun = (Vec<(f64, f64)>, ModeLog<f64>);
+
+/// One row of the exponent table: Γ, the exact map's λ, two trajectories (λ, ±), QR (λ, ±).
+type ExponentRow = (f64, Option<f64>, Option<(f64, f64)>, Option<(f64, f64)>);
+
 fn tolerances() -> nonsmooth::Result<Tolerances<f64, 2>> {
     Ok(Tolerances::new(1e-10, 1e-12)?)
 }
 
 /// Impact phases over `[transient, transient + record]` table periods, with chattering and
 /// sticking handled.
-fn phases(
-    p: &BouncingBallTable,
-    transient: f64,
-    record: f64,
-) -> nonsmooth::Result<(Vec<(f64, f64)>, ModeLog<f64>)> {
+fn phases(p: &BouncingBallTable, transient: f64, record: f64) -> nonsmooth::Result<PhaseRun> {
     let mut obs = Phases {
         omega: p.omega,
         record_from: transient,
@@ -174,7 +176,7 @@ fn main() -> nonsmooth::Result<()> {
     println!("|   Γ | exact map | two trajectories | QR with saltation |");
     println!("|---|---|---|---|");
     let mut ok = true;
-    let mut lyap_rows = Vec::new();
+    let mut lyap_rows: Vec<ExponentRow> = Vec::new();
     for &gamma in &gammas {
         let p = BouncingBallTable::with_gamma(gamma, E)?;
         let (exact, two, qr) = exponents(&p, seconds)?;
@@ -231,9 +233,7 @@ fn main() -> nonsmooth::Result<()> {
             .with(Series::dots(rows.iter().map(|&(g, p, _)| (g, p))).color(Rgb::BLACK))
             .legend(None);
         let mut lyap = Panel::new("Γ", "λ₁ [1/s]").hline(0.0, Rgb::BLACK);
-        let pick = |f: &dyn Fn(
-            &(f64, Option<f64>, Option<(f64, f64)>, Option<(f64, f64)>),
-        ) -> Option<f64>| {
+        let pick = |f: &dyn Fn(&ExponentRow) -> Option<f64>| {
             lyap_rows
                 .iter()
                 .filter_map(|r| f(r).map(|v| (r.0, v)))

@@ -245,3 +245,48 @@ fn ramp_sections_follow_the_phase() {
     assert!(!rec.impacts.is_empty());
     assert!(rec.impacts.iter().all(|i| i.velocity > 0.0));
 }
+
+#[test]
+fn sweep_config_rejects_degenerate_input() {
+    // A step far too small for the range would allocate 10¹⁸ values.
+    assert!(matches!(
+        SweepConfig::grid(0.0, 1.0, 1e-18),
+        Err(SweepError::TooManyValues { .. })
+    ));
+    assert!(matches!(
+        SweepConfig::grid(0.0, f64::MAX, 1.0),
+        Err(SweepError::TooManyValues { .. })
+    ));
+    // An ordinary grid still builds.
+    assert!(SweepConfig::grid(0.0, 1.0, 0.25).is_ok());
+    let cfg = SweepConfig::new(vec![14.0]).unwrap();
+    for (tol, max) in [
+        (f64::NAN, 4),
+        (-1.0, 4),
+        (f64::INFINITY, 4),
+        (0.0, 4),
+        (1e-6, 0),
+    ] {
+        assert!(
+            matches!(
+                cfg.clone().period_detection(tol, max),
+                Err(SweepError::InvalidPeriodDetection { .. })
+            ),
+            "tol {tol}, max period {max}"
+        );
+    }
+    assert!(cfg.period_detection(1e-6, 8).is_ok());
+}
+
+#[test]
+fn huge_transient_and_record_fail_on_the_step_cap_not_on_overflow() {
+    // `transient + record` does not fit a u32: the run's end is computed in f64 and the
+    // step cap stops it with an error.
+    let cfg = SweepConfig::new(vec![14.0])
+        .unwrap()
+        .record(u32::MAX)
+        .unwrap()
+        .max_steps(1000);
+    let r = run_point(&cfg, 14.0, make(14.0).unwrap(), stepper(), x0(), u32::MAX);
+    assert!(matches!(r, Err(SweepError::Failed { .. })), "{r:?}");
+}

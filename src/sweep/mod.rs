@@ -67,6 +67,24 @@ pub enum SweepError {
     /// No recorded periods.
     #[error("the number of recorded periods must be > 0")]
     NoRecordedPeriods,
+    /// More parameter values than a sweep takes.
+    #[error("{count} parameter values requested; at most {max} (a step too small for the range?)")]
+    TooManyValues {
+        /// The requested number of values.
+        count: f64,
+        /// The limit.
+        max: usize,
+    },
+    /// Period detection settings that cannot detect anything.
+    #[error(
+        "invalid period detection: tolerance {tol} must be finite and > 0, max period {max_period} >= 1"
+    )]
+    InvalidPeriodDetection {
+        /// The tolerance.
+        tol: f64,
+        /// The largest period.
+        max_period: usize,
+    },
     /// The forcing period returned by the system builder is not finite and positive.
     #[error("invalid forcing period {period} at parameter {param}")]
     InvalidPeriod {
@@ -146,6 +164,10 @@ pub enum SweepDirection {
     Both,
 }
 
+/// The most parameter values of one sweep (10⁷: far beyond any diagram, well below an
+/// allocation that would abort the process).
+pub const MAX_VALUES: usize = 10_000_000;
+
 /// How a sweep is run.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SweepConfig {
@@ -176,6 +198,12 @@ impl SweepConfig {
     pub fn new(values: Vec<f64>) -> Result<Self, SweepError> {
         if values.is_empty() {
             return Err(SweepError::EmptyRange);
+        }
+        if values.len() > MAX_VALUES {
+            return Err(SweepError::TooManyValues {
+                count: values.len() as f64,
+                max: MAX_VALUES,
+            });
         }
         for (i, &v) in values.iter().enumerate() {
             if !v.is_finite() {
@@ -220,7 +248,14 @@ impl SweepConfig {
         if !(step.is_finite() && step > 0.0 && end >= start) {
             return Err(SweepError::WrongStep { start, end, step });
         }
-        let n = ((end - start) / step + 1e-9).floor() as usize + 1;
+        let n = ((end - start) / step + 1e-9).floor() + 1.0;
+        if !(n <= MAX_VALUES as f64) {
+            return Err(SweepError::TooManyValues {
+                count: n,
+                max: MAX_VALUES,
+            });
+        }
+        let n = n as usize;
         Self::new((0..n).map(|i| start + i as f64 * step).collect())
     }
 
@@ -256,10 +291,17 @@ impl SweepConfig {
     }
 
     /// Period detection: relative tolerance and largest period tested.
-    pub fn period_detection(mut self, tol: f64, max_period: usize) -> Self {
+    ///
+    /// # Errors
+    /// [`SweepError::InvalidPeriodDetection`] unless `tol` is finite and > 0 and
+    /// `max_period ≥ 1` (a NaN or negative tolerance would call every orbit not periodic).
+    pub fn period_detection(mut self, tol: f64, max_period: usize) -> Result<Self, SweepError> {
+        if !(tol.is_finite() && tol > 0.0) || max_period == 0 {
+            return Err(SweepError::InvalidPeriodDetection { tol, max_period });
+        }
         self.period_tol = tol;
         self.max_period = max_period;
-        self
+        Ok(self)
     }
 
     /// Step cap per parameter value.
@@ -400,7 +442,8 @@ where
     }
     let stop = sys.stop;
     let t_rec = transient as f64 * period;
-    let t_end = (transient + config.record) as f64 * period;
+    // In f64: `transient + record` may not fit a u32.
+    let t_end = (f64::from(transient) + f64::from(config.record)) * period;
     let ev = Event::new(SurfaceEvent(stop.clone()), Direction::Rising);
     let mut sim = Simulation::new(sys.system, stepper)
         .with_events(ev)
