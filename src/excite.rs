@@ -110,9 +110,44 @@ impl<T: Real> Harmonic<T> {
         })
     }
 
+    /// `amplitude·sin(omega·t)`.
+    ///
+    /// # Errors
+    /// As [`new`](Harmonic::new).
+    pub fn sine(amplitude: T, omega: T) -> Result<Self, ParameterError> {
+        Self::new(amplitude, omega, T::zero())
+    }
+
+    /// `amplitude·cos(omega·t)`, i.e. `φ0 = π/2`: the forcing phase is `φ(t) = ωt + π/2`,
+    /// so sections at `φ = 2πi` fall a quarter period before `t = 2πi/ω`; take sections at
+    /// `t = 2πi/ω` with [`Stroboscopic::periodic`](crate::sample::Stroboscopic::periodic).
+    ///
+    /// # Errors
+    /// As [`new`](Harmonic::new).
+    ///
+    /// ```
+    /// use nonsmooth::excite::{Excitation, Harmonic};
+    /// let f = Harmonic::cosine(7.5, 1.0).unwrap();
+    /// assert_eq!(f.force(0.0), 7.5);
+    /// assert!((f.force(2.0) - 7.5 * 2.0_f64.cos()).abs() < 1e-14);
+    /// ```
+    pub fn cosine(amplitude: T, omega: T) -> Result<Self, ParameterError> {
+        Self::new(amplitude, omega, T::frac_pi_2())
+    }
+
     /// The angular frequency `ω`.
     pub fn omega(&self) -> T {
         self.omega
+    }
+
+    /// The amplitude `F0`.
+    pub fn amplitude(&self) -> T {
+        self.amplitude
+    }
+
+    /// The phase offset `φ0`.
+    pub fn phase_offset(&self) -> T {
+        self.phase0
     }
 
     /// The forcing period `2π/ω`.

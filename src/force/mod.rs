@@ -10,6 +10,9 @@
 //! |---|---|---|
 //! | [`LinearSpring`] | `k·x` | linear |
 //! | [`ViscousDamper`] | `c·ẋ` | linear |
+//! | [`CubicSpring`] | `k₁u + k₃u³`, `u = x − x₀` (Duffing) | polynomial |
+//! | [`Polynomial`] | `Σ c_i u^i` | polynomial |
+//! | [`Bilinear`] | `k_in·x + k_out[(x−hi)⁺ − (lo−x)⁺]` (backlash, bilinear stop) | piecewise |
 //! | [`DryFriction`] | `T·ẋ/√(ẋ²+ε²)` or `T·tanh(ẋ/ε)` | friction |
 //! | [`HertzContact`] | `k_I·[(x−x_I)^{n1} + b·(x−x_I)^{n2}·sgn ẋ·|ẋ|^{n3}]⁺` | contact |
 //!
@@ -33,10 +36,14 @@
 mod contact;
 mod friction;
 mod linear;
+mod piecewise;
+mod polynomial;
 
 pub use contact::{HertzContact, Side};
 pub use friction::{DryFriction, Regularization};
 pub use linear::{LinearSpring, ViscousDamper};
+pub use piecewise::Bilinear;
+pub use polynomial::{CubicSpring, Polynomial};
 
 use crate::Real;
 use crate::scalar::{epsilon, lit};

@@ -296,6 +296,39 @@ where
         })
     }
 
+    /// An estimator whose stepper is built from the system's tolerances: `make_stepper`
+    /// receives them extended by [`tangent_tolerances`] with `tangent_rtol`,
+    /// `tangent_atol`, so the sizes are spelled once, on the estimator.
+    ///
+    /// ```
+    /// use nonsmooth::integrate::{Dopri5, Tolerances};
+    /// use nonsmooth::lyapunov::{Norm, TangentSpace};
+    /// use nonsmooth::model::paper::PAPER;
+    /// let tol = Tolerances::per_component(1e-8, [1e-12, 1e-10])?;
+    /// let qr = TangentSpace::<_, 2, 2, 6, _, _>::with_tolerances(
+    ///     PAPER.oscillator::<f64>(14.0)?,
+    ///     Dopri5::new,
+    ///     &tol,
+    ///     (1e-8, 1e-8),
+    ///     Norm::paper(),
+    /// )?;
+    /// # drop(qr);
+    /// # Ok::<(), nonsmooth::Error>(())
+    /// ```
+    ///
+    /// # Errors
+    /// As [`tangent_tolerances`] and [`new`](Self::new).
+    pub fn with_tolerances(
+        system: S,
+        make_stepper: impl FnOnce(Tolerances<T, M>) -> St,
+        tol: &Tolerances<T, N>,
+        (tangent_rtol, tangent_atol): (T, T),
+        norm: Norm<T, N>,
+    ) -> Result<Self> {
+        let t = tangent_tolerances::<T, N, K, M>(tol, tangent_rtol, tangent_atol)?;
+        Self::new(system, make_stepper(t), norm)
+    }
+
     /// Sets the number of blocks for the standard error (default 10).
     ///
     /// # Errors

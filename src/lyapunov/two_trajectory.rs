@@ -228,6 +228,39 @@ where
         })
     }
 
+    /// An estimator whose stepper is built from the system's tolerances: `make_stepper`
+    /// receives them doubled for the pair ([`pair_tolerances`]), so the sizes are spelled
+    /// once, on the estimator.
+    ///
+    /// ```
+    /// use nonsmooth::integrate::{Dopri5, Tolerances};
+    /// use nonsmooth::lyapunov::{Norm, TwoTrajectory};
+    /// use nonsmooth::model::paper::PAPER;
+    /// let tol = Tolerances::per_component(1e-8, [1e-12, 1e-10])?;
+    /// let est = TwoTrajectory::<_, 2, 4, _, _>::with_tolerances(
+    ///     PAPER.oscillator::<f64>(14.0)?,
+    ///     Dopri5::new,
+    ///     &tol,
+    ///     1e-8,
+    ///     Norm::paper(),
+    /// )?;
+    /// # drop(est);
+    /// # Ok::<(), nonsmooth::Error>(())
+    /// ```
+    ///
+    /// # Errors
+    /// As [`new`](Self::new).
+    pub fn with_tolerances(
+        system: S,
+        make_stepper: impl FnOnce(Tolerances<T, M>) -> St,
+        tol: &Tolerances<T, N>,
+        d0: T,
+        norm: Norm<T, N>,
+    ) -> Result<Self> {
+        let pair_tol = pair_tolerances::<T, N, M>(tol)?;
+        Self::new(system, make_stepper(pair_tol), d0, norm)
+    }
+
     /// Sets the direction of the initial perturbation (any non-zero finite vector; it is
     /// scaled to length `d0` in the norm).
     ///

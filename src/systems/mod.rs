@@ -5,6 +5,7 @@
 //! |---|---|---|
 //! | the paper's cart | `m·ẍ + kx + cẋ + T·ẋ/√(ẋ²+ε²) + F_I(x, ẋ) = m₀eω² sin ωt` | [`paper`] |
 //! | ball on a vibrating table | `ÿ = −g` above `s = A sin ωt`, Newton restitution `e` (rigid) | [`bouncing_ball`] |
+//! | Duffing–Ueda oscillator | `ẍ + kẋ + x³ = B cos ωt` | [`duffing_ueda`] |
 //! | 2-DOF impact oscillator | primary mass, coupled secondary mass hitting a Hertz stop | [`two_dof`] |
 //!
 //! Every entry is an ordinary [`Oscillator`](crate::model::Oscillator) or
@@ -12,8 +13,10 @@
 //! them.
 
 pub mod bouncing_ball;
+pub mod duffing_ueda;
 pub mod paper;
 pub mod two_dof;
 
 pub use bouncing_ball::BouncingBallTable;
+pub use duffing_ueda::DuffingUeda;
 pub use two_dof::TwoDofImpact;

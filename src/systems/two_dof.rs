@@ -135,10 +135,7 @@ impl TwoDofImpact {
                 )?,
                 Element::on_dof(1, contact)?,
             ))
-            .with_loads(Load::on_dof(
-                0,
-                Harmonic::new(lit(self.force), omega, T::frac_pi_2())?,
-            )?))
+            .with_loads(Load::on_dof(0, Harmonic::cosine(lit(self.force), omega)?)?))
     }
 
     /// The stop as a contact surface for events and samplers: the penetration `q_2 − d`

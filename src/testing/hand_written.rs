@@ -34,3 +34,30 @@ impl Dynamics<f64, 4> for TwoDofImpactByHand {
         dy[3] = (-coupling - contact) / p.m2;
     }
 }
+
+/// The Duffing–Ueda oscillator `ẍ + kẋ + x³ = B cos ωt` written out by hand, with its
+/// Jacobian (an independent reference for [`DuffingUeda`](crate::systems::DuffingUeda)'s
+/// assembled model).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DuffingUedaByHand {
+    /// The parameters.
+    pub params: crate::systems::DuffingUeda,
+}
+
+impl Dynamics<f64, 2> for DuffingUedaByHand {
+    fn rhs(&self, t: f64, y: &SVector<f64, 2>, dy: &mut SVector<f64, 2>) {
+        let p = &self.params;
+        let (x, v) = (y[0], y[1]);
+        dy[0] = v;
+        dy[1] = p.b * (p.omega * t).cos() - p.k * v - x * x * x;
+    }
+
+    fn jacobian(&self, _t: f64, y: &SVector<f64, 2>) -> Option<nalgebra::SMatrix<f64, 2, 2>> {
+        Some(nalgebra::SMatrix::<f64, 2, 2>::new(
+            0.0,
+            1.0,
+            -3.0 * y[0] * y[0],
+            -self.params.k,
+        ))
+    }
+}

@@ -121,6 +121,7 @@
 //! | [`NearGrazing`] | 2 | a crossing pair of width `≈ 2√(2δ/L)/ω` |
 //! | [`BallOnTableExact`] | — | the exact impact map of a ball on a vibrating table |
 //! | [`TwoDofImpactByHand`] | 4 | none; the catalogue's 2-DOF impact oscillator written out by hand |
+//! | [`DuffingUedaByHand`] | 2 | none; the catalogue's Duffing–Ueda oscillator written out by hand |
 //!
 //! Order tests of integrators should use a non-autonomous problem: a tableau with a wrong
 //! node `c_i` is exact on autonomous ones. [`convergence_order`] fits the observed order.
@@ -134,7 +135,7 @@ mod problems;
 
 pub use ball_table::{BallOnTableExact, TableImpact};
 pub use convergence::{ConvergenceFit, convergence_fit, convergence_order};
-pub use hand_written::TwoDofImpactByHand;
+pub use hand_written::{DuffingUedaByHand, TwoDofImpactByHand};
 pub use impacts::{BallDrop, BouncingBall, Crossing, HarmonicZeroCrossings, NearGrazing};
 pub use law_check::{
     Axis, CheckConfig, CheckReport, ContactClaim, LawSpec, LawViolation, Property, Sides, Variable,
