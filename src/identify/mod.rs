@@ -38,11 +38,13 @@
 //! ```
 
 mod fit;
+mod model_fit;
 mod objective;
 mod paper;
 mod space;
 
 pub use fit::{FitReport, NelderMeadOptions, Termination, fit_nelder_mead};
+pub use model_fit::ModelFit;
 pub use objective::{M2_TO_MM2, objective_f0, objective_f0_mm2};
 pub use paper::{
     Forcing, PAPER_FIT_PARAMETERS, PaperFit, PaperFitReport, paper_parameter, set_paper_parameter,

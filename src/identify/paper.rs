@@ -5,14 +5,14 @@ use std::time::{Duration, Instant};
 
 use nalgebra::Vector2;
 
+use super::model_fit::{simulate_at_nodes, window_nodes};
 use super::{
     FitReport, IdentifyError, M2_TO_MM2, NelderMeadOptions, ParamValues, Parameter, ParameterSpace,
     fit_nelder_mead, objective_f0,
 };
 use crate::integrate::Tolerances;
 use crate::model::paper::PaperParameters;
-use crate::sample::{SectionClock, Stroboscopic};
-use crate::signal::{TimeSeries, run_paper};
+use crate::signal::TimeSeries;
 
 pub use crate::signal::Forcing;
 
@@ -165,19 +165,6 @@ impl PaperFitReport {
     }
 }
 
-/// The measured times at which the simulation is sampled, as a section clock.
-#[derive(Debug, Clone, Copy)]
-struct Nodes<'a>(&'a [f64]);
-
-impl SectionClock<f64> for Nodes<'_> {
-    fn section_time(&self, i: u64) -> Option<f64> {
-        usize::try_from(i).ok().and_then(|i| self.0.get(i).copied())
-    }
-    fn first_index_from(&self, t: f64) -> u64 {
-        self.0.partition_point(|&s| s < t) as u64
-    }
-}
-
 impl PaperFit {
     /// Steps allowed per simulated second by default (see [`with_max_steps`](Self::with_max_steps)).
     pub const DEFAULT_STEPS_PER_SECOND: usize = 250_000;
@@ -197,35 +184,7 @@ impl PaperFit {
         forcing: Forcing,
         base: PaperParameters,
     ) -> Result<Self, IdentifyError> {
-        let (t1, t2) = window;
-        if !(t1.is_finite() && t2.is_finite() && 0.0 <= t1 && t1 < t2) {
-            return Err(IdentifyError::InvalidWindow { t1, t2 });
-        }
-        let (start, end) = measured.span().unwrap_or((f64::NAN, f64::NAN));
-        if !(start <= t1 && t2 <= end) {
-            return Err(IdentifyError::WindowOutsideData {
-                which: "measured",
-                t1,
-                t2,
-                start,
-                end,
-            });
-        }
-        let t = measured.t();
-        let lo = t.partition_point(|&s| s < t1);
-        let hi = t.partition_point(|&s| s <= t2);
-        if hi - lo < 2 {
-            return Err(IdentifyError::EmptyWindow {
-                t1,
-                t2,
-                samples: hi - lo,
-            });
-        }
-        // t1, the samples strictly inside, t2: the nodes of the trapezoidal rule.
-        let mut nodes = Vec::with_capacity(hi - lo + 2);
-        nodes.push(t1);
-        nodes.extend(t[lo..hi].iter().copied().filter(|&s| t1 < s && s < t2));
-        nodes.push(t2);
+        let nodes = window_nodes(&measured, window)?;
         Ok(Self {
             measured,
             window,
@@ -380,32 +339,28 @@ impl PaperFit {
     /// equilibrium, or a failed simulation (e.g.
     /// [`IntegrateError::MaxSteps`](crate::integrate::IntegrateError::MaxSteps)).
     pub fn simulate(&self, params: &PaperParameters) -> crate::Result<Vec<f64>> {
-        let nodes = &self.nodes[..];
-        let mut sampler = Stroboscopic::<f64, 2, _>::new(Nodes(nodes), 0.0, nodes.len())?;
-        let t_end = nodes[nodes.len() - 1];
-        run_paper(
-            params,
-            self.forcing,
+        let x0 = params.static_equilibrium()?;
+        let y0 = Vector2::new(x0, 0.0);
+        let (nodes, tol, cap, w) = (
+            &self.nodes[..],
             self.tolerances,
             self.max_steps(),
-            (),
-            t_end,
-            &mut sampler,
-        )?;
-        let points = sampler.points();
-        if points.len() != nodes.len() {
-            // Every node in [0, t_end] is sampled when the run succeeds; report a shortfall
-            // as the simulation not covering the window rather than trusting it.
-            return Err(IdentifyError::WindowOutsideData {
-                which: "simulated",
-                t1: self.window.0,
-                t2: self.window.1,
-                start: points.first().map_or(f64::NAN, |p| p.t),
-                end: points.last().map_or(f64::NAN, |p| p.t),
+            self.window,
+        );
+        match self.forcing {
+            Forcing::Constant { omega } => {
+                simulate_at_nodes(params.oscillator::<f64>(omega)?, tol, cap, y0, nodes, 0, w)
             }
-            .into());
+            Forcing::Ramp { omega0, rate } => simulate_at_nodes(
+                params.ramped::<f64>(omega0, rate)?,
+                tol,
+                cap,
+                y0,
+                nodes,
+                0,
+                w,
+            ),
         }
-        Ok(points.iter().map(|p| p.y[0]).collect())
     }
 
     /// `F0` (m²) of the parameter set `params` against the record on the window.
@@ -460,7 +415,9 @@ impl PaperFit {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::identify::model_fit::Nodes;
     use crate::model::paper::PAPER;
+    use crate::sample::SectionClock;
 
     #[test]
     fn names_map_to_fields() {

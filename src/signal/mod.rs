@@ -58,8 +58,9 @@ pub use phase::{
     unwrap_phase_inplace,
 };
 pub use series::{Column, CsvOptions, PhaseColumn, TimeSeries};
-pub(crate) use synthetic::run_paper;
-pub use synthetic::{Forcing, NormalNoise, SyntheticExperiment, SyntheticRecord};
+pub use synthetic::{
+    Forcing, ModelExperiment, ModelRecord, NormalNoise, SyntheticExperiment, SyntheticRecord,
+};
 
 use crate::error::ParameterError;
 use crate::scalar::to_f64;
