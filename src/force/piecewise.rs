@@ -22,7 +22,7 @@ use crate::{ForceLaw, Real};
 /// # Examples
 /// ```
 /// use nonsmooth::{ForceLaw, force::Bilinear};
-/// let gear = Bilinear::backlash(2.0, 0.1).unwrap();
+/// let gear = Bilinear::backlash(2.0_f64, 0.1).unwrap();
 /// assert_eq!(gear.force(0.05, 0.0), 0.0);
 /// assert!((gear.force(0.3, 0.0) - 0.4).abs() < 1e-15);
 /// assert!((gear.force(-0.3, 0.0) + 0.4).abs() < 1e-15);
