@@ -142,6 +142,16 @@ pub trait Observer<T: Real, const N: usize> {
         Ok(())
     }
 
+    /// Checks that the run over `[t0, t_end]` is within the observer's bounds (e.g. a
+    /// section clock whose sections over the span are countable); an error stops the run
+    /// before its first step. Default: `Ok`.
+    ///
+    /// # Errors
+    /// Whatever the observer finds wrong for this span.
+    fn check_span(&self, _t0: T, _t_end: T) -> Result<()> {
+        Ok(())
+    }
+
     /// Called once before the first step.
     fn on_start(&mut self, _t0: T, _y0: &SVector<T, N>) {}
 
@@ -165,6 +175,9 @@ impl<T: Real, const N: usize, O: Observer<T, N> + ?Sized> Observer<T, N> for &mu
     fn check(&self) -> Result<()> {
         (**self).check()
     }
+    fn check_span(&self, t0: T, t_end: T) -> Result<()> {
+        (**self).check_span(t0, t_end)
+    }
     fn on_start(&mut self, t0: T, y0: &SVector<T, N>) {
         (**self).on_start(t0, y0)
     }
@@ -185,6 +198,10 @@ macro_rules! observer_tuple {
         impl<T: Real, const N: usize, $($name: Observer<T, N>),+> Observer<T, N> for ($($name,)+) {
             fn check(&self) -> Result<()> {
                 $(self.$idx.check()?;)+
+                Ok(())
+            }
+            fn check_span(&self, t0: T, t_end: T) -> Result<()> {
+                $(self.$idx.check_span(t0, t_end)?;)+
                 Ok(())
             }
             fn on_start(&mut self, t0: T, y0: &SVector<T, N>) {
@@ -212,6 +229,9 @@ macro_rules! observer_tuple {
 impl<T: Real, const N: usize, O: Observer<T, N>> Observer<T, N> for Option<O> {
     fn check(&self) -> Result<()> {
         self.as_ref().map_or(Ok(()), |o| o.check())
+    }
+    fn check_span(&self, t0: T, t_end: T) -> Result<()> {
+        self.as_ref().map_or(Ok(()), |o| o.check_span(t0, t_end))
     }
     fn on_start(&mut self, t0: T, y0: &SVector<T, N>) {
         if let Some(o) = self {
@@ -386,8 +406,11 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
             .into());
         }
         check_state(&y0)?;
+        self.stepper.check()?;
         self.events.check()?;
         observer.check()?;
+        observer.check_span(t0, t_end)?;
+        self.check_work(t0, t_end)?;
         self.stepper.reset_state(t0, y0);
         self.history.clear();
         observer.on_start(t0, &y0);
@@ -413,10 +436,37 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
             }
             .into());
         }
+        self.stepper.check()?;
         self.events.check()?;
         observer.check()?;
+        observer.check_span(t0, t_end)?;
+        self.check_work(t0, t_end)?;
         observer.on_start(t0, &y0);
         self.advance(t_end, observer)
+    }
+
+    /// Fails at once when the run provably needs more steps than the cap: its span over the
+    /// largest step it may take (the stepper's `h_max` or fixed step, the landing grid's
+    /// spacing).
+    fn check_work(&self, t0: T, t_end: T) -> Result<()> {
+        let mut h = self.stepper.max_step();
+        if let Some((_, dt)) = self.grid {
+            h = Some(h.map_or(dt, |h| h.min(dt)));
+        }
+        let Some(h) = h else { return Ok(()) };
+        let span = to_f64(t_end - t0);
+        let needed = span / to_f64(h);
+        // A margin of one step for the rounding of the last one.
+        if !(needed <= self.max_steps as f64 + 1.0) {
+            return Err(IntegrateError::WorkExceedsCap {
+                needed,
+                span,
+                h: to_f64(h),
+                max_steps: self.max_steps,
+            }
+            .into());
+        }
+        Ok(())
     }
 
     fn advance<O: Observer<T, N>>(&mut self, t_end: T, observer: &mut O) -> Result<Outcome<T, N>> {

@@ -4,8 +4,8 @@ use nalgebra::SVector;
 
 use super::{
     Controller, Core, DenseOutput, HermiteDense, IntegrateError, Stats, StepOptions, Stepper,
-    Tolerances, adaptive_constructors, all_finite, clamp_to_limit, core_accessors, dense_endpoints,
-    min_step,
+    Tolerances, adaptive_checks, adaptive_constructors, all_finite, clamp_to_limit, core_accessors,
+    dense_endpoints, step_too_small,
 };
 use crate::scalar::{lit, to_f64};
 use crate::{Dynamics, Real};
@@ -71,6 +71,7 @@ impl<T: Real, const N: usize> Stepper<T, N> for Dopri5<T, N> {
     type Dense = Dopri5Dense<T, N>;
 
     core_accessors!();
+    adaptive_checks!();
 
     fn step<S: Dynamics<T, N>>(&mut self, sys: &S, t_limit: T) -> Result<(), IntegrateError> {
         self.core.begin(sys, t_limit)?;
@@ -119,7 +120,7 @@ impl<T: Real, const N: usize> Stepper<T, N> for Dopri5<T, N> {
         let mut nonfinite = 0u32;
         loop {
             let (hs, lands) = clamp_to_limit(t, h, t_limit);
-            if hs < min_step(t, self.ctrl.opts.h_min) && !lands {
+            if step_too_small(t, hs, self.ctrl.opts.h_min) && !lands {
                 return Err(IntegrateError::StepSizeTooSmall {
                     t: to_f64(t),
                     h: to_f64(hs),

@@ -97,6 +97,24 @@ pub enum IntegrateError {
         /// Step end.
         t1: f64,
     },
+    /// A tolerance or step option set through a public field is invalid.
+    #[error("invalid integrator settings: {0}")]
+    InvalidSettings(ParameterError),
+    /// The run provably needs more steps than the cap allows (its span over the largest
+    /// step it may take), detected before the first step.
+    #[error(
+        "the run needs at least {needed:e} steps (span {span} over the largest step {h}), more than the cap of {max_steps}"
+    )]
+    WorkExceedsCap {
+        /// The lower bound on the steps needed.
+        needed: f64,
+        /// `t_end − t0`.
+        span: f64,
+        /// The largest step the run may take (`h_max`, a fixed step or a landing grid).
+        h: f64,
+        /// The cap.
+        max_steps: usize,
+    },
     /// The stepper was used before [`Stepper::reset_state`] gave it a state.
     #[error("the stepper has no state: call reset_state first")]
     NotInitialized,
@@ -147,6 +165,19 @@ impl<T: Real, const N: usize> Tolerances<T, N> {
             rtol: SVector::repeat(rtol),
             atol: SVector::from(atol),
         })
+    }
+
+    /// Checks every component (finite and > 0): the fields are public, so a value set
+    /// through them is checked here, by [`Stepper::check`] before each run.
+    ///
+    /// # Errors
+    /// [`ParameterError`] naming `rtol` or `atol`.
+    pub fn validate(&self) -> Result<(), ParameterError> {
+        for i in 0..N {
+            positive("rtol", self.rtol[i])?;
+            positive("atol", self.atol[i])?;
+        }
+        Ok(())
     }
 
     /// The weighted RMS norm of `err` relative to `y0`, `y1` (see the module docs).
@@ -210,6 +241,37 @@ impl<T: Real> Default for StepOptions<T> {
 }
 
 impl<T: Real> StepOptions<T> {
+    /// Checks the options (the fields are public): `h_max > 0` (may be the largest finite
+    /// value), `0 ≤ h_min ≤ h_max`, `h_init` finite and > 0 if set, `0 < safety ≤ 1`,
+    /// `0 < fac_min < 1 < fac_max`, `β ≥ 0`, all finite.
+    ///
+    /// # Errors
+    /// [`ParameterError`] naming the first invalid option.
+    pub fn validate(&self) -> Result<(), ParameterError> {
+        positive("h_max", self.h_max)?;
+        crate::validate::non_negative("h_min", self.h_min)?;
+        if self.h_min > self.h_max {
+            return Err(ParameterError::new("h_min", to_f64(self.h_min), "<= h_max"));
+        }
+        if let Some(h) = self.h_init {
+            positive("h_init", h)?;
+        }
+        positive("safety", self.safety)?;
+        if self.safety > T::one() {
+            return Err(ParameterError::new("safety", to_f64(self.safety), "<= 1"));
+        }
+        positive("fac_min", self.fac_min)?;
+        if !(self.fac_min < T::one()) {
+            return Err(ParameterError::new("fac_min", to_f64(self.fac_min), "< 1"));
+        }
+        positive("fac_max", self.fac_max)?;
+        if !(self.fac_max > T::one()) {
+            return Err(ParameterError::new("fac_max", to_f64(self.fac_max), "> 1"));
+        }
+        crate::validate::non_negative("beta", self.beta)?;
+        Ok(())
+    }
+
     /// Sets the largest step.
     ///
     /// # Errors
@@ -357,6 +419,46 @@ pub trait Stepper<T: Real, const N: usize> {
 
     /// The order of the propagated solution.
     fn order(&self) -> u8;
+
+    /// Checks the settings that public fields could have set past the constructors' checks
+    /// (tolerances, step options); the driver calls it before a run.
+    ///
+    /// # Errors
+    /// [`IntegrateError::InvalidSettings`] naming the offending setting.
+    fn check(&self) -> Result<(), IntegrateError> {
+        Ok(())
+    }
+
+    /// The largest step this stepper takes (`h_max`, or the fixed step), if bounded: the
+    /// driver fails a run at once when `(t_end − t0)/max_step` exceeds its step cap.
+    fn max_step(&self) -> Option<T> {
+        None
+    }
+}
+
+/// `check` and `max_step` of the adaptive steppers `{ tol, ctrl, .. }`.
+macro_rules! adaptive_checks {
+    () => {
+        fn check(&self) -> Result<(), IntegrateError> {
+            self.tol
+                .validate()
+                .and_then(|()| self.ctrl.opts.validate())
+                .map_err(IntegrateError::InvalidSettings)
+        }
+
+        fn max_step(&self) -> Option<T> {
+            let h = self.ctrl.opts.h_max;
+            (h.is_finite() && h > T::zero()).then_some(h)
+        }
+    };
+}
+pub(crate) use adaptive_checks;
+
+/// `true` if a trial step `hs` from `t` is below the minimum or does not advance `t` at all
+/// in floating point (`t + hs == t`, or `hs` NaN): the step fails instead of looping.
+#[inline(always)]
+pub(crate) fn step_too_small<T: Real>(t: T, hs: T, h_min: T) -> bool {
+    hs < min_step(t, h_min) || !(t + hs > t)
 }
 
 /// The state every one-step method keeps: `(t, y)`, the cached derivative `f(t, y)` (the

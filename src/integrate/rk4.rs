@@ -125,6 +125,13 @@ impl<T: Real, const N: usize> Stepper<T, N> for Rk4<T, N> {
         } else {
             (self.h, t + self.h)
         };
+        if !(t_new > t) {
+            // A step below the time resolution at t: no progress is possible.
+            return Err(IntegrateError::StepSizeTooSmall {
+                t: to_f64(t),
+                h: to_f64(self.h),
+            });
+        }
         let half = lit::<T>(0.5);
         let k1 = self.core.f;
         let mut k2 = SVector::zeros();
@@ -147,5 +154,9 @@ impl<T: Real, const N: usize> Stepper<T, N> for Rk4<T, N> {
 
     fn order(&self) -> u8 {
         4
+    }
+
+    fn max_step(&self) -> Option<T> {
+        Some(self.h)
     }
 }

@@ -4,8 +4,8 @@ use nalgebra::{SMatrix, SVector};
 
 use super::{
     Controller, Core, DenseOutput, HermiteDense, IntegrateError, Stats, StepOptions, Stepper,
-    Tolerances, adaptive_constructors, all_finite, clamp_to_limit, core_accessors, dense_endpoints,
-    min_step,
+    Tolerances, adaptive_checks, adaptive_constructors, all_finite, clamp_to_limit, core_accessors,
+    dense_endpoints, step_too_small,
 };
 use crate::linalg::Lu;
 use crate::scalar::{epsilon, lit, to_f64};
@@ -130,6 +130,7 @@ impl<T: Real, const N: usize> Stepper<T, N> for Rosenbrock23<T, N> {
     type Dense = Rosenbrock23Dense<T, N>;
 
     core_accessors!();
+    adaptive_checks!();
 
     fn step<S: Dynamics<T, N>>(&mut self, sys: &S, t_limit: T) -> Result<(), IntegrateError> {
         self.core.begin(sys, t_limit)?;
@@ -149,7 +150,7 @@ impl<T: Real, const N: usize> Stepper<T, N> for Rosenbrock23<T, N> {
         let mut nonfinite = 0u32;
         loop {
             let (hs, lands) = clamp_to_limit(t, h, t_limit);
-            if hs < min_step(t, self.ctrl.opts.h_min) && !lands {
+            if step_too_small(t, hs, self.ctrl.opts.h_min) && !lands {
                 return Err(IntegrateError::StepSizeTooSmall {
                     t: to_f64(t),
                     h: to_f64(hs),

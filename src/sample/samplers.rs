@@ -16,18 +16,43 @@ pub trait SectionClock<T: Real> {
     /// The `i`-th section time, if defined.
     fn section_time(&self, i: u64) -> Option<T>;
 
-    /// The first index whose time is `≥ t` (up to rounding).
+    /// The first index whose time is `≥ t` (up to rounding). The default assumes section
+    /// times increase with `i` and searches by doubling and bisection (at most ~128 calls
+    /// of [`section_time`](Self::section_time), whatever `t`); an index without a time
+    /// counts as past every `t`.
     fn first_index_from(&self, t: T) -> u64 {
-        let mut i = 0;
-        while let Some(ti) = self.section_time(i) {
-            if ti >= t - lit::<T>(4.0) * T::default_epsilon() * t.abs() || i > 1 << 40 {
-                break;
-            }
-            i += 1;
+        let at_or_after = |i: u64| {
+            self.section_time(i)
+                .is_none_or(|ti| ti >= t - lit::<T>(4.0) * T::default_epsilon() * t.abs())
+        };
+        if at_or_after(0) {
+            return 0;
         }
-        i
+        // section_time(lo) < t ≤ section_time(hi)
+        let (mut lo, mut hi) = (0u64, 1u64);
+        while !at_or_after(hi) {
+            lo = hi;
+            if hi >= 1 << 62 {
+                return u64::MAX;
+            }
+            hi *= 2;
+        }
+        while hi - lo > 1 {
+            let mid = lo + (hi - lo) / 2;
+            if at_or_after(mid) {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        hi
     }
 }
+
+/// The most sections one [`Stroboscopic`] sampler visits in one run (10⁹): a clock whose
+/// spacing is so small for the run's span that it would exceed it (or would not advance
+/// time at all) is an error before the first step, not a loop without end.
+pub const MAX_SECTIONS_PER_RUN: u64 = 1_000_000_000;
 
 /// Sections at `t_i = origin + i·period` (computed from `i`, never accumulated).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -72,6 +97,32 @@ impl<T: Real, E: Excitation<T>> SectionClock<T> for PhaseClock<E> {
     fn section_time(&self, i: u64) -> Option<T> {
         self.0.time_of_phase(T::two_pi() * lit::<T>(i as f64))
     }
+}
+
+/// The sections of `clock` in `[t0, t_end]` are at most [`MAX_SECTIONS_PER_RUN`] and each
+/// advances time.
+fn check_sections<T: Real, C: SectionClock<T>>(clock: &C, t0: T, t_end: T) -> crate::Result<()> {
+    let (a, b) = (clock.first_index_from(t0), clock.first_index_from(t_end));
+    let count = b.saturating_sub(a);
+    let too_many = || {
+        crate::Error::from(ParameterError::new(
+            "section clock",
+            count as f64,
+            "at most 10^9 sections per run, each advancing time (spacing too small for the span?)",
+        ))
+    };
+    if count > MAX_SECTIONS_PER_RUN {
+        return Err(too_many());
+    }
+    // Spacing below the time resolution at either end: consecutive sections coincide.
+    for i in [a, b.saturating_sub(1)] {
+        if let (Some(x), Some(y)) = (clock.section_time(i), clock.section_time(i + 1)) {
+            if !(y > x) && count > 0 {
+                return Err(too_many());
+            }
+        }
+    }
+    Ok(())
 }
 
 /// A recorded section point.
@@ -191,6 +242,10 @@ impl<T: Real, const N: usize, C: SectionClock<T>> Stroboscopic<T, N, C> {
 }
 
 impl<T: Real, const N: usize, C: SectionClock<T>> Observer<T, N> for Stroboscopic<T, N, C> {
+    fn check_span(&self, t0: T, t_end: T) -> crate::Result<()> {
+        check_sections(&self.clock, t0, t_end)
+    }
+
     fn on_start(&mut self, t0: T, y0: &SVector<T, N>) {
         let i = self.clock.first_index_from(t0);
         self.advance(i);
@@ -590,6 +645,10 @@ impl<T: Real, const N: usize, C: SectionClock<T>, G: Surface<T, N>> Observer<T, 
         crate::event::check_index(self.position, N)?;
         crate::event::check_index(self.velocity, N)?;
         Ok(self.surface.check()?)
+    }
+
+    fn check_span(&self, t0: T, t_end: T) -> crate::Result<()> {
+        check_sections(&self.clock, t0, t_end)
     }
 
     fn on_start(&mut self, t0: T, y0: &SVector<T, N>) {

@@ -84,9 +84,10 @@ impl<T: Real> PhaseSection<T> {
     /// Sets the section's phase offset `φ_0` (radians).
     ///
     /// # Errors
-    /// [`SignalError::Parameter`] if `offset` is not finite.
+    /// [`SignalError::Parameter`] if `offset` is not finite or `|offset| > 2π·2⁴⁰` (beyond
+    /// that, levels `2π` apart are not resolved in floating point).
     pub fn with_offset(mut self, offset: T) -> Result<Self, SignalError> {
-        self.offset = finite("offset", offset)?;
+        self.offset = resolvable("offset", finite("offset", offset)?)?;
         Ok(self)
     }
 
@@ -112,7 +113,8 @@ impl<T: Real> PhaseSection<T> {
     ///
     /// # Errors
     /// [`SignalError::LengthMismatch`], [`SignalError::NonIncreasingTime`] or
-    /// [`SignalError::NonFinite`] (with the sample index) for invalid data; `out` is then
+    /// [`SignalError::NonFinite`] (with the sample index) for invalid data;
+    /// [`SignalError::Parameter`] for an (unwrapped) phase beyond `2π·2⁴⁰`; `out` is then
     /// left empty.
     pub fn sample_into(
         &self,
@@ -134,6 +136,7 @@ impl<T: Real> PhaseSection<T> {
         let Some(&phi0) = phase.first() else {
             return Ok(());
         };
+        resolvable("phase", phi0)?;
         let two_pi = T::two_pi();
         let level = |i: i64| two_pi * lit::<T>(i as f64) + self.offset;
         // The first level strictly above the initial phase.
@@ -151,7 +154,13 @@ impl<T: Real> PhaseSection<T> {
         let mut unwrap = Unwrapper::new(phi0, self.input);
         let mut p0 = phi0;
         for n in 0..t.len() - 1 {
-            let p1 = unwrap.next(phase[n + 1]);
+            let p1 = match resolvable("phase", unwrap.next(phase[n + 1])) {
+                Ok(p) => p,
+                Err(e) => {
+                    out.clear();
+                    return Err(e);
+                }
+            };
             while p1 >= next {
                 // p0 < next ≤ p1 by the invariant `next > max φ so far`.
                 let s = (next - p0) / (p1 - p0);
@@ -181,6 +190,24 @@ impl<T: Real> PhaseSection<T> {
         let mut out = Vec::new();
         self.sample_into(t, phase, x, &mut out)?;
         Ok(out)
+    }
+}
+
+/// The largest phase magnitude (and offset) a section takes, `2π·2⁴⁰`: the section levels
+/// `2πi + φ₀` stay resolved (`ulp(φ) ≤ 2⁻¹⁰`) and their indices fit an `i64` exactly.
+const MAX_PHASE: f64 = std::f64::consts::TAU * 1_099_511_627_776.0;
+
+/// `value` if `|value| ≤ MAX_PHASE`.
+fn resolvable<T: Real>(name: &'static str, value: T) -> Result<T, SignalError> {
+    if value.abs() <= lit::<T>(MAX_PHASE) {
+        Ok(value)
+    } else {
+        Err(crate::ParameterError::new(
+            name,
+            to_f64(value),
+            "|phase| <= 2π·2^40 (levels 2π apart must be resolvable)",
+        )
+        .into())
     }
 }
 

@@ -1,0 +1,168 @@
+//! Regressions of the reliability probe: no loop without progress in the integrators, the
+//! driver and the samplers; invalid settings set through public fields are errors before
+//! the first step.
+
+use nalgebra::Vector2;
+use nonsmooth::Error;
+use nonsmooth::drive::Simulation;
+use nonsmooth::excite::RampedRotor;
+use nonsmooth::integrate::{
+    Dop853, Dopri5, IntegrateError, Rk4, Rosenbrock23, StepOptions, Stepper, Tolerances,
+};
+use nonsmooth::sample::{PhaseClock, Stroboscopic};
+use nonsmooth::signal::PhaseSection;
+use nonsmooth::testing::HarmonicOscillator;
+
+fn osc() -> HarmonicOscillator<f64> {
+    HarmonicOscillator::new(1.0).unwrap()
+}
+
+fn tol() -> Tolerances<f64, 2> {
+    Tolerances::new(1e-8, 1e-10).unwrap()
+}
+
+fn y0() -> Vector2<f64> {
+    Vector2::new(1.0, 0.0)
+}
+
+#[test]
+fn nan_tolerances_through_public_fields_fail_before_the_first_step() {
+    // Before: rtol NaN gave a minimum step of 0 at t0 = 0 and uncapped rejections.
+    let mut bad = tol();
+    bad.rtol[1] = f64::NAN;
+    let r = Simulation::new(osc(), Dopri5::new(bad)).run(0.0, y0(), 1.0, &mut ());
+    assert!(
+        matches!(r, Err(Error::Integrate(IntegrateError::InvalidSettings(_)))),
+        "{r:?}"
+    );
+    let mut neg = tol();
+    neg.atol[0] = -1.0;
+    let r = Simulation::new(osc(), Dop853::new(neg)).run(0.0, y0(), 1.0, &mut ());
+    assert!(matches!(
+        r,
+        Err(Error::Integrate(IntegrateError::InvalidSettings(_)))
+    ));
+    // Step options through public fields.
+    let mut opts = StepOptions::default();
+    opts.fac_min = f64::NAN;
+    let r = Simulation::new(osc(), Rosenbrock23::with_options(tol(), opts)).run(
+        0.0,
+        y0(),
+        1.0,
+        &mut (),
+    );
+    assert!(matches!(
+        r,
+        Err(Error::Integrate(IntegrateError::InvalidSettings(_)))
+    ));
+    // Driven directly (no driver): the stepper still terminates, with an error.
+    let mut st = Dopri5::new(bad);
+    st.reset_state(0.0, y0());
+    assert!(st.step(&osc(), 1.0).is_err());
+}
+
+#[test]
+fn a_step_below_the_time_resolution_is_an_error_not_a_loop() {
+    // Before: Rk4 with h = 1e-12 at t0 = 1e6 made no progress (t + h == t) until the cap.
+    let mut st = Rk4::<f64, 2>::new(1e-12).unwrap();
+    st.reset_state(1e6, y0());
+    let r = st.step(&osc(), 1e6 + 1.0);
+    assert!(
+        matches!(r, Err(IntegrateError::StepSizeTooSmall { .. })),
+        "{r:?}"
+    );
+    // Through the driver the work bound catches it first.
+    let r = Simulation::new(osc(), Rk4::new(1e-12).unwrap()).run(1e6, y0(), 1e6 + 1.0, &mut ());
+    assert!(
+        matches!(
+            r,
+            Err(Error::Integrate(IntegrateError::WorkExceedsCap { .. }))
+        ),
+        "{r:?}"
+    );
+}
+
+#[test]
+fn work_that_provably_exceeds_the_cap_fails_at_once() {
+    // h_max = 1e-300; h_max = 1e-7 over 1e3 s; a landing grid of 1e-9 over 1 s. Before,
+    // each ran to the 10^8-step cap (18–46 s).
+    for (h_max, t_end) in [(1e-300, 1.0), (1e-7, 1e3)] {
+        let opts = StepOptions::default().with_h_max(h_max).unwrap();
+        let r = Simulation::new(osc(), Dopri5::with_options(tol(), opts)).run(
+            0.0,
+            y0(),
+            t_end,
+            &mut (),
+        );
+        match r {
+            Err(Error::Integrate(IntegrateError::WorkExceedsCap {
+                needed, max_steps, ..
+            })) => {
+                assert!(needed >= t_end / h_max * 0.999 && max_steps == 100_000_000);
+            }
+            other => panic!("h_max {h_max}: {other:?}"),
+        }
+    }
+    let r = Simulation::new(osc(), Dopri5::new(tol()))
+        .landing_grid(Some((0.0, 1e-9)))
+        .unwrap()
+        .run(0.0, y0(), 1.0, &mut ());
+    assert!(
+        matches!(
+            r,
+            Err(Error::Integrate(IntegrateError::WorkExceedsCap { .. }))
+        ),
+        "{r:?}"
+    );
+    // An ordinary h_max still runs.
+    let opts = StepOptions::default().with_h_max(0.01).unwrap();
+    let out = Simulation::new(osc(), Dopri5::with_options(tol(), opts))
+        .run(0.0, y0(), 10.0, &mut ())
+        .unwrap();
+    assert!(out.stats.accepted >= 1000);
+}
+
+#[test]
+fn section_clocks_too_fine_for_the_span_are_errors_and_late_starts_are_fast() {
+    // Period 1e-300: 10^300 sections per run. Before, the sampler looped inside one step.
+    let mut s = Stroboscopic::<f64, 2>::periodic(0.0, 1e-300, 0.0, 10).unwrap();
+    let r = Simulation::new(osc(), Dopri5::new(tol())).run(0.0, y0(), 1.0, &mut s);
+    assert!(matches!(r, Err(Error::Parameter(_))), "{r:?}");
+    // A period below the time resolution at t0 = 1e6 (sections coincide).
+    let mut s = Stroboscopic::<f64, 2>::periodic(0.0, 1e-11, 0.0, 10).unwrap();
+    let r = Simulation::new(osc(), Dopri5::new(tol())).run(1e6, y0(), 1e6 + 1e-9, &mut s);
+    assert!(matches!(r, Err(Error::Parameter(_))), "{r:?}");
+    // A phase clock started at t0 = 1e11: before, the first section index was counted up
+    // from 0 (≈ 10^11 calls). Now a bisection; sections are then taken as usual.
+    let rotor = RampedRotor::new(0.01, 20.0, 1e-9).unwrap();
+    let mut s = Stroboscopic::<f64, 2, _>::new(PhaseClock(rotor), 0.0, 100).unwrap();
+    let t0 = 1e11;
+    let out = Simulation::new(osc(), Dopri5::new(tol()))
+        .run(t0, y0(), t0 + 10.0, &mut s)
+        .unwrap();
+    assert_eq!(out.t, t0 + 10.0);
+    let pts = s.points();
+    // ω(t0) = 20 + 100 = 120 rad/s: ≈ 191 sections in 10 s, capacity 100.
+    assert_eq!(pts.len(), 100);
+    assert!(pts[0].t >= t0 && pts[0].t < t0 + 0.06, "{}", pts[0].t);
+    assert!(pts.windows(2).all(|w| w[1].index == w[0].index + 1));
+}
+
+#[test]
+fn phase_sections_reject_unresolvable_phases_instead_of_overflowing() {
+    // Before: offset −1.7e308 (the probe used −1.8e308, which is −inf as a literal) overflowed the i64 level index; a phase of 1e20 cannot
+    // resolve levels 2π apart.
+    assert!(PhaseSection::<f64>::new().with_offset(-1.7e308).is_err());
+    assert!(PhaseSection::<f64>::new().with_offset(1e13).is_err());
+    let sec = PhaseSection::<f64>::new()
+        .with_input(nonsmooth::signal::PhaseInput::Unwrapped)
+        .with_offset(0.5)
+        .unwrap();
+    let t = [0.0, 1.0, 2.0];
+    let x = [0.0, 1.0, 2.0];
+    assert!(sec.sample(&t, &[1e20, 1e20 + 1e5, 1e20 + 2e5], &x).is_err());
+    assert!(sec.sample(&t, &[0.0, 1e13, 2e13], &x).is_err());
+    // An ordinary unwrapped phase still works: levels 0.5, 6.78, 13.07, 19.35 in 0..20.
+    let pts = sec.sample(&t, &[0.0, 10.0, 20.0], &x).unwrap();
+    assert_eq!(pts.len(), 4);
+}
