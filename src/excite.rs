@@ -194,15 +194,21 @@ impl<T: Real> UnbalancedRotor<T> {
     /// A rotor with unbalance `m0e` (kg·m) turning at `omega` (rad/s).
     ///
     /// # Errors
-    /// [`ParameterError`] unless `m0e ≥ 0` and `omega > 0`, both finite.
+    /// [`ParameterError`] unless `m0e ≥ 0` and `omega > 0`, both finite, with the force
+    /// amplitude `m0e·ω²` and its rate `m0e·ω³` finite.
     pub fn new(m0e: T, omega: T) -> Result<Self, ParameterError> {
         let m0e = non_negative("m0e", m0e)?;
         let omega = positive("omega", omega)?;
-        Ok(Self {
-            m0e,
-            omega,
-            amp: m0e * omega * omega,
-        })
+        let amp = m0e * omega * omega;
+        // The force m0e·ω² and its rate m0e·ω³ must be finite.
+        if !(amp * omega).is_finite() {
+            return Err(ParameterError::new(
+                "omega",
+                crate::scalar::to_f64(omega),
+                "small enough that m0e·ω³ is finite",
+            ));
+        }
+        Ok(Self { m0e, omega, amp })
     }
 
     /// The angular speed `ω`.
@@ -268,13 +274,21 @@ impl<T: Real> RampedRotor<T> {
     /// A rotor starting at `omega0` (rad/s) and accelerating at `rate` (rad/s², any sign).
     ///
     /// # Errors
-    /// [`ParameterError`] unless `m0e ≥ 0`, `omega0 > 0` and `rate` are finite.
+    /// [`ParameterError`] unless `m0e ≥ 0`, `omega0 > 0` and `rate` are finite and the
+    /// force and its rate at `t = 0` are finite.
     pub fn new(m0e: T, omega0: T, rate: T) -> Result<Self, ParameterError> {
-        Ok(Self {
-            m0e: non_negative("m0e", m0e)?,
-            omega0: positive("omega0", omega0)?,
-            rate: finite("rate", rate)?,
-        })
+        let m0e = non_negative("m0e", m0e)?;
+        let omega0 = positive("omega0", omega0)?;
+        let rate = finite("rate", rate)?;
+        // The force and its rate at t = 0 (m0e·ω0³, m0e·ω0·r) must be finite.
+        if !(m0e * omega0 * omega0 * omega0).is_finite() || !(m0e * omega0 * rate).is_finite() {
+            return Err(ParameterError::new(
+                "omega0",
+                crate::scalar::to_f64(omega0),
+                "small enough that m0e·ω0³ and m0e·ω0·rate are finite",
+            ));
+        }
+        Ok(Self { m0e, omega0, rate })
     }
 
     /// `ω(t) = ω0 + r·t`.

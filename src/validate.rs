@@ -45,3 +45,21 @@ pub(crate) fn finite<T: crate::Real>(
         ))
     }
 }
+
+/// Validates that `value²` is a normal number (no underflow to 0 or a subnormal), for
+/// regularization scales that enter as `x² + value²`.
+pub(crate) fn normal_square<T: crate::Real>(
+    name: &'static str,
+    value: T,
+) -> std::result::Result<T, ParameterError> {
+    let sq = crate::scalar::to_f64(value * value);
+    if sq.is_normal() {
+        Ok(value)
+    } else {
+        Err(ParameterError::new(
+            name,
+            crate::scalar::to_f64(value),
+            "with a square that does not underflow (>= 1.5e-154 for f64)",
+        ))
+    }
+}

@@ -166,3 +166,133 @@ fn phase_sections_reject_unresolvable_phases_instead_of_overflowing() {
     let pts = sec.sample(&t, &[0.0, 10.0, 20.0], &x).unwrap();
     assert_eq!(pts.len(), 4);
 }
+
+/// Probe values of the reliability issue: each was accepted and later gave NaN/∞ from
+/// finite input; each is now rejected by its constructor (or evaluates finitely).
+#[test]
+fn constructors_reject_what_would_later_be_nan() {
+    use nonsmooth::ForceLaw;
+    use nonsmooth::excite::{Excitation, UnbalancedRotor};
+    use nonsmooth::force::{DryFriction, HertzContact};
+    assert!(UnbalancedRotor::new(0.49, 1e265).is_err());
+    assert!(RampedRotor::new(2.0, 3e184, 0.5).is_err());
+    assert!(DryFriction::sqrt(8.5, 1.6e-308).is_err());
+    let h = HertzContact::new(0.0, 1e8)
+        .unwrap()
+        .with_damping(0.8, 1.5, 0.2)
+        .unwrap();
+    assert!(h.with_rate_regularization(1e-300).is_err());
+    // The exact law (η = 0, n3 < 1): ∂F/∂v at v = 0 in contact is the largest finite
+    // value, as documented (it was +∞), also for a subnormal n3.
+    for n3 in [0.2_f64, 5e-324] {
+        let exact = HertzContact::new(0.0_f64, 1e8)
+            .unwrap()
+            .with_damping(0.8, 1.5, n3)
+            .unwrap();
+        let (dx, dv) = exact.partials(1e-3, 0.0);
+        assert!(dx.is_finite() && dv.is_finite(), "n3 {n3}: {dx} {dv}");
+        assert!(exact.force(1e-3, 0.0).is_finite());
+    }
+    let r = UnbalancedRotor::new(0.49_f64, 1e30).unwrap();
+    assert!(r.force(1.0).is_finite() && r.force_rate(1.0).is_finite());
+}
+
+#[test]
+fn lyapunov_interval_counts_and_times_are_bounded() {
+    use nonsmooth::lyapunov::{LyapunovError, Norm, TwoTrajectory, decades};
+    // decades(i32::MIN, i32::MAX, 1) overflowed; now clamped to the f64 range.
+    let d = decades::<f64>(i32::MIN, i32::MAX, 1);
+    assert_eq!(d.len(), 616);
+    assert!(d.iter().all(|v| v.is_finite() && *v > 0.0));
+    assert!(decades::<f64>(0, 1, usize::MAX).len() <= 1_000_001);
+    let mut est = TwoTrajectory::<_, 2, 4, _, _>::with_tolerances(
+        osc(),
+        Dopri5::new,
+        &tol(),
+        1e-8,
+        Norm::Euclidean,
+    )
+    .unwrap();
+    // estimate(τ, usize::MAX) panicked with a capacity overflow.
+    est.start(0.0, y0()).unwrap();
+    let r = est.estimate(1.0, usize::MAX);
+    assert!(
+        matches!(
+            r,
+            Err(Error::Lyapunov(LyapunovError::TooManyIntervals { .. }))
+        ),
+        "{r:?}"
+    );
+    // At t0 = 1e17 an interval of 1 does not advance time: it reported 0 ± 0.
+    est.start(1e17, y0()).unwrap();
+    let r = est.estimate(1.0, 10);
+    assert!(
+        matches!(
+            r,
+            Err(Error::Lyapunov(LyapunovError::InvalidInterval { .. }))
+        ),
+        "{r:?}"
+    );
+}
+
+mod properties {
+    use super::*;
+    use nonsmooth::ForceLaw;
+    use nonsmooth::excite::{Excitation, UnbalancedRotor};
+    use nonsmooth::force::{Bilinear, CubicSpring, DryFriction, HertzContact};
+    use proptest::prelude::*;
+
+    /// Magnitudes 1e-100 … 1e100 with either sign, and 0.
+    fn value() -> impl Strategy<Value = f64> {
+        prop_oneof![
+            Just(0.0),
+            (-100.0f64..100.0, any::<bool>()).prop_map(|(e, s)| {
+                let v = 10f64.powf(e);
+                if s { v } else { -v }
+            }),
+        ]
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(400))]
+
+        /// A constructor either rejects its input or returns a law that never yields NaN
+        /// at moderate states (|x|, |v| ≤ 1e3 around the contact point), and never panics.
+        #[test]
+        fn accepted_laws_never_yield_nan(a in value(), b in value(), c in value(), d in value()) {
+            let states = [(0.0, 0.0), (1e-3, 0.0), (1e-3, -1.0), (-1.0, 1e3), (1e3, -1e-3)];
+            let check = |f: &dyn Fn(f64, f64) -> (f64, f64, f64)| {
+                for &(x, v) in &states {
+                    let (g, p, q) = f(x, v);
+                    assert!(!g.is_nan() && !p.is_nan() && !q.is_nan(), "({x}, {v}): {g} {p} {q}");
+                }
+            };
+            if let Ok(l) = DryFriction::sqrt(a.abs(), b) {
+                check(&|x, v| { let (p, q) = l.partials(x, v); (l.force(x, v), p, q) });
+            }
+            if let Ok(l) = DryFriction::tanh(a.abs(), b) {
+                check(&|x, v| { let (p, q) = l.partials(x, v); (l.force(x, v), p, q) });
+            }
+            if let Ok(l) = HertzContact::new(0.0, a)
+                .and_then(|h| h.with_damping(b, 1.5, c.abs()))
+                .and_then(|h| h.with_rate_regularization(d.abs()))
+            {
+                check(&|x, v| { let (p, q) = l.partials(x * 1e-6, v); (l.force(x * 1e-6, v), p, q) });
+            }
+            if let Ok(l) = CubicSpring::new(a, b) {
+                check(&|x, v| { let (p, q) = l.partials(x, v); (l.force(x, v), p, q) });
+            }
+            if let Ok(l) = Bilinear::new(a.abs(), b.abs(), c.min(d), c.max(d)) {
+                check(&|x, v| { let (p, q) = l.partials(x, v); (l.force(x, v), p, q) });
+            }
+            if let Ok(r) = UnbalancedRotor::new(a.abs(), b) {
+                for t in [0.0, 1.0, 1e3] {
+                    prop_assert!(r.force(t).is_finite() && r.force_rate(t).is_finite());
+                }
+            }
+            if let Ok(r) = RampedRotor::new(a.abs(), b, c) {
+                prop_assert!(r.force(0.0).is_finite() && r.force_rate(0.0).is_finite());
+            }
+        }
+    }
+}

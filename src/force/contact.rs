@@ -107,9 +107,13 @@ impl<T: Real> HertzContact<T> {
     /// `eta = 0` restores the exact law.
     ///
     /// # Errors
-    /// [`ParameterError`] unless `eta` is finite and ≥ 0.
+    /// [`ParameterError`] unless `eta` is finite and ≥ 0, and `eta²` does not underflow
+    /// when `eta > 0` (`eta ≥ 1.5·10⁻¹⁵⁴` for `f64`; the rate term would be `0·∞`).
     pub fn with_rate_regularization(mut self, eta: T) -> Result<Self, ParameterError> {
         self.eta = non_negative("eta", eta)?;
+        if self.eta > T::zero() {
+            crate::validate::normal_square("eta", self.eta)?;
+        }
         Ok(self)
     }
 
@@ -149,7 +153,8 @@ impl<T: Real> HertzContact<T> {
             let s = w * w + self.eta * self.eta;
             // (w²+η²)^{(n3−1)/2}: the one transcendental pair of the evaluation.
             let p = (self.half_n3_minus_1 * s.ln()).exp();
-            let g = w * p;
+            // g(0) = 0 exactly, also when p overflows (a huge n3): never 0·∞.
+            let g = if w == T::zero() { w } else { w * p };
             let dg = p * (self.n3 * w * w + self.eta * self.eta) / s;
             (g, dg)
         } else if w == T::zero() {
@@ -230,7 +235,17 @@ impl<T: Real> ForceLaw<T> for HertzContact<T> {
             return (T::zero(), T::zero());
         }
         // For Side::Lower both δ = x_I − x and δ̇ = −v flip sign, and so does F.
-        (self.k_i * fd, self.k_i * fw)
+        let big = T::max_value().unwrap_or(T::zero());
+        let clamp = |p: T| {
+            if p.is_finite() {
+                p
+            } else if p > T::zero() {
+                big
+            } else {
+                -big
+            }
+        };
+        (clamp(self.k_i * fd), clamp(self.k_i * fw))
     }
 }
 

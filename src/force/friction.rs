@@ -1,7 +1,7 @@
 //! Regularized dry (Coulomb) friction.
 
 use crate::error::ParameterError;
-use crate::validate::{non_negative, positive};
+use crate::validate::{non_negative, normal_square, positive};
 use crate::{ForceLaw, Real};
 
 /// How the sign function of Coulomb friction is smoothed.
@@ -53,11 +53,12 @@ impl<T: Real> DryFriction<T> {
     /// Friction with an explicit regularization.
     ///
     /// # Errors
-    /// [`ParameterError`] if `t < 0`, `eps ≤ 0`, or either is not finite.
+    /// [`ParameterError`] if `t < 0`, `eps ≤ 0`, either is not finite, or `eps² `
+    /// underflows (`eps < 1.5·10⁻¹⁵⁴` for `f64`: the force at `v = 0` would be `0/0`).
     pub fn new(t: T, eps: T, reg: Regularization) -> Result<Self, ParameterError> {
         Ok(Self {
             t: non_negative("T", t)?,
-            eps: positive("eps", eps)?,
+            eps: normal_square("eps", positive("eps", eps)?)?,
             reg,
         })
     }

@@ -207,8 +207,8 @@ where
         let blocks = self.blocks.min(intervals);
         let mut stats = Stats::default();
         let (mut log_sum, mut time) = (T::zero(), T::zero());
-        let mut local = Vec::with_capacity(intervals);
-        let mut history = Vec::with_capacity(intervals);
+        let mut local = Vec::with_capacity(intervals.min(1 << 16));
+        let mut history = Vec::with_capacity(intervals.min(1 << 16));
         for _ in 0..intervals {
             let (l, dt) = self.interval(tau, &mut stats)?;
             log_sum += l;
@@ -452,8 +452,8 @@ where
         let blocks = self.blocks.min(intervals);
         let mut stats = Stats::default();
         let mut sums = [T::zero(); K];
-        let mut local = Vec::with_capacity(intervals);
-        let mut history = Vec::with_capacity(intervals);
+        let mut local = Vec::with_capacity(intervals.min(1 << 16));
+        let mut history = Vec::with_capacity(intervals.min(1 << 16));
         for k in 0..intervals {
             let logs = self.interval(tau, &mut stats)?;
             let mut rates = [T::zero(); K];

@@ -177,6 +177,14 @@ pub enum LyapunovError {
         /// The minimum.
         minimum: usize,
     },
+    /// More intervals than one estimate records ([`MAX_INTERVALS`]).
+    #[error("{intervals} intervals requested; at most {maximum} per estimate")]
+    TooManyIntervals {
+        /// The requested number.
+        intervals: usize,
+        /// The maximum.
+        maximum: usize,
+    },
     /// The number of blocks for the standard error is < 2.
     #[error("invalid number of blocks {blocks}: at least 2 are needed for a spread")]
     InvalidBlocks {
@@ -480,13 +488,33 @@ pub(crate) fn check_interval<T: Real>(tau: T) -> Result<T, LyapunovError> {
     }
 }
 
+/// As [`check_interval`], and `t + τ > t` in floating point (an interval below the time
+/// resolution at `t` would make no progress and report 0 ± 0).
+pub(crate) fn check_interval_at<T: Real>(t: T, tau: T) -> Result<T, LyapunovError> {
+    let tau = check_interval(tau)?;
+    if t + tau > t {
+        Ok(tau)
+    } else {
+        Err(LyapunovError::InvalidInterval { tau: to_f64(tau) })
+    }
+}
+
 pub(crate) fn check_intervals(intervals: usize, minimum: usize) -> Result<(), LyapunovError> {
     if intervals < minimum {
         Err(LyapunovError::TooFewIntervals { intervals, minimum })
+    } else if intervals > MAX_INTERVALS {
+        Err(LyapunovError::TooManyIntervals {
+            intervals,
+            maximum: MAX_INTERVALS,
+        })
     } else {
         Ok(())
     }
 }
+
+/// The most intervals one estimate records (10⁸: its history and local rates take 16 bytes
+/// per interval, 1.6 GB at the limit).
+pub const MAX_INTERVALS: usize = 100_000_000;
 
 pub(crate) fn check_blocks(blocks: usize) -> Result<usize, LyapunovError> {
     if blocks < 2 {

@@ -4,7 +4,7 @@ use nalgebra::{SMatrix, SVector};
 
 use super::{
     DEFAULT_BLOCKS, DEFAULT_MAX_STEPS_PER_INTERVAL, LyapunovError, Norm, block_standard_error,
-    check_blocks, check_interval, check_intervals, check_state, grid_time, integrate_to,
+    check_blocks, check_interval_at, check_intervals, check_state, grid_time, integrate_to,
     stats_since,
 };
 use crate::error::Result;
@@ -392,7 +392,7 @@ where
     /// # Errors
     /// As [`estimate`](Self::estimate), except that 0 intervals are allowed (a no-op).
     pub fn transient(&mut self, tau: T, intervals: usize) -> Result<()> {
-        check_interval(tau)?;
+        check_interval_at(self.stepper.current().0, tau)?;
         self.run(tau, intervals, true, |_, _| {})
     }
 
@@ -404,12 +404,12 @@ where
     /// vector degenerates within an interval (shorten `tau`), and integration errors (a
     /// non-finite right-hand side where the Jacobian is missing or infinite).
     pub fn estimate(&mut self, tau: T, intervals: usize) -> Result<Spectrum<T, K>> {
-        check_interval(tau)?;
+        check_interval_at(self.stepper.current().0, tau)?;
         check_intervals(intervals, 2)?;
         let blocks = self.blocks.min(intervals);
         let s0 = *self.stepper.stats();
-        let mut local = Vec::with_capacity(intervals);
-        let mut history = Vec::with_capacity(intervals);
+        let mut local = Vec::with_capacity(intervals.min(1 << 16));
+        let mut history = Vec::with_capacity(intervals.min(1 << 16));
         let mut sum = [T::zero(); K];
         self.run(tau, intervals, false, |k, s| {
             local.push(s);

@@ -4,8 +4,8 @@ use nalgebra::{SMatrix, SVector};
 
 use super::{
     DEFAULT_BLOCKS, DEFAULT_MAX_STEPS_PER_INTERVAL, Estimate, LyapunovError, Norm,
-    block_standard_error, check_blocks, check_interval, check_intervals, check_state, grid_time,
-    integrate_to, stats_since,
+    block_standard_error, check_blocks, check_interval, check_interval_at, check_intervals,
+    check_state, grid_time, integrate_to, stats_since,
 };
 use crate::error::Result;
 use crate::integrate::{Stepper, Tolerances};
@@ -344,7 +344,7 @@ where
     /// # Errors
     /// As [`estimate`](Self::estimate), except that 0 intervals are allowed (a no-op).
     pub fn transient(&mut self, tau: T, intervals: usize) -> Result<()> {
-        check_interval(tau)?;
+        check_interval_at(self.stepper.current().0, tau)?;
         self.run(tau, intervals, true, |_, _| {})
     }
 
@@ -356,12 +356,12 @@ where
     /// [`LyapunovError::SeparationLost`] if the separation collapses or overflows, and
     /// integration errors.
     pub fn estimate(&mut self, tau: T, intervals: usize) -> Result<Estimate<T>> {
-        check_interval(tau)?;
+        check_interval_at(self.stepper.current().0, tau)?;
         check_intervals(intervals, 2)?;
         let blocks = self.blocks.min(intervals);
         let s0 = *self.stepper.stats();
-        let mut local = Vec::with_capacity(intervals);
-        let mut history = Vec::with_capacity(intervals);
+        let mut local = Vec::with_capacity(intervals.min(1 << 16));
+        let mut history = Vec::with_capacity(intervals.min(1 << 16));
         let mut sum = T::zero();
         self.run(tau, intervals, false, |k, s| {
             local.push(s);
@@ -472,7 +472,9 @@ pub struct SeparationPoint<T> {
 }
 
 /// `per_decade` logarithmically spaced values per decade from `10^lo` to `10^hi`
-/// (inclusive), computed from the index (no accumulation).
+/// (inclusive), computed from the index (no accumulation). Decades are clamped to
+/// `10⁻³⁰⁷ … 10³⁰⁸` (beyond, a value is 0 or ∞) and `per_decade` so that at most about 10⁶
+/// values are returned.
 ///
 /// ```
 /// let d = nonsmooth::lyapunov::decades::<f64>(-9, -6, 1);
@@ -483,6 +485,13 @@ pub fn decades<T: Real>(lo: i32, hi: i32, per_decade: usize) -> Vec<T> {
     if hi < lo || per_decade == 0 {
         return Vec::new();
     }
+    // Decades outside the normal f64 range give 0 or ∞, never a separation: clamp them,
+    // and bound the count (at most 10⁶ values).
+    let (lo, hi) = (lo.max(-307), hi.min(308));
+    if hi < lo {
+        return Vec::new();
+    }
+    let per_decade = per_decade.min(1_000_000 / (hi - lo).max(1) as usize).max(1);
     let n = (hi - lo) as usize * per_decade;
     (0..=n)
         .map(|i| lit::<T>(10f64.powf(lo as f64 + i as f64 / per_decade as f64)))
