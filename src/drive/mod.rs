@@ -406,11 +406,7 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
             .into());
         }
         check_state(&y0)?;
-        self.stepper.check()?;
-        self.events.check()?;
-        observer.check()?;
-        observer.check_span(t0, t_end)?;
-        self.check_work(t0, t_end)?;
+        self.preflight(t0, t_end, observer)?;
         self.stepper.reset_state(t0, y0);
         self.history.clear();
         observer.on_start(t0, &y0);
@@ -436,13 +432,19 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
             }
             .into());
         }
+        self.preflight(t0, t_end, observer)?;
+        observer.on_start(t0, &y0);
+        self.advance(t_end, observer)
+    }
+
+    /// The checks before a run over `[t0, t_end]`: the stepper's settings, the events' and
+    /// the observer's indices and span, and the work bound.
+    fn preflight<O: Observer<T, N>>(&self, t0: T, t_end: T, observer: &O) -> Result<()> {
         self.stepper.check()?;
         self.events.check()?;
         observer.check()?;
         observer.check_span(t0, t_end)?;
-        self.check_work(t0, t_end)?;
-        observer.on_start(t0, &y0);
-        self.advance(t_end, observer)
+        self.check_work(t0, t_end)
     }
 
     /// Fails at once when the run provably needs more steps than the cap: its span over the

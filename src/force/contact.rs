@@ -94,12 +94,30 @@ impl<T: Real> HertzContact<T> {
     /// Sets the nonlinear damping `b·δ^{n2}·sgn(δ̇)|δ̇|^{n3}`.
     ///
     /// # Errors
-    /// [`ParameterError`] unless `b ≥ 0` and `n2`, `n3` are > 0, all finite.
+    /// [`ParameterError`] unless `b ≥ 0` and `n2`, `n3` are > 0, all finite, and (with a
+    /// rate regularization `η > 0`) `η^{n3−1}` is finite.
     pub fn with_damping(mut self, b: T, n2: T, n3: T) -> Result<Self, ParameterError> {
         self.b = non_negative("b", b)?;
         self.n2 = Exponent::new(positive("n2", n2)?);
         self.n3 = positive("n3", n3)?;
         self.half_n3_minus_1 = (self.n3 - T::one()) * lit(0.5);
+        self.check_rate_scale()
+    }
+
+    /// With `η > 0`, the regularized rate term's factor at `δ̇ = 0`, `η^{n3−1}`, must be
+    /// finite (and `η²` must not underflow): otherwise `δ̇·(δ̇²+η²)^{(n3−1)/2}` is `0·∞`.
+    fn check_rate_scale(self) -> Result<Self, ParameterError> {
+        if self.eta > T::zero() {
+            crate::validate::normal_square("eta", self.eta)?;
+            let s = self.eta * self.eta;
+            if !(self.half_n3_minus_1 * s.ln()).exp().is_finite() {
+                return Err(ParameterError::new(
+                    "eta",
+                    crate::scalar::to_f64(self.eta),
+                    "with eta^(n3-1) finite",
+                ));
+            }
+        }
         Ok(self)
     }
 
@@ -108,13 +126,11 @@ impl<T: Real> HertzContact<T> {
     ///
     /// # Errors
     /// [`ParameterError`] unless `eta` is finite and ≥ 0, and `eta²` does not underflow
-    /// when `eta > 0` (`eta ≥ 1.5·10⁻¹⁵⁴` for `f64`; the rate term would be `0·∞`).
+    /// when `eta > 0` (`eta ≥ 1.5·10⁻¹⁵⁴` for `f64`) and `eta^{n3−1}` is finite (the rate
+    /// term would be `0·∞` at `δ̇ = 0`).
     pub fn with_rate_regularization(mut self, eta: T) -> Result<Self, ParameterError> {
         self.eta = non_negative("eta", eta)?;
-        if self.eta > T::zero() {
-            crate::validate::normal_square("eta", self.eta)?;
-        }
-        Ok(self)
+        self.check_rate_scale()
     }
 
     /// The stop position `x_I`.
@@ -153,8 +169,8 @@ impl<T: Real> HertzContact<T> {
             let s = w * w + self.eta * self.eta;
             // (w²+η²)^{(n3−1)/2}: the one transcendental pair of the evaluation.
             let p = (self.half_n3_minus_1 * s.ln()).exp();
-            // g(0) = 0 exactly, also when p overflows (a huge n3): never 0·∞.
-            let g = if w == T::zero() { w } else { w * p };
+            // p ≤ η^{n3−1} < ∞ near w = 0 (checked at construction): never 0·∞.
+            let g = w * p;
             let dg = p * (self.n3 * w * w + self.eta * self.eta) / s;
             (g, dg)
         } else if w == T::zero() {
