@@ -644,7 +644,10 @@ proptest! {
     ) {
         for law in [DryFriction::sqrt(t, eps).unwrap(), DryFriction::tanh(t, eps).unwrap()] {
             let f = law.force(0.0, v);
-            prop_assert!(f.abs() <= t, "{:?}: F({}) = {}", law, v, f);
+            // |v|/√(v²+ε²) ≤ 1 exactly, but T·v is rounded before the division: for ε ≪ |v|
+            // the result may exceed T by one rounding (seen: T = 7.26562476379122,
+            // v = −621.27, ε = 1e-9 gives |F| = T + 1 ulp). Two ulps of T bound that.
+            prop_assert!(f.abs() <= t * (1.0 + 4.0 * f64::EPSILON), "{:?}: F({}) = {}", law, v, f);
         }
     }
 
