@@ -309,6 +309,8 @@ fn ramp_tables() {
                 velocity: 0.021,
             },
         ],
+        dropped_sections: 0,
+        dropped_impacts: 0,
     };
     let mut out = Vec::new();
     write_ramp_sections(&mut out, &rec, STATE_XV).unwrap();

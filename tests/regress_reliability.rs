@@ -296,3 +296,25 @@ mod properties {
         }
     }
 }
+
+#[test]
+fn implicit_method_on_the_exact_contact_law_reports_the_cause() {
+    // The exact law (η = 0, n3 < 1) has ∂F/∂v = ∞ at v = 0 in contact. Before, Rosenbrock23
+    // reported "singular iteration matrix at t = 0" for a start resting in contact; with
+    // the partial reported as the largest finite value the implicit method runs through.
+    use nonsmooth::Dynamics;
+    use nonsmooth::systems::paper::PAPER;
+    let p = nonsmooth::systems::paper::PaperParameters { eta: 0.0, ..PAPER };
+    let sys = p.oscillator(14.0_f64).unwrap();
+    let x0 = p.x_i + 1e-6; // in contact: δ = x − x_I > 0
+    let y0 = Vector2::new(x0, 0.0);
+    let mut f = Vector2::zeros();
+    sys.rhs(0.0, &y0, &mut f);
+    assert!(f.iter().all(|v| v.is_finite()));
+    let jac = sys.jacobian(0.0, &y0).unwrap();
+    assert!(jac.iter().all(|v| v.is_finite()), "{jac}");
+    let stepper = Rosenbrock23::new(Tolerances::new(1e-8, 1e-10).unwrap());
+    let r = Simulation::new(sys, stepper).run(0.0, y0, 0.05, &mut ());
+    let out = r.unwrap();
+    assert!(out.stats.accepted > 0);
+}

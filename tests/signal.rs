@@ -430,6 +430,15 @@ fn csv_errors_name_the_line() {
             },
         ),
         (
+            // A shifted row (decimal comma): silently reading "1" and "5" would be wrong.
+            "t_s,x_m\n0,1\n1,5,3\n",
+            SignalError::ExtraFields {
+                line: 3,
+                found: 3,
+                expected: 2,
+            },
+        ),
+        (
             "t_s,x_m\n0,1\n1\n",
             SignalError::MissingField {
                 line: 3,
@@ -498,7 +507,9 @@ fn csv_errors_name_the_line() {
             _ => assert_eq!(got, want, "input {text:?}"),
         }
         let line = match &want {
-            SignalError::ParseField { line, .. } | SignalError::MissingField { line, .. } => *line,
+            SignalError::ParseField { line, .. }
+            | SignalError::MissingField { line, .. }
+            | SignalError::ExtraFields { line, .. } => *line,
             SignalError::NonFinite {
                 location: Location::Line(l),
                 ..

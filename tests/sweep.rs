@@ -244,6 +244,22 @@ fn ramp_sections_follow_the_phase() {
     }
     assert!(!rec.impacts.is_empty());
     assert!(rec.impacts.iter().all(|i| i.velocity > 0.0));
+    assert_eq!((rec.dropped_sections, rec.dropped_impacts), (0, 0));
+
+    // A bounded run keeps the first `capacity` records, counts the rest, and they are the
+    // unbounded run's records.
+    use nonsmooth::sweep::ramp_with_capacity;
+    let capped = ramp_with_capacity(osc, exc, stop(), stepper(), x0(), 30.0, 10).unwrap();
+    assert_eq!(capped.sections[..], rec.sections[..10]);
+    assert_eq!(capped.impacts[..], rec.impacts[..10.min(rec.impacts.len())]);
+    assert_eq!(
+        capped.dropped_sections,
+        (rec.sections.len() - capped.sections.len()) as u64
+    );
+    assert_eq!(
+        capped.dropped_impacts,
+        (rec.impacts.len() - capped.impacts.len()) as u64
+    );
 }
 
 #[test]

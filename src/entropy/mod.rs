@@ -229,6 +229,15 @@ pub enum EntropyError {
         /// The rejected value.
         q: f64,
     },
+    /// The exact value is finite but beyond the floating-point range (for `q` far below 1
+    /// the terms `p_i^q` grow like `p_min^q`: e.g. `R(q)` at `q = −10³⁰⁰`).
+    #[error("{quantity} at q = {q} is beyond the floating-point range")]
+    NotRepresentable {
+        /// Which quantity overflowed.
+        quantity: &'static str,
+        /// The `q` asked for.
+        q: f64,
+    },
     /// A `q` range is not finite, not increasing, or (for the maximization) not positive.
     #[error("invalid q range [{lo}, {hi}]: {requirement}")]
     InvalidQRange {

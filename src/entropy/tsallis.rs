@@ -43,7 +43,7 @@ pub fn shannon<T: Real>(p: &Probabilities<T>) -> T {
 /// ```
 pub fn tsallis<T: Real>(p: &Probabilities<T>, q: T) -> Result<T, EntropyError> {
     check_q(q)?;
-    Ok(tsallis_unchecked(p, q))
+    representable("the Tsallis entropy", q, tsallis_unchecked(p, q))
 }
 
 /// The largest Tsallis entropy of `n` states (for `q > 0`), attained at `p_i = 1/n`:
@@ -60,7 +60,11 @@ pub fn tsallis_max<T: Real>(n: usize, q: T) -> Result<T, EntropyError> {
         return Err(EntropyError::EmptyDistribution);
     }
     check_q(q)?;
-    Ok(tsallis_max_unchecked(ln_states(n), q))
+    representable(
+        "the largest Tsallis entropy",
+        q,
+        tsallis_max_unchecked(ln_states(n), q),
+    )
 }
 
 /// The redundancy
@@ -86,7 +90,23 @@ pub fn redundancy<T: Real>(p: &Probabilities<T>, q: T) -> Result<T, EntropyError
     if p.len() < 2 {
         return Err(EntropyError::SingleState);
     }
-    Ok(redundancy_unchecked(p, ln_states(p.len()), q))
+    representable(
+        "the redundancy",
+        q,
+        redundancy_unchecked(p, ln_states(p.len()), q),
+    )
+}
+
+/// `Ok(value)` if it is finite, else [`EntropyError::NotRepresentable`].
+fn representable<T: Real>(quantity: &'static str, q: T, value: T) -> Result<T, EntropyError> {
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(EntropyError::NotRepresentable {
+            quantity,
+            q: to_f64(q),
+        })
+    }
 }
 
 fn check_q<T: Real>(q: T) -> Result<(), EntropyError> {
@@ -145,10 +165,44 @@ pub(crate) fn tsallis_max_unchecked<T: Real>(ln_n: T, q: T) -> T {
     }
 }
 
-/// [`redundancy`] from `ln N` (`N ≥ 2`), without checks.
+/// [`redundancy`] from `ln N` (`N ≥ 2`), without checks. Never NaN: where `S_q` or
+/// `S_q,max` overflows (`q` far below 1) the ratio is taken in logarithms (see
+/// [`redundancy_far_below_one`]); `−∞` only where the exact `R` is below `−f64::MAX`.
 #[inline]
 pub(crate) fn redundancy_unchecked<T: Real>(p: &Probabilities<T>, ln_n: T, q: T) -> T {
-    T::one() - tsallis_unchecked(p, q) / tsallis_max_unchecked(ln_n, q)
+    let s = tsallis_unchecked(p, q);
+    let m = tsallis_max_unchecked(ln_n, q);
+    if s.is_finite() && m.is_finite() {
+        T::one() - s / m
+    } else {
+        redundancy_far_below_one(p, ln_n, q)
+    }
+}
+
+/// `R(q)` for `q < 1` when `X = Σ p_i^q` or `Y = N^{1−q}` overflows.
+///
+/// # Formula
+/// For `q < 1`, `S_q = (X − 1)/(1 − q)` and `S_q,max = (Y − 1)/(1 − q)`, so
+/// $$ 1 - R = \frac{X - 1}{Y - 1}
+///    = \frac{X}{Y}\,\frac{1 - 1/X}{1 - 1/Y}, \qquad
+///    \ln\frac{X}{Y} = \ln\frac{1}{N}\sum_i e^{\,q \ln(N p_i)} , $$
+/// the last a log-sum-exp of the moderate numbers `ln(N p_i)` (shifted by its largest term).
+/// Then `R = −expm1(ln(X/Y) + ln1p(−1/X) − ln1p(−1/Y))`.
+#[cold]
+fn redundancy_far_below_one<T: Real>(p: &Probabilities<T>, ln_n: T, q: T) -> T {
+    let terms = p.ln_probabilities().iter().map(|&li| q * (li + ln_n));
+    let neg_inf = -lit::<T>(f64::INFINITY);
+    let top = terms.clone().fold(neg_inf, T::max);
+    if !top.is_finite() {
+        // q·ln(N p_i) = +∞ for some i: X/Y, and so −R, is beyond the range.
+        return neg_inf;
+    }
+    let sum = terms.fold(T::zero(), |s, x| s + (x - top).exp());
+    let ln_ratio = top + sum.ln() - ln_n;
+    let ln_y = (T::one() - q) * ln_n;
+    let ln_x = ln_ratio + ln_y;
+    let correction = (-(-ln_x).exp()).ln_1p() - (-(-ln_y).exp()).ln_1p();
+    -(ln_ratio + correction).exp_m1()
 }
 
 #[cfg(test)]
@@ -187,6 +241,45 @@ mod tests {
         assert!(s.is_finite());
         let n = naive_tsallis(p.as_slice(), -0.2);
         assert!((s - n).abs() <= 1e-12 * n.abs());
+    }
+
+    #[test]
+    fn far_below_one_is_never_nan() {
+        // X = Σ p^q and Y = N^{1−q} overflow; R comes from the log form.
+        let p = Probabilities::new(vec![0.5_f64, 0.3, 0.2]).unwrap();
+        let ln_n = ln_states::<f64>(3);
+        // At q = −1000 the direct form overflows (0.2^q ≈ 10⁶⁹⁹); R = 1 − (X − 1)/(Y − 1)
+        // with X/Y = mean((N p_i)^q) dominated by the smallest p: (0.6)^q/3 ≈ e^509.7.
+        let q = -1000.0;
+        assert!(!tsallis_unchecked(&p, q).is_finite());
+        let r = redundancy_unchecked(&p, ln_n, q);
+        let ln_ratio = q * (0.6_f64).ln() - 3f64.ln();
+        assert!(((1.0 - r).ln() - ln_ratio).abs() < 1e-9 * ln_ratio, "{r}");
+        // Beyond the range: an error, never NaN.
+        for q in [-1.3e199, -1e300, -f64::MAX] {
+            assert!(!redundancy_unchecked(&p, ln_n, q).is_nan());
+            assert!(matches!(
+                redundancy(&p, q),
+                Err(EntropyError::NotRepresentable { .. })
+            ));
+            assert!(matches!(
+                tsallis(&p, q),
+                Err(EntropyError::NotRepresentable { .. })
+            ));
+        }
+        // Uniform: R = 0 exactly, however far q is from 1.
+        let u = Probabilities::new(vec![0.25_f64; 4]).unwrap();
+        for q in [-1e6, -1.3e199, -f64::MAX] {
+            assert_eq!(redundancy(&u, q), Ok(0.0), "q = {q}");
+        }
+        // Agreement where both forms apply: q = −400 (direct) vs the log form.
+        let q = -400.0;
+        let direct = redundancy(&p, q).unwrap();
+        let logs = redundancy_far_below_one(&p, ln_n, q);
+        assert!(
+            (direct - logs).abs() <= 1e-12 * direct.abs(),
+            "{direct} vs {logs}"
+        );
     }
 
     #[test]

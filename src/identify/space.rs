@@ -139,27 +139,57 @@ impl Mapping {
         match self.bounds {
             BoundMap::Free => u,
             BoundMap::Both { lo, hi } => {
+                let w = 0.5 * (1.0 + u.sin());
+                let span = hi - lo;
                 // Clamp: rounding must never leave [lo, hi].
-                (lo + (hi - lo) * 0.5 * (1.0 + u.sin())).clamp(lo, hi)
+                if span.is_finite() {
+                    (lo + span * w).clamp(lo, hi)
+                } else {
+                    // hi − lo overflows (bounds near ±f64::MAX): the convex combination.
+                    (lo * (1.0 - w) + hi * w).clamp(lo, hi)
+                }
             }
-            BoundMap::Lower { lo, s } => lo + s * ((u / s).hypot(1.0) - 1.0),
-            BoundMap::Upper { hi, s } => hi - s * ((u / s).hypot(1.0) - 1.0),
+            BoundMap::Lower { lo, s } => lo + sqrt_one_plus_minus_one(u, s),
+            BoundMap::Upper { hi, s } => hi - sqrt_one_plus_minus_one(u, s),
         }
     }
 
     fn u_of_z(&self, z: f64) -> f64 {
         match self.bounds {
             BoundMap::Free => z,
-            BoundMap::Both { lo, hi } => (2.0 * (z - lo) / (hi - lo) - 1.0).clamp(-1.0, 1.0).asin(),
-            BoundMap::Lower { lo, s } => {
-                let r = (z - lo) / s + 1.0;
-                s * (r * r - 1.0).max(0.0).sqrt()
+            BoundMap::Both { lo, hi } => {
+                let span = hi - lo;
+                let r = if span.is_finite() {
+                    2.0 * (z - lo) / span - 1.0
+                } else {
+                    2.0 * (0.5 * z - 0.5 * lo) / (0.5 * hi - 0.5 * lo) - 1.0
+                };
+                r.clamp(-1.0, 1.0).asin()
             }
-            BoundMap::Upper { hi, s } => {
-                let r = (hi - z) / s + 1.0;
-                s * (r * r - 1.0).max(0.0).sqrt()
-            }
+            BoundMap::Lower { lo, s } => inverse_sqrt_map(z - lo, s),
+            BoundMap::Upper { hi, s } => inverse_sqrt_map(hi - z, s),
         }
+    }
+}
+
+/// `s·(√(1 + (u/s)²) − 1) = u²/(√(u² + s²) + s)`, evaluated as `|u|·(|u|/(hypot(u, s) + s))`:
+/// no cancellation for `|u| ≪ s`, no overflow of `u/s` for a tiny scale or of `u²` for a
+/// large `u`.
+fn sqrt_one_plus_minus_one(u: f64, s: f64) -> f64 {
+    let a = u.abs();
+    a * (a / (a.hypot(s) + s))
+}
+
+/// The inverse of [`sqrt_one_plus_minus_one`] on `d = |z − bound| ≥ 0`:
+/// `s·√(r² − 1)` with `r = d/s + 1` is `√d·√(d + 2s)`, finite for every finite `d`. Where
+/// `d` itself overflows (a bound and a value near ±f64::MAX of opposite signs) the exact
+/// `u` is beyond the range and saturates at `f64::MAX`.
+fn inverse_sqrt_map(d: f64, s: f64) -> f64 {
+    if d.is_finite() {
+        let d = d.max(0.0);
+        d.sqrt() * (d + 2.0 * s).sqrt()
+    } else {
+        f64::MAX
     }
 }
 
@@ -503,7 +533,9 @@ impl ParameterSpace {
     /// does (the routine used in the paper): `x_j → (1 + relative_step)·x_j`, or
     /// `x_j + zero_step` when `x_j = 0`. If that leaves the bounds the step is taken the
     /// other way, then halved until it fits. The step is made in physical units and mapped
-    /// to `u`, so a `Log` parameter moves by the factor `1 + relative_step`.
+    /// to `u`, so a `Log` parameter moves by the factor `1 + relative_step`. A relative
+    /// step too small to move `u` (a tiny `x_j` far from its bound) is replaced by
+    /// `zero_step`.
     ///
     /// # Errors
     /// As [`to_unconstrained`](Self::to_unconstrained) for `at`;
@@ -521,11 +553,6 @@ impl ParameterSpace {
         let mut vertices = vec![u0.clone()];
         for (j, p) in self.params.iter().enumerate() {
             let x = at[j];
-            let step = if x == 0.0 {
-                zero_step
-            } else {
-                relative_step * x
-            };
             let lo = p.lower.unwrap_or(f64::NEG_INFINITY);
             let hi = p.upper.unwrap_or(f64::INFINITY);
             let fits = |y: f64| {
@@ -535,32 +562,36 @@ impl ParameterSpace {
                     && !(p.transform == Transform::Log && y <= 0.0)
                     && y != x
             };
-            let mut h = step;
-            let mut chosen = None;
-            for _ in 0..60 {
-                if fits(x + h) {
-                    chosen = Some(x + h);
-                    break;
+            let m = &self.maps[j];
+            // The vertex coordinate for a physical step `step`: tried forwards, then
+            // backwards, then halved until it fits the bounds; `None` if it never fits or
+            // does not move `u` (a step below the resolution of the map there).
+            let vertex = |step: f64| {
+                let mut h = step;
+                for _ in 0..60 {
+                    for y in [x + h, x - h] {
+                        if fits(y) {
+                            let u = m.u_of_z(m.z_of_x(y));
+                            return (u != u0[j] && u.is_finite()).then_some(u);
+                        }
+                    }
+                    h *= 0.5;
                 }
-                if fits(x - h) {
-                    chosen = Some(x - h);
-                    break;
-                }
-                h *= 0.5;
-            }
-            let y = chosen.ok_or(IdentifyError::DegenerateSimplex {
+                None
+            };
+            // A tiny nonzero x (e.g. −1e-16 reached by an optimizer near a bound at −1)
+            // gives a relative step below the map's resolution: fall back to `zero_step`.
+            let u = if x == 0.0 {
+                vertex(zero_step)
+            } else {
+                vertex(relative_step * x).or_else(|| vertex(zero_step))
+            };
+            let u = u.ok_or(IdentifyError::DegenerateSimplex {
                 name: p.name.clone(),
                 value: x,
             })?;
-            let m = &self.maps[j];
             let mut v = u0.clone();
-            v[j] = m.u_of_z(m.z_of_x(y));
-            if v[j] == u0[j] {
-                return Err(IdentifyError::DegenerateSimplex {
-                    name: p.name.clone(),
-                    value: x,
-                });
-            }
+            v[j] = u;
             vertices.push(v);
         }
         Ok(vertices)
@@ -623,6 +654,51 @@ mod tests {
             assert!(x["e"] > 0.0 && x["e"] <= 2.0);
             assert!(x["f"] > 0.0 && x["f"] <= 10.0);
             assert!(x["g"] <= 0.0);
+        }
+    }
+
+    #[test]
+    fn extreme_magnitudes_give_finite_vertices_and_round_trips() {
+        // Scales from 1e-100 to 1e100 on every kind of map: the simplex vertices are finite
+        // and map back to finite values within the bounds (an infinite vertex came from
+        // (z − lo)/s squared overflowing for a tiny scale s).
+        let mags = [1e-100, 1e-30, 1e-3, 1.0, 1e3, 1e30, 1e100];
+        for &a in &mags {
+            for &b in &mags {
+                for p in [
+                    Parameter::new("x", a).with_lower(a * (1.0 - 1e-15)),
+                    Parameter::new("x", a).with_lower(-b),
+                    Parameter::new("x", -a).with_upper(b),
+                    Parameter::new("x", a).with_bounds(-b, a + b),
+                    Parameter::positive("x", a).with_lower(a * 0.5),
+                    Parameter::positive("x", a).with_upper(a + b),
+                    Parameter::new("x", a).with_bounds(-f64::MAX, f64::MAX),
+                ] {
+                    let space = ParameterSpace::new([p.clone()]).unwrap();
+                    for at in [p.initial(), p.initial() + b, p.initial() * 0.5] {
+                        let Ok(v) = space.simplex(&[at], 0.05, 2.5e-4) else {
+                            continue; // `at` outside the bounds
+                        };
+                        for vertex in &v {
+                            assert!(vertex[0].is_finite(), "{p:?} at {at}: {v:?}");
+                            let x = space.to_physical(vertex).unwrap();
+                            assert!(x.values()[0].is_finite(), "{p:?}");
+                        }
+                        // The maps resolve z relative to the bounds' magnitude.
+                        let (lo, hi) = p.bounds();
+                        let scale = [Some(at), lo, hi]
+                            .into_iter()
+                            .flatten()
+                            .fold(0.0_f64, |m, x| m.max(x.abs()));
+                        let back = space.to_physical(&v[0]).unwrap().values()[0];
+                        assert!(
+                            (back - at).abs() <= 1e-9 * scale,
+                            "{p:?}: {at} -> {} -> {back}",
+                            v[0][0]
+                        );
+                    }
+                }
+            }
         }
     }
 

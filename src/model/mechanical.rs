@@ -76,6 +76,42 @@ pub enum ModelError {
 pub struct Coordinate<T: Real, const N: usize> {
     weights: SVector<T, N>,
     offset: T,
+    /// The sparsity of `w`, derived from it, so that the common shapes cost no
+    /// multiplications by `±1` or `0` on the hot path (same values to the bit).
+    shape: Shape,
+    /// `i` for [`Shape::Dof`]`(i)`, else `N`: the commonest shape as one comparison.
+    dof: usize,
+}
+
+/// The sparsity pattern of a coordinate's weights (and whether its offset is zero).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Shape {
+    /// `w = e_i`, `o = 0`.
+    Dof(usize),
+    /// `w = e_i`, `o ≠ 0`.
+    DofOffset(usize),
+    /// `w = e_plus − e_minus`.
+    Pair { plus: usize, minus: usize },
+    /// Anything else.
+    General,
+}
+
+impl Shape {
+    fn of<T: Real, const N: usize>(w: &SVector<T, N>, offset: T) -> Self {
+        let mut nonzero = (0..N).filter(|&k| w[k] != T::zero());
+        let (one, minus_one) = (T::one(), -T::one());
+        match (nonzero.next(), nonzero.next(), nonzero.next()) {
+            (Some(i), None, None) if w[i] == one && offset == T::zero() => Self::Dof(i),
+            (Some(i), None, None) if w[i] == one => Self::DofOffset(i),
+            (Some(a), Some(b), None) if w[a] == one && w[b] == minus_one => {
+                Self::Pair { plus: a, minus: b }
+            }
+            (Some(a), Some(b), None) if w[a] == minus_one && w[b] == one => {
+                Self::Pair { plus: b, minus: a }
+            }
+            _ => Self::General,
+        }
+    }
 }
 
 impl<T: Real, const N: usize> Coordinate<T, N> {
@@ -87,10 +123,7 @@ impl<T: Real, const N: usize> Coordinate<T, N> {
         check_dof::<N>(i)?;
         let mut weights = SVector::zeros();
         weights[i] = T::one();
-        Ok(Self {
-            weights,
-            offset: T::zero(),
-        })
+        Ok(Self::from_weights(weights))
     }
 
     /// The relative coordinate `q_i − q_j` (e.g. the extension of a spring from mass `j` to
@@ -108,10 +141,27 @@ impl<T: Real, const N: usize> Coordinate<T, N> {
         let mut weights = SVector::zeros();
         weights[i] = T::one();
         weights[j] = -T::one();
-        Ok(Self {
+        Ok(Self::from_weights(weights))
+    }
+
+    fn from_weights(weights: SVector<T, N>) -> Self {
+        Self {
             weights,
             offset: T::zero(),
-        })
+            shape: Shape::General,
+            dof: N,
+        }
+        .reshaped()
+    }
+
+    /// Derives `shape` and `dof` from the weights and the offset.
+    fn reshaped(mut self) -> Self {
+        self.shape = Shape::of(&self.weights, self.offset);
+        self.dof = match self.shape {
+            Shape::Dof(i) => i,
+            _ => N,
+        };
+        self
     }
 
     /// Any linear combination `Σ w_k q_k`.
@@ -127,10 +177,7 @@ impl<T: Real, const N: usize> Coordinate<T, N> {
         if !any {
             return Err(ParameterError::new("weights", 0.0, "not all zero"));
         }
-        Ok(Self {
-            weights: SVector::from(weights),
-            offset: T::zero(),
-        })
+        Ok(Self::from_weights(SVector::from(weights)))
     }
 
     /// The same coordinate plus a constant offset `o` (e.g. `q_2 − q_1 + gap`).
@@ -139,14 +186,14 @@ impl<T: Real, const N: usize> Coordinate<T, N> {
     /// [`ParameterError`] unless `offset` is finite.
     pub fn with_offset(mut self, offset: T) -> Result<Self, ParameterError> {
         self.offset = finite("offset", offset)?;
-        Ok(self)
+        Ok(self.reshaped())
     }
 
     /// The coordinate with its sign reversed, `−g` (e.g. to put a stop on the other side).
     pub fn reversed(mut self) -> Self {
         self.weights = -self.weights;
         self.offset = -self.offset;
-        self
+        self.reshaped()
     }
 
     /// The weights `w`.
@@ -159,24 +206,70 @@ impl<T: Real, const N: usize> Coordinate<T, N> {
         self.offset
     }
 
-    /// `g(q)`.
+    /// `g(q)`: `o + Σ w_k q_k` summed in index order.
     #[inline(always)]
     pub fn value(&self, q: &[T]) -> T {
-        let mut g = self.offset;
-        for (w, x) in self.weights.iter().zip(q) {
-            g += *w * *x;
-        }
-        g
+        self.combine(self.offset, q)
     }
 
     /// `ġ = w·q̇`.
     #[inline(always)]
     pub fn rate(&self, qd: &[T]) -> T {
-        let mut g = T::zero();
-        for (w, v) in self.weights.iter().zip(qd) {
-            g += *w * *v;
+        self.combine(T::zero(), qd)
+    }
+
+    /// `start + Σ w_k x_k` in index order. Terms with `w_k = 0` and multiplications by
+    /// `±1` are skipped for the sparse shapes: the same value (adding `±0` or multiplying
+    /// by `±1` is exact), without their latency on the right-hand side's critical path.
+    #[inline(always)]
+    fn combine(&self, start: T, x: &[T]) -> T {
+        // Indices are `< N` by construction; `min` states it to the compiler (no bounds
+        // check, and the index is the constant 0 for one DOF).
+        // The commonest shape first, as a plain test (`o = 0` for it, and `start` is `o`
+        // or 0).
+        if self.dof < N {
+            return x[self.dof];
         }
-        g
+        match self.shape {
+            Shape::Dof(i) | Shape::DofOffset(i) => start + x[i.min(N - 1)],
+            Shape::Pair { plus, minus } => {
+                if start == T::zero() {
+                    x[plus] - x[minus]
+                } else if plus < minus {
+                    start + x[plus] - x[minus]
+                } else {
+                    start - x[minus] + x[plus]
+                }
+            }
+            Shape::General => {
+                let mut g = start;
+                for (w, v) in self.weights.iter().zip(x) {
+                    g += *w * *v;
+                }
+                g
+            }
+        }
+    }
+
+    /// `out += w·f`.
+    #[inline(always)]
+    fn distribute(&self, f: T, out: &mut SVector<T, N>) {
+        if self.dof < N {
+            out[self.dof] += f;
+            return;
+        }
+        match self.shape {
+            Shape::Dof(i) | Shape::DofOffset(i) => out[i.min(N - 1)] += f,
+            Shape::Pair { plus, minus } => {
+                out[plus] += f;
+                out[minus] -= f;
+            }
+            Shape::General => {
+                for k in 0..N {
+                    out[k] += self.weights[k] * f;
+                }
+            }
+        }
     }
 }
 
@@ -251,9 +344,7 @@ impl<T: Real, const N: usize, L: ForceLaw<T>> Elements<T, N> for Element<T, N, L
         let g = self.coordinate.value(q);
         let gd = self.coordinate.rate(qd);
         let f = self.law.force(g, gd);
-        for k in 0..N {
-            out[k] += self.coordinate.weights[k] * f;
-        }
+        self.coordinate.distribute(f, out);
     }
 
     fn add_tangent(&self, q: &[T], qd: &[T], k: &mut SMatrix<T, N, N>, c: &mut SMatrix<T, N, N>) {
@@ -361,16 +452,12 @@ impl<T: Real, const N: usize, E: Excitation<T>> Loads<T, N> for Load<T, N, E> {
     #[inline(always)]
     fn add_forces(&self, t: T, out: &mut SVector<T, N>) {
         let f = self.excitation.force(t);
-        for k in 0..N {
-            out[k] += self.coordinate.weights[k] * f;
-        }
+        self.coordinate.distribute(f, out);
     }
     #[inline(always)]
     fn add_rates(&self, t: T, out: &mut SVector<T, N>) {
         let f = self.excitation.force_rate(t);
-        for k in 0..N {
-            out[k] += self.coordinate.weights[k] * f;
-        }
+        self.coordinate.distribute(f, out);
     }
     fn phase(&self, t: T) -> Option<T> {
         self.excitation.phase(t)
@@ -639,26 +726,30 @@ impl<T: Real, const N: usize, const M: usize, El: Elements<T, N>, Ld: Loads<T, N
     /// The generalized force `f(t) − Kq − Cq̇ − Σ w F` (the right-hand side before `M⁻¹`).
     #[inline(always)]
     pub fn generalized_force(&self, t: T, q: &[T], qd: &[T]) -> SVector<T, N> {
-        let mut f = SVector::<T, N>::zeros();
-        self.elements.add_forces(q, qd, &mut f);
-        f = -f;
+        // Accumulators start at −0, the identity of floating-point addition (−0 + x = x
+        // for every x), so the first term of each sum costs nothing once inlined: for one
+        // DOF without `K`, `C` this is `f(t) − ΣF` as in the scalar oscillator, to the bit.
+        // Loads first: their sines overlap with the laws' arithmetic (as in the scalar
+        // oscillator's `f(t) − F(x, ẋ)`).
+        let mut load = SVector::<T, N>::repeat(-T::zero());
+        self.loads.add_forces(t, &mut load);
+        let mut r = SVector::<T, N>::repeat(-T::zero());
+        self.elements.add_forces(q, qd, &mut r);
         if let Some(k) = &self.stiffness {
             for i in 0..N {
                 for j in 0..N {
-                    f[i] -= k[(i, j)] * q[j];
+                    r[i] += k[(i, j)] * q[j];
                 }
             }
         }
         if let Some(c) = &self.damping {
             for i in 0..N {
                 for j in 0..N {
-                    f[i] -= c[(i, j)] * qd[j];
+                    r[i] += c[(i, j)] * qd[j];
                 }
             }
         }
-        let mut load = SVector::<T, N>::zeros();
-        self.loads.add_forces(t, &mut load);
-        f + load
+        load - r
     }
 
     /// The tangent stiffness `K_t` and damping `C_t` at `(q, q̇)`.
@@ -747,7 +838,7 @@ impl<T: Real, const N: usize, const M: usize, El: Elements<T, N>, Ld: Loads<T, N
         for i in 0..N {
             dy[i] = qd[i];
         }
-        if self.diagonal {
+        if N == 1 || self.diagonal {
             for i in 0..N {
                 dy[N + i] = f[i] * self.inv_mass[(i, i)];
             }
@@ -806,6 +897,65 @@ mod tests {
         assert_eq!(g.value(&[1.0, 7.0, 4.0]), 3.5);
         assert_eq!(g.rate(&[1.0, 7.0, 4.0]), 3.0);
         assert_eq!(g.reversed().value(&[1.0, 7.0, 4.0]), -3.5);
+    }
+
+    #[test]
+    fn sparse_shapes_equal_the_general_linear_form_to_the_bit() {
+        // The shortcuts for e_i, e_i − e_j (and offsets, reversal) must give exactly
+        // o + Σ w_k q_k summed in index order, and distribute exactly w·F.
+        let general = |c: &Coordinate<f64, 3>, start: f64, x: &[f64]| {
+            let mut g = start;
+            for (w, v) in c.weights().iter().zip(x) {
+                g += *w * *v;
+            }
+            g
+        };
+        let coords = [
+            Coordinate::<f64, 3>::dof(1).unwrap(),
+            Coordinate::dof(2).unwrap().with_offset(0.3).unwrap(),
+            Coordinate::dof(0).unwrap().reversed(),
+            Coordinate::relative(0, 2).unwrap(),
+            Coordinate::relative(2, 0)
+                .unwrap()
+                .with_offset(-1e-3)
+                .unwrap(),
+            Coordinate::relative(1, 2)
+                .unwrap()
+                .with_offset(0.7)
+                .unwrap()
+                .reversed(),
+            Coordinate::linear([0.5, 0.0, -2.0]).unwrap(),
+        ];
+        let shapes: Vec<Shape> = coords.iter().map(|c| c.shape).collect();
+        assert!(matches!(shapes[0], Shape::Dof(1)));
+        assert!(matches!(shapes[1], Shape::DofOffset(2)));
+        assert!(matches!(shapes[2], Shape::General));
+        assert!(matches!(shapes[3], Shape::Pair { plus: 0, minus: 2 }));
+        assert!(matches!(shapes[4], Shape::Pair { plus: 2, minus: 0 }));
+        assert!(matches!(shapes[5], Shape::Pair { plus: 2, minus: 1 }));
+        assert!(matches!(shapes[6], Shape::General));
+        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
+        let mut next = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        for _ in 0..1000 {
+            let x = [next() * 1e-3, next(), next() * 1e3];
+            let f = next() * 50.0;
+            for c in &coords {
+                assert_eq!(c.value(&x).to_bits(), general(c, c.offset(), &x).to_bits());
+                assert_eq!(c.rate(&x).to_bits(), general(c, 0.0, &x).to_bits());
+                let mut out = SVector::<f64, 3>::from([0.25, -1.0, 2.0]);
+                let mut want = out;
+                for k in 0..3 {
+                    want[k] += c.weights()[k] * f;
+                }
+                c.distribute(f, &mut out);
+                assert_eq!(out, want);
+            }
+        }
     }
 
     #[test]

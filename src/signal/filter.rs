@@ -100,7 +100,7 @@ impl<T: Real> LowPass<T> {
     /// streaming use; no validation).
     #[inline]
     pub fn advance(&self, y: T, u: T, h: T) -> T {
-        y - (-h / self.theta).exp_m1() * (u - y)
+        blend(y, u, -(-h / self.theta).exp_m1())
     }
 
     fn initial_value(&self, u0: T) -> Result<T, SignalError> {
@@ -160,8 +160,7 @@ impl<T: Real> LowPass<T> {
                 b_ref = gain(h);
                 b_ref
             };
-            // y + b·(u − y) = a·y + (1 − a)·u, and leaves a constant input exactly unchanged.
-            y += b * (u_prev - y);
+            y = blend(y, u_prev, b);
             u_prev = u[n];
             u[n] = y;
             t_prev = t[n];
@@ -192,9 +191,47 @@ impl<T: Real> LowPass<T> {
     }
 }
 
+/// `y + b·(u − y)` for `b ∈ [0, 1]`: leaves a constant input exactly unchanged. When
+/// `u − y` overflows (finite values of opposite sign near the range's end) the convex
+/// combination `(1 − b)·y + b·u` is used instead, clamped to `[min(y, u), max(y, u)]`
+/// where the exact value lies, so finite inputs never give an infinite output.
+#[inline]
+fn blend<T: Real>(y: T, u: T, b: T) -> T {
+    let d = u - y;
+    if d.is_finite() {
+        y + b * d
+    } else {
+        let (lo, hi) = if y < u { (y, u) } else { (u, y) };
+        ((T::one() - b) * y + b * u).max(lo).min(hi)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn opposite_extremes_stay_finite() {
+        // u − y overflows: the output must stay finite and between the inputs.
+        let t = [0.0_f64, 1e-3, 2e-3, 3e-3];
+        let u = [1.7e308, -1.7e308, f64::MAX, -f64::MAX];
+        for init in [InitialState::FirstSample, InitialState::Zero] {
+            let y = LowPass::new(1e-3)
+                .unwrap()
+                .with_initial(init)
+                .filter(&t, &u)
+                .unwrap();
+            assert!(
+                y.iter().all(|v| v.is_finite() && v.abs() <= f64::MAX),
+                "{y:?}"
+            );
+        }
+        let f = LowPass::new(1e-3_f64).unwrap();
+        let y = f.advance(-f64::MAX, f64::MAX, 1e-3);
+        // e^{-1}·(−M) + (1 − e^{-1})·M = (1 − 2e^{-1})·M.
+        let exact = (1.0 - 2.0 * (-1.0_f64).exp()) * f64::MAX;
+        assert!((y - exact).abs() <= 1e-15 * f64::MAX, "{y} vs {exact}");
+    }
 
     #[test]
     fn rejects_bad_theta() {

@@ -128,6 +128,17 @@ pub enum SignalError {
         /// The column's name.
         column: String,
     },
+    /// A row has more fields than the header names (a misplaced delimiter or a shifted
+    /// row: which field belongs to which column is ambiguous).
+    #[error("line {line}: {found} fields but the header names {expected} columns")]
+    ExtraFields {
+        /// 1-based line (counting the header).
+        line: u64,
+        /// Fields in the row.
+        found: usize,
+        /// Columns in the header.
+        expected: usize,
+    },
     /// A field could not be parsed as a number.
     #[error("line {line}: cannot parse `{text}` in column {column} as a number")]
     ParseField {

@@ -356,12 +356,15 @@ impl TimeSeries {
         Self::from_csv_reader(io::BufReader::new(file), options)
     }
 
-    /// Reads CSV text: a header row naming the columns, then one sample per row. Extra
-    /// columns are ignored, blank lines and comment lines skipped; nothing else is dropped.
+    /// Reads CSV text: a header row naming the columns, then one sample per row. Columns
+    /// the options do not name are ignored, blank lines and comment lines skipped; nothing
+    /// else is dropped. A row may be shorter than the header as long as the columns read
+    /// are present; a row with more fields than the header is an error.
     ///
     /// # Errors
     /// Each with the 1-based line number (the header is line 1):
     /// [`SignalError::MissingField`] for a short row or an empty field,
+    /// [`SignalError::ExtraFields`] for a row with more fields than the header,
     /// [`SignalError::ParseField`] for text that is not a number,
     /// [`SignalError::NonFinite`] for NaN/∞ (also after scaling),
     /// [`SignalError::NonIncreasingTime`] when time does not increase strictly,
@@ -432,6 +435,13 @@ impl TimeSeries {
             let line = rdr
                 .get_ref()
                 .line_of(record.position().map_or(u64::MAX, |p| p.byte()));
+            if record.len() > header.len() {
+                return Err(SignalError::ExtraFields {
+                    line,
+                    found: record.len(),
+                    expected: header.len(),
+                });
+            }
             let field = |idx: usize, name: &str, scale: f64| -> Result<f64, SignalError> {
                 let text = record.get(idx).unwrap_or("");
                 if text.is_empty() {

@@ -20,7 +20,7 @@
 
 mod ramp;
 
-pub use ramp::{RampImpact, RampRecord, RampSection, ramp};
+pub use ramp::{RampImpact, RampRecord, RampSection, ramp, ramp_with_capacity};
 
 use nalgebra::SVector;
 use thiserror::Error;

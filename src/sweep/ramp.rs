@@ -37,18 +37,29 @@ pub struct RampImpact {
 }
 
 /// The records of a ramped run.
+///
+/// Memory: `24 + 8N` bytes per section (48 B for the paper's `N = 2`) and 40 B per impact;
+/// the run keeps them while it lasts, so the peak is about twice that. Bound it with
+/// [`ramp_with_capacity`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct RampRecord<const N: usize> {
     /// Stroboscopic points.
     pub sections: Vec<RampSection<N>>,
     /// Impacts.
     pub impacts: Vec<RampImpact>,
+    /// Sections passed but not stored because the capacity was reached.
+    pub dropped_sections: u64,
+    /// Impacts seen but not stored because the capacity was reached.
+    pub dropped_impacts: u64,
 }
 
 /// Runs `system` (whose forcing is `excitation`, e.g. a
 /// [`RampedRotor`](crate::excite::RampedRotor)) from `y0` at `t = 0` to `t_end`, taking
 /// stroboscopic points where the forcing phase passes `2πi` (computed exactly from the
 /// phase, never accumulated) and impacts as upward crossings of `stop`.
+///
+/// Every section and impact is kept (see [`RampRecord`] for the memory per record); use
+/// [`ramp_with_capacity`] to bound it.
 ///
 /// # Errors
 /// [`SweepError::Failed`] if the run fails.
@@ -65,13 +76,36 @@ where
     St: Stepper<f64, N>,
     E: Excitation<f64> + Clone,
 {
+    ramp_with_capacity(system, excitation, stop, stepper, y0, t_end, usize::MAX)
+}
+
+/// [`ramp`] keeping at most `capacity` sections and `capacity` impacts (the first ones);
+/// the rest are counted in [`RampRecord::dropped_sections`] and
+/// [`RampRecord::dropped_impacts`]. Memory is then bounded by `capacity` whatever `t_end`.
+///
+/// # Errors
+/// [`SweepError::Failed`] if the run fails.
+pub fn ramp_with_capacity<const N: usize, S, St, E>(
+    system: S,
+    excitation: E,
+    stop: Stop,
+    stepper: St,
+    y0: SVector<f64, N>,
+    t_end: f64,
+    capacity: usize,
+) -> Result<RampRecord<N>, SweepError>
+where
+    S: Dynamics<f64, N>,
+    St: Stepper<f64, N>,
+    E: Excitation<f64> + Clone,
+{
     let fail = |e: crate::Error| SweepError::failed(f64::NAN, e);
     let ev = Event::new(StopEvent(Some(stop)), Direction::Rising);
     let mut sim = Simulation::new(system, stepper)
         .with_events(ev)
         .max_steps(usize::MAX)
         .map_err(fail)?;
-    let cap = usize::MAX;
+    let cap = capacity;
     let mut strobe = Stroboscopic::<f64, N, _>::new(PhaseClock(excitation.clone()), 0.0, cap)
         .map_err(|e| fail(e.into()))?;
     let mut impacts = ImpactSequence::new(0, stop.position, stop.velocity, stop.level, 0.0, cap)
@@ -100,5 +134,7 @@ where
                 velocity: i.velocity,
             })
             .collect(),
+        dropped_sections: strobe.dropped(),
+        dropped_impacts: impacts.dropped(),
     })
 }
