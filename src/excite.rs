@@ -85,6 +85,48 @@ impl<T: Real> Excitation<T> for () {
     }
 }
 
+/// A constant `f(t) = c`: a weight or a static preload as a [`Load`](crate::model::Load), a
+/// belt's constant velocity for a friction contact.
+///
+/// ```
+/// use nonsmooth::excite::{Constant, Excitation};
+/// let g = Constant::new(-9.81_f64)?;
+/// assert_eq!((g.force(3.0), g.force_rate(3.0)), (-9.81, 0.0));
+/// # Ok::<(), nonsmooth::ParameterError>(())
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Constant<T> {
+    value: T,
+}
+
+impl<T: Real> Constant<T> {
+    /// The constant `value`.
+    ///
+    /// # Errors
+    /// [`ParameterError`] unless `value` is finite.
+    pub fn new(value: T) -> Result<Self, ParameterError> {
+        Ok(Self {
+            value: finite("value", value)?,
+        })
+    }
+
+    /// The value.
+    pub fn value(&self) -> T {
+        self.value
+    }
+}
+
+impl<T: Real> Excitation<T> for Constant<T> {
+    #[inline(always)]
+    fn force(&self, _t: T) -> T {
+        self.value
+    }
+    #[inline(always)]
+    fn force_rate(&self, _t: T) -> T {
+        T::zero()
+    }
+}
+
 /// Harmonic forcing `F0·sin(ωt + φ0)`.
 ///
 /// # Model

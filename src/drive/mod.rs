@@ -25,9 +25,13 @@
 
 use nalgebra::SVector;
 
+pub mod modes;
+pub mod stick_slip;
 pub mod sticking;
 
-pub use sticking::{Constrained, ModeLog, run_with_sticking};
+pub use modes::{ModeRun, ModeSystem, Segment, run_modes};
+pub use stick_slip::{Coulomb, SlipMode, StickSlip};
+pub use sticking::{Constrained, ContactMode, ModeLog, RigidContact, run_with_sticking};
 
 use crate::error::Result;
 use crate::event::{Direction, EventError, EventHistory, EventSet, MAX_EVENTS, ZenoGuard, locate};

@@ -24,6 +24,7 @@
 
 use nalgebra::SVector;
 
+use super::modes::{ModeSystem, Segment, run_modes};
 use super::{Observer, Outcome, Simulation, Termination};
 use crate::error::Result;
 use crate::event::{Direction, Event, EventError, EventFunction, Gap, NewtonImpact};
@@ -166,10 +167,141 @@ pub struct ModeLog<T> {
     pub release: Vec<T>,
 }
 
+/// The modes of [`RigidContact`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ContactMode {
+    /// Free flight with impacts.
+    Free,
+    /// Moving with the surface under a compressive constraint force.
+    Stuck,
+}
+
+/// Rigid contact on a [`Gap`] as a [`ModeSystem`]: free flight with Newton impacts ↔
+/// sticking to the surface (see the [module docs](self)).
+pub struct RigidContact<'a, T, const N: usize, const M: usize, El, Ld, S, St>
+where
+    T: Real,
+    El: Elements<T, N>,
+    Ld: Loads<T, N>,
+    S: Excitation<T>,
+{
+    constrained: Constrained<'a, T, N, M, El, Ld, S>,
+    free: FreeFlight<T, N, M, El, Ld, S, St>,
+    stuck: Sticking<'a, T, N, M, El, Ld, S, St>,
+}
+
+/// The free mode's simulation: the model with its impact event.
+type FreeFlight<T, const N: usize, const M: usize, El, Ld, S, St> =
+    Simulation<T, M, Mechanical<T, N, M, El, Ld>, St, Event<Gap<T, N, S>, NewtonImpact<T, N, S>>>;
+
+/// The sticking mode's simulation: the constrained motion with its release event.
+type Sticking<'a, T, const N: usize, const M: usize, El, Ld, S, St> = Simulation<
+    T,
+    M,
+    Constrained<'a, T, N, M, El, Ld, S>,
+    St,
+    Event<Release<'a, T, N, M, El, Ld, S>>,
+>;
+
+impl<'a, T, const N: usize, const M: usize, El, Ld, S, St> RigidContact<'a, T, N, M, El, Ld, S, St>
+where
+    T: Real,
+    El: Elements<T, N> + Clone,
+    Ld: Loads<T, N> + Clone,
+    S: Excitation<T> + Clone,
+    St: Stepper<T, M>,
+{
+    /// `model` with rigid impacts `impact` on `gap` (the impact's gap), each mode with a
+    /// stepper made by `stepper()`.
+    pub fn new<F: Fn() -> St>(
+        model: &'a Mechanical<T, N, M, El, Ld>,
+        gap: &'a Gap<T, N, S>,
+        impact: &NewtonImpact<T, N, S>,
+        stepper: F,
+    ) -> Self {
+        let constrained = Constrained::new(model, gap);
+        Self {
+            constrained,
+            free: Simulation::new(model.clone(), stepper())
+                .with_events(Event::new(gap.clone(), Direction::Rising).with_reset(impact.clone())),
+            stuck: Simulation::new(constrained, stepper())
+                .with_events(Event::new(Release(constrained), Direction::Falling).terminal()),
+        }
+    }
+
+    /// Whether the constraint force at `(t, y)` (on the surface) is compressive.
+    fn compressive(&self, t: T, y: &SVector<T, M>) -> bool {
+        -self.constrained.gap.sign() * self.constrained.multiplier(t, y).1 > T::zero()
+    }
+}
+
+impl<T, const N: usize, const M: usize, El, Ld, S, St> ModeSystem<T, M>
+    for RigidContact<'_, T, N, M, El, Ld, S, St>
+where
+    T: Real,
+    El: Elements<T, N> + Clone,
+    Ld: Loads<T, N> + Clone,
+    S: Excitation<T> + Clone,
+    St: Stepper<T, M>,
+{
+    type Mode = ContactMode;
+
+    fn segment<O: Observer<T, M>>(
+        &mut self,
+        mode: ContactMode,
+        t: T,
+        y: SVector<T, M>,
+        t_end: T,
+        observer: &mut O,
+    ) -> Result<Segment<T, M, ContactMode>> {
+        match mode {
+            ContactMode::Free => match self.free.run(t, y, t_end, observer) {
+                // Free flight until t_end, an accumulation or a catch.
+                Ok(outcome) => Ok(Segment {
+                    outcome,
+                    next: None,
+                }),
+                Err(crate::Error::Event(EventError::Zeno { .. }))
+                | Err(crate::Error::Event(EventError::Sticking { .. })) => {
+                    let (ts, ys) = self.free.stepper().current();
+                    let (ts, mut ys) = (ts, *ys);
+                    self.constrained.project(ts, &mut ys);
+                    // Stick only while the constraint force is compressive; else fly on.
+                    let next = if self.compressive(ts, &ys) {
+                        ContactMode::Stuck
+                    } else {
+                        ContactMode::Free
+                    };
+                    Ok(Segment {
+                        outcome: Outcome {
+                            t: ts,
+                            y: ys,
+                            termination: Termination::TerminalEvent(0),
+                            stats: *self.free.stepper().stats(),
+                        },
+                        next: Some(next),
+                    })
+                }
+                Err(e) => Err(e),
+            },
+            ContactMode::Stuck => {
+                let outcome = self.stuck.run(t, y, t_end, observer)?;
+                let next = match outcome.termination {
+                    Termination::TerminalEvent(_) => Some(ContactMode::Free),
+                    _ => None,
+                };
+                Ok(Segment { outcome, next })
+            }
+        }
+    }
+}
+
 /// Runs `model` with rigid impacts `impact` from `(t0, y0)` to `t_end` through chattering,
 /// sticking and release (see the [module docs](self)), streaming both modes to `observer`
-/// (it sees `on_start` at each mode change). `stepper()` makes a fresh stepper per mode
-/// segment; at most `max_segments` mode changes.
+/// (it sees `on_start` at each mode change). `stepper()` makes a fresh stepper per mode;
+/// at most `max_segments` mode segments. The same run as [`run_modes`] on a
+/// [`RigidContact`] started in free flight, with the transitions split into stick and
+/// release times.
 ///
 /// # Errors
 /// Integration and event errors other than the accumulation and sticking that this function
@@ -195,49 +327,25 @@ where
     O: Observer<T, M>,
 {
     let gap = impact.gap().clone();
-    let constrained = Constrained::new(model, &gap);
+    let mut system = RigidContact::new(model, &gap, impact, stepper);
+    let run = run_modes(
+        &mut system,
+        ContactMode::Free,
+        t0,
+        y0,
+        t_end,
+        max_segments,
+        observer,
+    )?;
     let mut log = ModeLog {
         stick: Vec::new(),
         release: Vec::new(),
     };
-    let (mut t, mut y) = (t0, y0);
-    let mut free = Simulation::new(model.clone(), stepper())
-        .with_events(Event::new(gap.clone(), Direction::Rising).with_reset(impact.clone()));
-    let mut sticky = Simulation::new(constrained, stepper())
-        .with_events(Event::new(Release(constrained), Direction::Falling).terminal());
-    for _ in 0..max_segments {
-        // Free flight until t_end, an accumulation or a catch.
-        match free.run(t, y, t_end, observer) {
-            Ok(out) => return Ok((out, log)),
-            Err(crate::Error::Event(EventError::Zeno { .. }))
-            | Err(crate::Error::Event(EventError::Sticking { .. })) => {
-                let (ts, ys) = free.stepper().current();
-                t = ts;
-                y = *ys;
-            }
-            Err(e) => return Err(e),
-        }
-        if t >= t_end {
-            break;
-        }
-        constrained.project(t, &mut y);
-        // Stick only while the constraint force is compressive; otherwise fly on.
-        if -gap.sign() * constrained.multiplier(t, &y).1 > T::zero() {
-            log.stick.push(t);
-            let out = sticky.run(t, y, t_end, observer)?;
-            t = out.t;
-            y = out.y;
-            if out.termination == Termination::ReachedEnd {
-                return Ok((out, log));
-            }
-            log.release.push(t);
+    for (t, mode) in run.transitions {
+        match mode {
+            ContactMode::Stuck => log.stick.push(t),
+            ContactMode::Free => log.release.push(t),
         }
     }
-    Err(EventError::Zeno {
-        t: crate::scalar::to_f64(t),
-        count: max_segments,
-        last_interval: 0.0,
-        state: y.iter().map(|&v| crate::scalar::to_f64(v)).collect(),
-    }
-    .into())
+    Ok((run.outcome, log))
 }
