@@ -6,10 +6,14 @@
 //!   including the stiff phase in resting contact).
 //! - `w2_100`: 100 periods on the attractor (from the state after 100 periods).
 //!
+//! - `paper_model_w2_100`: `w2_100` at rtol 1e-8 with the model as the scalar oscillator and
+//!   as a 1-DOF `Mechanical` system.
+//!
 //! Time per period = reported time / 100.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use nalgebra::Vector2;
+use nonsmooth::Dynamics;
 use nonsmooth::drive::Simulation;
 use nonsmooth::event::{Direction, Event, Level};
 use nonsmooth::integrate::{Dop853, Dopri5, Stepper, Tolerances};
@@ -24,10 +28,18 @@ fn tol(rtol: f64) -> Tolerances<f64, 2> {
 }
 
 fn run<St: Stepper<f64, 2>>(st: St, y0: Vector2<f64>, periods: u32) -> (usize, Vector2<f64>) {
+    run_system(PAPER.oscillator::<f64>(OMEGA).unwrap(), st, y0, periods)
+}
+
+fn run_system<S: Dynamics<f64, 2>, St: Stepper<f64, 2>>(
+    system: S,
+    st: St,
+    y0: Vector2<f64>,
+    periods: u32,
+) -> (usize, Vector2<f64>) {
     let period = std::f64::consts::TAU / OMEGA;
-    let osc = PAPER.oscillator::<f64>(OMEGA).unwrap();
     let ev = Event::new(Level::new(0, PAPER.x_i).unwrap(), Direction::Rising);
-    let mut sim = Simulation::new(osc, st)
+    let mut sim = Simulation::new(system, st)
         .with_events(ev)
         .landing_grid(Some((0.0, period)))
         .unwrap();
@@ -60,6 +72,24 @@ fn bench(c: &mut Criterion) {
             b.iter(|| black_box(run(Dop853::new(tol(rtol)), on_attractor, 100)))
         });
     }
+    g.finish();
+    // The same W2 run with the paper's model as the scalar oscillator and as a 1-DOF
+    // `Mechanical` system (bit-identical trajectories): the N-DOF builder's cost on a whole
+    // run, as a ratio in one run.
+    let mut g = c.benchmark_group("paper_model_w2_100");
+    g.sample_size(20);
+    let mech = PAPER.mechanical::<f64>(OMEGA).unwrap();
+    assert_eq!(
+        run_system(mech, Dopri5::new(tol(1e-8)), on_attractor, 10).1,
+        run(Dopri5::new(tol(1e-8)), on_attractor, 10).1,
+        "the two forms must give the same trajectory"
+    );
+    g.bench_function("oscillator/1e-8", |b| {
+        b.iter(|| black_box(run(Dopri5::new(tol(1e-8)), on_attractor, 100)))
+    });
+    g.bench_function("mechanical/1e-8", |b| {
+        b.iter(|| black_box(run_system(mech, Dopri5::new(tol(1e-8)), on_attractor, 100)))
+    });
     g.finish();
 }
 

@@ -563,6 +563,8 @@ pub struct Mechanical<T: Real, const N: usize, const M: usize, El = (), Ld = ()>
     diagonal: bool,
     stiffness: Option<SMatrix<T, N, N>>,
     damping: Option<SMatrix<T, N, N>>,
+    /// `[K | C]` (an absent matrix as zeros) if either is given: one test on the hot path.
+    linear: Option<SMatrix<T, N, M>>,
     elements: El,
     loads: Ld,
 }
@@ -587,6 +589,7 @@ impl<T: Real, const N: usize, const M: usize> Mechanical<T, N, M, (), ()> {
             diagonal: true,
             stiffness: None,
             damping: None,
+            linear: None,
             elements: (),
             loads: (),
         })
@@ -627,6 +630,7 @@ impl<T: Real, const N: usize, const M: usize> Mechanical<T, N, M, (), ()> {
             diagonal,
             stiffness: None,
             damping: None,
+            linear: None,
             elements: (),
             loads: (),
         })
@@ -660,6 +664,7 @@ impl<T: Real, const N: usize, const M: usize, El, Ld> Mechanical<T, N, M, El, Ld
             diagonal: self.diagonal,
             stiffness: self.stiffness,
             damping: self.damping,
+            linear: self.linear,
             elements,
             loads: self.loads,
         }
@@ -673,9 +678,26 @@ impl<T: Real, const N: usize, const M: usize, El, Ld> Mechanical<T, N, M, El, Ld
             diagonal: self.diagonal,
             stiffness: self.stiffness,
             damping: self.damping,
+            linear: self.linear,
             elements: self.elements,
             loads,
         }
+    }
+
+    /// `[K | C]`, an absent matrix as zeros.
+    fn linear_part(&self) -> SMatrix<T, N, M> {
+        let mut kc = SMatrix::<T, N, M>::zeros();
+        for i in 0..N {
+            for j in 0..N {
+                if let Some(k) = &self.stiffness {
+                    kc[(i, j)] = k[(i, j)];
+                }
+                if let Some(c) = &self.damping {
+                    kc[(i, N + j)] = c[(i, j)];
+                }
+            }
+        }
+        kc
     }
 
     /// Sets the linear stiffness matrix `K` (not required to be symmetric: follower forces
@@ -686,6 +708,7 @@ impl<T: Real, const N: usize, const M: usize, El, Ld> Mechanical<T, N, M, El, Ld
     pub fn with_stiffness(mut self, k: SMatrix<T, N, N>) -> Result<Self, ModelError> {
         check_finite("stiffness", &k)?;
         self.stiffness = Some(k);
+        self.linear = Some(self.linear_part());
         Ok(self)
     }
 
@@ -696,6 +719,7 @@ impl<T: Real, const N: usize, const M: usize, El, Ld> Mechanical<T, N, M, El, Ld
     pub fn with_damping(mut self, c: SMatrix<T, N, N>) -> Result<Self, ModelError> {
         check_finite("damping", &c)?;
         self.damping = Some(c);
+        self.linear = Some(self.linear_part());
         Ok(self)
     }
 
@@ -735,17 +759,14 @@ impl<T: Real, const N: usize, const M: usize, El: Elements<T, N>, Ld: Loads<T, N
         self.loads.add_forces(t, &mut load);
         let mut r = SVector::<T, N>::repeat(-T::zero());
         self.elements.add_forces(q, qd, &mut r);
-        if let Some(k) = &self.stiffness {
+        // K q then C q̇, each summed in index order (an absent matrix adds zeros).
+        if let Some(kc) = &self.linear {
             for i in 0..N {
                 for j in 0..N {
-                    r[i] += k[(i, j)] * q[j];
+                    r[i] += kc[(i, j)] * q[j];
                 }
-            }
-        }
-        if let Some(c) = &self.damping {
-            for i in 0..N {
                 for j in 0..N {
-                    r[i] += c[(i, j)] * qd[j];
+                    r[i] += kc[(i, N + j)] * qd[j];
                 }
             }
         }
