@@ -54,6 +54,9 @@ pub enum Error {
     /// A Lyapunov estimate failed.
     #[error(transparent)]
     Lyapunov(#[from] crate::lyapunov::LyapunovError),
+    /// A periodic orbit could not be computed.
+    #[error(transparent)]
+    Orbit(#[from] crate::orbit::OrbitError),
     /// An entropy estimate failed.
     #[error(transparent)]
     Entropy(#[from] crate::entropy::EntropyError),

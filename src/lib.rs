@@ -58,6 +58,7 @@ pub mod integrate;
 pub mod linalg;
 pub mod lyapunov;
 pub mod model;
+pub mod orbit;
 pub mod output;
 pub mod roots;
 pub mod sample;

@@ -241,6 +241,16 @@ pub struct Saltation<T: Real, S, E, const N: usize, const K: usize> {
 impl<T: Real, S: Dynamics<T, N>, E: EventSet<T, N>, const N: usize, const K: usize>
     Saltation<T, S, E, N, K>
 {
+    /// `events` of `system` lifted to its variational system with tangent vectors scaled by
+    /// `scales` (see [`Norm`]).
+    pub(crate) fn new(system: S, events: E, scales: SVector<T, N>) -> Self {
+        Self {
+            system,
+            events,
+            scales,
+        }
+    }
+
     fn state<const M: usize>(z: &SVector<T, M>) -> SVector<T, N> {
         let mut y = SVector::<T, N>::zeros();
         for i in 0..N {

@@ -1,0 +1,325 @@
+//! Periodic orbits of periodically forced systems by shooting, their monodromy matrix and
+//! Floquet multipliers — stable and unstable orbits alike, with contact (compliant laws) and
+//! rigid impacts (resets, through saltation matrices).
+//!
+//! # Method
+//! For forcing of period `T` the stroboscopic map `P(y) = φ(t₀ + kT; t₀, y)` (the flow over
+//! `k` periods) has the orbit's point as a fixed point. Newton's method on
+//! `F(y) = P(y) − y` needs `∂P/∂y = Φ`, the monodromy matrix, which is integrated with the
+//! state: the variational equations `Φ̇ = J(t, y)Φ`, `Φ(t₀) = I` between events
+//! ([`Variational`]), and `Φ⁺ = S Φ⁻` across each reset, `S` the saltation matrix
+//! ([`Saltation`]). Each iteration solves `(Φ − I)Δ = −F` and takes the step with
+//! backtracking on `‖F‖`. The orbit is converged when every component of the step is
+//! within the state's integration tolerance `atol_i + rtol_i|y_i|` (the flow itself is not
+//! more accurate).
+//!
+//! The eigenvalues `μ` of `Φ` at the converged orbit are its Floquet multipliers: the orbit
+//! is asymptotically stable if all `|μ| < 1`; a real `μ` leaving through `+1` is a fold, through
+//! `−1` a period doubling, a complex pair a Neimark–Sacker bifurcation. The orbit's Lyapunov
+//! exponents are `ln|μ_j| / (kT)`. Liouville's formula gives an exact check:
+//! `Π μ_j = det Φ = exp(∫ tr J dt) · Π det S` (e.g. `e^{−c kT/m}` for a linear damper).
+//!
+//! Newton does not care about stability: started near a saddle it converges to the saddle,
+//! an orbit no forward simulation shows.
+//!
+//! # Example
+//! A forced linear oscillator `ẍ + 2ζẋ + x = cos ωt`: its periodic orbit is the steady state,
+//! its multipliers `e^{(−ζ ± i√(1−ζ²))T}`.
+//! ```
+//! use nalgebra::SVector;
+//! use nonsmooth::excite::Harmonic;
+//! use nonsmooth::force::{LinearSpring, ViscousDamper};
+//! use nonsmooth::integrate::Tolerances;
+//! use nonsmooth::lyapunov::tangent_tolerances;
+//! use nonsmooth::model::{Element, Load, Mechanical};
+//! use nonsmooth::orbit::Shooting;
+//!
+//! let (zeta, omega) = (0.05, 1.3);
+//! let model = Mechanical::<f64, 1, 2>::with_masses([1.0])?
+//!     .with_elements(Element::on_dof(0, (LinearSpring::new(1.0)?, ViscousDamper::new(2.0 * zeta)?))?)
+//!     .with_loads(Load::on_dof(0, Harmonic::cosine(1.0, omega)?)?);
+//! let tol = Tolerances::new(1e-11, 1e-13)?;
+//! let shooting = Shooting::new(model, (), tangent_tolerances::<f64, 2, 2, 6>(&tol, 1e-11, 1e-13)?);
+//! let period = std::f64::consts::TAU / omega;
+//! let orbit = shooting.find(0.0, period, SVector::from([0.0, 0.0]))?;
+//! // Steady state x = A cos(ωt − δ): at t = 0, x = A cos δ = (1 − ω²)/((1 − ω²)² + (2ζω)²).
+//! let d = (1.0 - omega * omega).powi(2) + (2.0 * zeta * omega).powi(2);
+//! assert!((orbit.state[0] - (1.0 - omega * omega) / d).abs() < 1e-9);
+//! let modulus = (-zeta * period).exp();
+//! for mu in &orbit.multipliers {
+//!     assert!((mu.norm() - modulus).abs() < 1e-9);
+//! }
+//! assert!(orbit.is_stable());
+//! # Ok::<(), nonsmooth::Error>(())
+//! ```
+
+use nalgebra::{Complex, DMatrix, SMatrix, SVector};
+
+use crate::Real;
+use crate::drive::Simulation;
+use crate::dynamics::Dynamics;
+use crate::error::Result;
+use crate::event::EventSet;
+use crate::integrate::{Dopri5, Tolerances};
+use crate::linalg::Lu;
+use crate::lyapunov::{Norm, Saltation, Variational};
+use crate::scalar::{lit, to_f64};
+
+/// Why a periodic-orbit computation failed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum OrbitError {
+    /// Newton's method did not converge.
+    #[error(
+        "periodic orbit: Newton did not converge in {iterations} iterations (last step {step:e} \
+         tolerances, residual {residual:e}); start closer to the orbit or check its period"
+    )]
+    NotConverged {
+        /// Iterations done.
+        iterations: usize,
+        /// The last step in units of the integration tolerance.
+        step: f64,
+        /// `‖P(y) − y‖∞` at the last iterate.
+        residual: f64,
+    },
+    /// `Φ − I` is singular: a multiplier is exactly 1 (a fold, or an autonomous direction).
+    #[error("periodic orbit: Φ − I is singular at iteration {iteration} (a multiplier at +1)")]
+    Singular {
+        /// The iteration.
+        iteration: usize,
+    },
+    /// A parameter is invalid.
+    #[error("periodic orbit: {what} must be {requirement} (got {value})")]
+    InvalidSetting {
+        /// Which setting.
+        what: &'static str,
+        /// What it must satisfy.
+        requirement: &'static str,
+        /// The value.
+        value: f64,
+    },
+}
+
+/// A periodic orbit found by [`Shooting::find`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct PeriodicOrbit<T: Real, const N: usize> {
+    /// The section time `t₀` (the orbit's point is taken there).
+    pub t0: T,
+    /// The orbit's period `kT`.
+    pub period: T,
+    /// The state at `t₀` (and at `t₀ + kT`).
+    pub state: SVector<T, N>,
+    /// The monodromy matrix `Φ = ∂P/∂y` at the orbit.
+    pub monodromy: SMatrix<T, N, N>,
+    /// The Floquet multipliers (eigenvalues of `Φ`), largest modulus first.
+    pub multipliers: Vec<Complex<T>>,
+    /// Newton iterations used.
+    pub iterations: usize,
+    /// `‖P(y) − y‖∞` at the returned state.
+    pub residual: T,
+}
+
+impl<T: Real, const N: usize> PeriodicOrbit<T, N> {
+    /// Asymptotically stable: every multiplier inside the unit circle.
+    pub fn is_stable(&self) -> bool {
+        self.multipliers.iter().all(|m| modulus(m) < T::one())
+    }
+
+    /// The orbit's Lyapunov exponents `ln|μ_j| / period`, largest first.
+    pub fn exponents(&self) -> Vec<T> {
+        self.multipliers
+            .iter()
+            .map(|m| modulus(m).ln() / self.period)
+            .collect()
+    }
+
+    /// The top Lyapunov exponent `ln max|μ| / period`.
+    pub fn top_exponent(&self) -> T {
+        modulus(&self.multipliers[0]).ln() / self.period
+    }
+}
+
+/// Periodic orbits of `system` (with the events `events`, `()` for none) by shooting on
+/// the stroboscopic map; see the [module docs](self).
+///
+/// `M = N + N²` is the size of the state with its monodromy matrix; it is fixed by the
+/// tolerances, e.g. [`tangent_tolerances::<f64, 2, 2, 6>`](crate::lyapunov::tangent_tolerances)
+/// (the first `N` components are the state's, the rest the matrix's).
+#[derive(Debug, Clone)]
+pub struct Shooting<T: Real, S, E, const N: usize, const M: usize> {
+    system: S,
+    events: E,
+    tolerances: Tolerances<T, M>,
+    max_iterations: usize,
+    newton_tolerance: f64,
+}
+
+impl<T, S, E, const N: usize, const M: usize> Shooting<T, S, E, N, M>
+where
+    T: Real,
+    S: Dynamics<T, N> + Clone,
+    E: EventSet<T, N> + Clone,
+{
+    /// Shooting on `system` with `events`, integrating the state and its monodromy matrix
+    /// with DOPRI5 at `tolerances`; at most 50 Newton iterations, converged at 100× the
+    /// integration tolerance ([`with_newton_tolerance`](Self::with_newton_tolerance)).
+    pub fn new(system: S, events: E, tolerances: Tolerances<T, M>) -> Self {
+        Self {
+            system,
+            events,
+            tolerances,
+            max_iterations: 50,
+            newton_tolerance: 100.0,
+        }
+    }
+
+    /// Sets the convergence threshold: Newton stops when every component of its step is
+    /// within `factor` times the state's integration tolerance `atol_i + rtol_i|y_i|`
+    /// (default 100: the map `P` carries the global error of the flow, a small multiple
+    /// of the local tolerance).
+    ///
+    /// # Errors
+    /// [`OrbitError::InvalidSetting`] unless `factor` is finite and `> 0`.
+    pub fn with_newton_tolerance(mut self, factor: f64) -> Result<Self> {
+        if !(factor.is_finite() && factor > 0.0) {
+            return Err(OrbitError::InvalidSetting {
+                what: "the Newton tolerance factor",
+                requirement: "finite and > 0",
+                value: factor,
+            }
+            .into());
+        }
+        self.newton_tolerance = factor;
+        Ok(self)
+    }
+
+    /// Sets the Newton iteration cap.
+    ///
+    /// # Errors
+    /// [`OrbitError::InvalidSetting`] for 0.
+    pub fn with_max_iterations(mut self, iterations: usize) -> Result<Self> {
+        if iterations == 0 {
+            return Err(OrbitError::InvalidSetting {
+                what: "the iteration cap",
+                requirement: "at least 1",
+                value: 0.0,
+            }
+            .into());
+        }
+        self.max_iterations = iterations;
+        Ok(self)
+    }
+
+    /// The flow over `span` from `(t0, y0)` and its Jacobian `∂y(t0 + span)/∂y0` (through
+    /// the events' resets).
+    ///
+    /// # Errors
+    /// Integration and event errors of the run; [`LyapunovError`](crate::lyapunov::LyapunovError)
+    /// if `M ≠ N + N²` or the system has no Jacobian.
+    pub fn flow(
+        &self,
+        t0: T,
+        y0: SVector<T, N>,
+        span: T,
+    ) -> Result<(SVector<T, N>, SMatrix<T, N, N>)> {
+        let var = Variational::<T, S, N, N, M>::new(self.system.clone(), Norm::Euclidean)?;
+        let lifted = Saltation::<T, S, E, N, N>::new(
+            self.system.clone(),
+            self.events.clone(),
+            SVector::repeat(T::one()),
+        );
+        let z0 = var.join(&y0, &SMatrix::<T, N, N>::identity());
+        let mut sim = Simulation::new(var, Dopri5::new(self.tolerances)).with_events(lifted);
+        let out = sim.run(t0, z0, t0 + span, &mut ())?;
+        let (y, phi) = sim.system().split(&out.y);
+        Ok((y, phi))
+    }
+
+    /// The periodic orbit of period `period` (the forcing period `T` times `k` for a
+    /// period-`k` orbit) through the section at `t0`, by Newton's method from `guess`.
+    ///
+    /// # Errors
+    /// [`OrbitError::InvalidSetting`] for a period that is not finite and `> 0`,
+    /// [`OrbitError::Singular`], [`OrbitError::NotConverged`], and the errors of
+    /// [`flow`](Self::flow).
+    pub fn find(&self, t0: T, period: T, guess: SVector<T, N>) -> Result<PeriodicOrbit<T, N>> {
+        if !(period.is_finite() && period > T::zero()) {
+            return Err(OrbitError::InvalidSetting {
+                what: "the period",
+                requirement: "finite and > 0",
+                value: to_f64(period),
+            }
+            .into());
+        }
+        let mut y = guess;
+        let (p, mut phi) = self.flow(t0, y, period)?;
+        let mut residual = p - y;
+        let mut step = f64::INFINITY;
+        for iteration in 0..self.max_iterations {
+            let jac = phi - SMatrix::<T, N, N>::identity();
+            let lu = Lu::new(jac).ok_or(OrbitError::Singular { iteration })?;
+            let delta = lu.solve(&(-residual));
+            // Backtracking on ‖P(y) − y‖: the full step, halved while the residual grows.
+            let mut lambda = T::one();
+            let mut accepted = None;
+            for _ in 0..12 {
+                let trial = y + delta * lambda;
+                if let Ok((p_t, phi_t)) = self.flow(t0, trial, period) {
+                    let r_t = p_t - trial;
+                    if r_t.amax() < residual.amax() || lambda < lit(1e-3) {
+                        accepted = Some((trial, phi_t, r_t));
+                        break;
+                    }
+                }
+                lambda *= lit(0.5);
+            }
+            let Some((trial, phi_t, r_t)) = accepted else {
+                break;
+            };
+            let taken = trial - y;
+            step = (0..N)
+                .map(|i| {
+                    let scale = self.tolerances.atol[i] + self.tolerances.rtol[i] * trial[i].abs();
+                    to_f64(taken[i].abs() / scale)
+                })
+                .fold(0.0, f64::max);
+            y = trial;
+            phi = phi_t;
+            residual = r_t;
+            if step <= self.newton_tolerance {
+                return Ok(PeriodicOrbit {
+                    t0,
+                    period,
+                    state: y,
+                    monodromy: phi,
+                    multipliers: multipliers(&phi),
+                    iterations: iteration + 1,
+                    residual: residual.amax(),
+                });
+            }
+        }
+        Err(OrbitError::NotConverged {
+            iterations: self.max_iterations,
+            step,
+            residual: to_f64(residual.amax()),
+        }
+        .into())
+    }
+}
+
+/// The eigenvalues of `phi`, largest modulus first.
+pub fn multipliers<T: Real, const N: usize>(phi: &SMatrix<T, N, N>) -> Vec<Complex<T>> {
+    let dynamic = DMatrix::from_iterator(N, N, phi.iter().copied());
+    let mut mu: Vec<Complex<T>> = dynamic.complex_eigenvalues().iter().copied().collect();
+    mu.sort_by(|a, b| {
+        modulus(b)
+            .partial_cmp(&modulus(a))
+            .unwrap_or(std::cmp::Ordering::Equal)
+    });
+    mu
+}
+
+/// `|μ|`.
+pub fn modulus<T: Real>(mu: &Complex<T>) -> T {
+    mu.re.hypot(mu.im)
+}
