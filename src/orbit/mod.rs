@@ -65,6 +65,13 @@ use crate::linalg::Lu;
 use crate::lyapunov::{Norm, Saltation, Variational};
 use crate::scalar::{lit, to_f64};
 
+pub mod continuation;
+
+pub use continuation::{
+    Bifurcation, BifurcationKind, Branch, BranchEnd, BranchPoint, ContinuationSettings, Grazing,
+    follow,
+};
+
 /// Why a periodic-orbit computation failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
@@ -304,6 +311,134 @@ where
             residual: to_f64(residual.amax()),
         }
         .into())
+    }
+}
+
+/// Which extremum of a component along an orbit ([`Shooting::extremum`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Extremum {
+    /// The smallest value (e.g. the gap to a stop below the motion).
+    Min,
+    /// The largest value.
+    Max,
+}
+
+/// The rate `ẏ_c` of one component, as an event function (its zeros are the component's
+/// extrema).
+#[derive(Debug, Clone)]
+struct Rate<S> {
+    system: S,
+    component: usize,
+}
+
+impl<T: Real, const N: usize, S: Dynamics<T, N>> crate::event::EventFunction<T, N> for Rate<S> {
+    fn value(&self, t: T, y: &SVector<T, N>) -> T {
+        let mut dy = SVector::<T, N>::zeros();
+        self.system.rhs(t, y, &mut dy);
+        dy[self.component]
+    }
+}
+
+/// Tracks the extremum of one component at the rate event and the run's ends.
+struct Extrema<T> {
+    component: usize,
+    event: usize,
+    which: Extremum,
+    best: Option<T>,
+}
+
+impl<T: Real> Extrema<T> {
+    fn offer(&mut self, v: T) {
+        let better = match (self.best, self.which) {
+            (None, _) => true,
+            (Some(b), Extremum::Min) => v < b,
+            (Some(b), Extremum::Max) => v > b,
+        };
+        if better {
+            self.best = Some(v);
+        }
+    }
+}
+
+impl<T: Real, const N: usize> crate::drive::Observer<T, N> for Extrema<T> {
+    fn on_start(&mut self, _t0: T, y0: &SVector<T, N>) {
+        self.offer(y0[self.component]);
+    }
+    fn on_event(&mut self, event: &crate::drive::EventRecord<T, N>) -> crate::drive::Control {
+        if event.index == self.event {
+            self.offer(event.y[self.component]);
+        }
+        crate::drive::Control::Continue
+    }
+    fn on_finish(&mut self, outcome: &crate::drive::Outcome<T, N>) {
+        self.offer(outcome.y[self.component]);
+    }
+}
+
+impl<T, S, E, const N: usize, const M: usize> Shooting<T, S, E, N, M>
+where
+    T: Real,
+    S: Dynamics<T, N> + Clone,
+    E: EventSet<T, N> + Clone,
+{
+    /// The state's tolerances (the first `N` components of the shooting tolerances).
+    pub fn state_tolerances(&self) -> Tolerances<T, N> {
+        let mut tol = Tolerances {
+            rtol: SVector::<T, N>::zeros(),
+            atol: SVector::<T, N>::zeros(),
+        };
+        for i in 0..N {
+            tol.rtol[i] = self.tolerances.rtol[i];
+            tol.atol[i] = self.tolerances.atol[i];
+        }
+        tol
+    }
+
+    /// The smallest or largest value of component `component` along the trajectory from
+    /// `(t0, y)` over `span` (an orbit's period): at the zeros of its rate `ẏ_c` located on
+    /// the dense output (to the event time tolerance), and at both ends. With `component` a
+    /// position and `span` the period of an orbit, `min − level` is the orbit's grazing
+    /// margin to a stop at `level`.
+    ///
+    /// # Errors
+    /// [`OrbitError::InvalidSetting`] for `component ≥ N`; the run's errors.
+    pub fn extremum(
+        &self,
+        t0: T,
+        span: T,
+        y: SVector<T, N>,
+        component: usize,
+        which: Extremum,
+    ) -> Result<T> {
+        if component >= N {
+            return Err(OrbitError::InvalidSetting {
+                what: "the component",
+                requirement: "below the state size",
+                value: component as f64,
+            }
+            .into());
+        }
+        let direction = match which {
+            Extremum::Min => crate::event::Direction::Rising,
+            Extremum::Max => crate::event::Direction::Falling,
+        };
+        let rate = crate::event::Event::new(
+            Rate {
+                system: self.system.clone(),
+                component,
+            },
+            direction,
+        );
+        let mut observer = Extrema {
+            component,
+            event: E::LEN,
+            which,
+            best: None,
+        };
+        let mut sim = Simulation::new(self.system.clone(), Dopri5::new(self.state_tolerances()))
+            .with_events((self.events.clone(), rate));
+        sim.run(t0, y, t0 + span, &mut observer)?;
+        Ok(observer.best.unwrap_or(y[component]))
     }
 }
 

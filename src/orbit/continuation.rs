@@ -1,0 +1,697 @@
+//! Continuation of periodic orbits in a parameter: pseudo-arclength with step control,
+//! through folds, with the bifurcations on the way located (not gridded).
+//!
+//! # Method
+//! A periodic orbit of period `T(p)` through the section at `t₀` solves
+//! `F(y, p) = P_p(y) − y = 0` (`N` equations, `N + 1` unknowns). In scaled unknowns
+//! `u = (y/s_y, p/s_p)` the branch is followed by a tangent predictor `u + Δs·τ` and a Newton
+//! corrector on
+//! $$ \begin{pmatrix} F(y, p) \\ \tau\cdot(u - u_{\text{pred}}) \end{pmatrix} = 0, \qquad
+//!    J = \begin{pmatrix} \Phi - I & F_p \\ \tau^{\mathsf T} \end{pmatrix}, $$
+//! `Φ` the monodromy matrix (integrated with the orbit, through resets) and `F_p` a central
+//! difference in `p`. The new tangent solves `(Φ − I, F_p)τ = 0`, `τ·τ_prev = 1`
+//! (normalized), so folds are passed without turning back. The step grows after easy
+//! corrections (≤ 3 Newton steps) and is halved after failed ones.
+//!
+//! # Bifurcations and grazing
+//! Test functions are evaluated at every point and a sign change between two points is
+//! located by the Illinois method on the arclength (each trial corrected onto the branch)
+//! to `locate_tolerance` in `p`:
+//! - **fold** (a multiplier through +1): the `p` component of the tangent, `τ_p`;
+//! - **period doubling** (a multiplier through −1): `det(Φ + I) = Π(μ_i + 1)`;
+//! - **Neimark–Sacker** (a complex pair through the unit circle): `Re Π_{i<j}(μ_iμ_j − 1)`,
+//!   kept only where the located multipliers are a complex pair on the unit circle (a real
+//!   pair with `μ_iμ_j = 1`, a neutral saddle, is not a bifurcation);
+//! - **grazing** (optional, [`Grazing`]): the orbit's extremum of a position minus a
+//!   contact level ([`Shooting::extremum`]), whose zero is where the orbit touches the
+//!   surface and the number of impacts per period changes.
+//!
+//! # Example
+//! The steady state of `ẍ + 2ζẋ + x = cos ωt` followed in `ω` (exact: `x(0) = (1 − ω²)/d`,
+//! `d = (1 − ω²)² + (2ζω)²`):
+//! ```
+//! use nalgebra::SVector;
+//! use nonsmooth::excite::Harmonic;
+//! use nonsmooth::force::{LinearSpring, ViscousDamper};
+//! use nonsmooth::integrate::Tolerances;
+//! use nonsmooth::lyapunov::tangent_tolerances;
+//! use nonsmooth::model::{Element, Load, Mechanical};
+//! use nonsmooth::orbit::{ContinuationSettings, Shooting, follow};
+//!
+//! let zeta = 0.1;
+//! let tol = Tolerances::new(1e-10, 1e-12)?;
+//! let build = |w: f64| -> nonsmooth::Result<_> {
+//!     let model = Mechanical::<f64, 1, 2>::with_masses([1.0])?
+//!         .with_elements(Element::on_dof(0, (LinearSpring::new(1.0)?, ViscousDamper::new(2.0 * zeta)?))?)
+//!         .with_loads(Load::on_dof(0, Harmonic::cosine(1.0, w)?)?);
+//!     Ok(Shooting::new(model, (), tangent_tolerances::<f64, 2, 2, 6>(&tol, 1e-10, 1e-12)?))
+//! };
+//! let period = |w: f64| std::f64::consts::TAU / w;
+//! let settings = ContinuationSettings::new(0.5, 0.9, 0.05)?;
+//! let branch = follow(build, period, 0.0, 0.5, SVector::zeros(), &settings)?;
+//! assert!(branch.points.len() > 3 && branch.bifurcations.is_empty());
+//! for q in &branch.points {
+//!     let d = (1.0 - q.p * q.p).powi(2) + (2.0 * zeta * q.p).powi(2);
+//!     assert!((q.state[0] - (1.0 - q.p * q.p) / d).abs() < 1e-7);
+//! }
+//! # Ok::<(), nonsmooth::Error>(())
+//! ```
+//!
+//! References: E. Doedel, H. B. Keller, J. P. Kernévez, *Int. J. Bifurcation Chaos* 1
+//! (1991) 493–520 (pseudo-arclength, test functions); Yu. A. Kuznetsov, *Elements of Applied
+//! Bifurcation Theory* (2004), ch. 10.
+
+use nalgebra::{Complex, DMatrix, DVector, SMatrix, SVector};
+
+use super::{Extremum, OrbitError, Shooting, modulus, multipliers};
+use crate::Dynamics;
+use crate::error::Result;
+use crate::event::EventSet;
+
+/// A grazing test: the orbit's [`Extremum`] of `component` minus `level`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Grazing {
+    /// The position component.
+    pub component: usize,
+    /// The contact level.
+    pub level: f64,
+    /// Which extremum approaches the level (`Min` for a stop below the motion).
+    pub extremum: Extremum,
+}
+
+/// Settings of [`follow`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct ContinuationSettings {
+    step: f64,
+    min_step: f64,
+    max_step: f64,
+    max_points: usize,
+    range: (f64, f64),
+    direction: f64,
+    locate_tolerance: f64,
+    scales: Option<(Vec<f64>, f64)>,
+    grazing: Option<Grazing>,
+}
+
+impl ContinuationSettings {
+    /// Follow the branch while `p` stays in `[lo, hi]`, starting towards increasing `p`
+    /// with arclength step `step` (in scaled units, see [`with_scales`](Self::with_scales)),
+    /// steps between `step/1024` and `16·step`, at most 10 000 points, bifurcations located
+    /// to `1e-9·max(|p|, 1)`.
+    ///
+    /// # Errors
+    /// [`OrbitError::InvalidSetting`] unless `lo < hi` are finite and `step` is finite and
+    /// `> 0`.
+    pub fn new(lo: f64, hi: f64, step: f64) -> Result<Self> {
+        if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+            return Err(invalid(
+                "the parameter range",
+                "finite with lo < hi",
+                hi - lo,
+            ));
+        }
+        if !(step.is_finite() && step > 0.0) {
+            return Err(invalid("the arclength step", "finite and > 0", step));
+        }
+        Ok(Self {
+            step,
+            min_step: step / 1024.0,
+            max_step: 16.0 * step,
+            max_points: 10_000,
+            range: (lo, hi),
+            direction: 1.0,
+            locate_tolerance: 1e-9 * lo.abs().max(hi.abs()).max(1.0),
+            scales: None,
+            grazing: None,
+        })
+    }
+
+    /// Starts towards decreasing `p`.
+    #[must_use]
+    pub fn downward(mut self) -> Self {
+        self.direction = -1.0;
+        self
+    }
+
+    /// At most `points` points on the branch.
+    ///
+    /// # Errors
+    /// [`OrbitError::InvalidSetting`] for fewer than 2.
+    pub fn with_max_points(mut self, points: usize) -> Result<Self> {
+        if points < 2 {
+            return Err(invalid("the point cap", "at least 2", points as f64));
+        }
+        self.max_points = points;
+        Ok(self)
+    }
+
+    /// The largest arclength step.
+    ///
+    /// # Errors
+    /// [`OrbitError::InvalidSetting`] unless finite and at least the initial step.
+    pub fn with_max_step(mut self, max_step: f64) -> Result<Self> {
+        if !(max_step.is_finite() && max_step >= self.step) {
+            return Err(invalid(
+                "the largest step",
+                "finite and ≥ the initial step",
+                max_step,
+            ));
+        }
+        self.max_step = max_step;
+        Ok(self)
+    }
+
+    /// Locates bifurcations to `tolerance` in `p`.
+    ///
+    /// # Errors
+    /// [`OrbitError::InvalidSetting`] unless finite and `> 0`.
+    pub fn with_locate_tolerance(mut self, tolerance: f64) -> Result<Self> {
+        if !(tolerance.is_finite() && tolerance > 0.0) {
+            return Err(invalid(
+                "the location tolerance",
+                "finite and > 0",
+                tolerance,
+            ));
+        }
+        self.locate_tolerance = tolerance;
+        Ok(self)
+    }
+
+    /// The scales of the state components and of the parameter in the arclength
+    /// (default: each component's range `max − min` over the first orbit, floored at
+    /// `10⁻⁶` of its magnitude, and `max(|p₀|, 1)`).
+    ///
+    /// # Errors
+    /// [`OrbitError::InvalidSetting`] unless every scale is finite and `> 0`.
+    pub fn with_scales(mut self, state: Vec<f64>, parameter: f64) -> Result<Self> {
+        for &s in state.iter().chain(std::iter::once(&parameter)) {
+            if !(s.is_finite() && s > 0.0) {
+                return Err(invalid("a scale", "finite and > 0", s));
+            }
+        }
+        self.scales = Some((state, parameter));
+        Ok(self)
+    }
+
+    /// Also locates grazing of the orbit with a contact level.
+    #[must_use]
+    pub fn with_grazing(mut self, grazing: Grazing) -> Self {
+        self.grazing = Some(grazing);
+        self
+    }
+}
+
+fn invalid(what: &'static str, requirement: &'static str, value: f64) -> crate::Error {
+    OrbitError::InvalidSetting {
+        what,
+        requirement,
+        value,
+    }
+    .into()
+}
+
+/// The kind of a located bifurcation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum BifurcationKind {
+    /// A multiplier through +1: the branch turns back in `p`.
+    Fold,
+    /// A multiplier through −1: a period-`2k` orbit branches off.
+    PeriodDoubling,
+    /// A complex pair through the unit circle: a torus branches off.
+    NeimarkSacker,
+    /// The orbit touches the contact level: the number of impacts per period changes.
+    Grazing,
+}
+
+/// A located bifurcation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Bifurcation<const N: usize> {
+    /// What it is.
+    pub kind: BifurcationKind,
+    /// Its arclength along the branch (scaled units).
+    pub arclength: f64,
+    /// The parameter.
+    pub p: f64,
+    /// The orbit's state at the section.
+    pub state: SVector<f64, N>,
+    /// The Floquet multipliers there.
+    pub multipliers: Vec<Complex<f64>>,
+}
+
+/// A point of a branch.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BranchPoint<const N: usize> {
+    /// The arclength from the first point (scaled units, see
+    /// [`ContinuationSettings::with_scales`]).
+    pub arclength: f64,
+    /// The parameter.
+    pub p: f64,
+    /// The orbit's state at the section.
+    pub state: SVector<f64, N>,
+    /// The Floquet multipliers, largest modulus first.
+    pub multipliers: Vec<Complex<f64>>,
+    /// All multipliers inside the unit circle.
+    pub stable: bool,
+    /// The grazing margin (extremum − level) if grazing is tested.
+    pub grazing_margin: Option<f64>,
+}
+
+/// Why a branch ended.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum BranchEnd {
+    /// `p` left the range.
+    ParameterRange,
+    /// The point cap was reached.
+    MaxPoints,
+    /// The corrector failed down to the smallest step (at this `p`).
+    StepTooSmall {
+        /// The last parameter on the branch.
+        p: f64,
+    },
+}
+
+/// A followed branch.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Branch<const N: usize> {
+    /// The points in order of arclength.
+    pub points: Vec<BranchPoint<N>>,
+    /// The bifurcations, in order of arclength.
+    pub bifurcations: Vec<Bifurcation<N>>,
+    /// Why it ended.
+    pub end: BranchEnd,
+}
+
+/// A corrected point with what the next step and the tests need.
+#[derive(Debug, Clone)]
+struct Point<const N: usize> {
+    arclength: f64,
+    u: DVector<f64>,
+    p: f64,
+    y: SVector<f64, N>,
+    tangent: DVector<f64>,
+    multipliers: Vec<Complex<f64>>,
+    tests: [f64; 4],
+    margin: Option<f64>,
+}
+
+const FOLD: usize = 0;
+const PD: usize = 1;
+const NS: usize = 2;
+const GRAZE: usize = 3;
+
+/// The residual and Jacobian at one point, with the shooting problem there.
+struct Evaluation<S, E, const N: usize, const M: usize> {
+    /// `F/s_y`.
+    f: DVector<f64>,
+    /// `(D⁻¹(Φ − I)D, D⁻¹F_p s_p)`.
+    a: DMatrix<f64>,
+    shooting: Shooting<f64, S, E, N, M>,
+}
+
+/// The continuation problem: the family of shooting problems and the scales.
+struct Problem<'a, B, P, const N: usize> {
+    build: &'a B,
+    period: &'a P,
+    t0: f64,
+    sy: SVector<f64, N>,
+    sp: f64,
+    grazing: Option<Grazing>,
+}
+
+impl<B, P, S, E, const N: usize, const M: usize> Problem<'_, B, P, N>
+where
+    B: Fn(f64) -> Result<Shooting<f64, S, E, N, M>>,
+    P: Fn(f64) -> f64,
+    S: Dynamics<f64, N> + Clone,
+    E: EventSet<f64, N> + Clone,
+{
+    fn unscale(&self, u: &DVector<f64>) -> (SVector<f64, N>, f64) {
+        let mut y = SVector::<f64, N>::zeros();
+        for i in 0..N {
+            y[i] = u[i] * self.sy[i];
+        }
+        (y, u[N] * self.sp)
+    }
+
+    fn scale(&self, y: &SVector<f64, N>, p: f64) -> DVector<f64> {
+        let mut u = DVector::zeros(N + 1);
+        for i in 0..N {
+            u[i] = y[i] / self.sy[i];
+        }
+        u[N] = p / self.sp;
+        u
+    }
+
+    /// `F/s_y` and the scaled Jacobian `(D⁻¹(Φ − I)D, D⁻¹F_p s_p)`.
+    fn evaluate(&self, y: &SVector<f64, N>, p: f64) -> Result<Evaluation<S, E, N, M>> {
+        let shooting = (self.build)(p)?;
+        let (py, phi) = shooting.flow(self.t0, *y, (self.period)(p))?;
+        let h = 1e-6 * p.abs().max(self.sp);
+        let (pp, _) = (self.build)(p + h)?.flow(self.t0, *y, (self.period)(p + h))?;
+        let (pm, _) = (self.build)(p - h)?.flow(self.t0, *y, (self.period)(p - h))?;
+        let fp = (pp - pm) / (2.0 * h);
+        let mut f = DVector::zeros(N);
+        let mut a = DMatrix::zeros(N, N + 1);
+        for i in 0..N {
+            f[i] = (py[i] - y[i]) / self.sy[i];
+            for j in 0..N {
+                let d = if i == j { 1.0 } else { 0.0 };
+                a[(i, j)] = (phi[(i, j)] - d) * self.sy[j] / self.sy[i];
+            }
+            a[(i, N)] = fp[i] * self.sp / self.sy[i];
+        }
+        Ok(Evaluation { f, a, shooting })
+    }
+
+    /// Newton's corrector from the prediction `pred` with the arclength condition along
+    /// `tangent`; the point and the iterations used.
+    fn correct(
+        &self,
+        pred: &DVector<f64>,
+        tangent: &DVector<f64>,
+        reach: f64,
+    ) -> Result<(Point<N>, usize)> {
+        let mut u = pred.clone();
+        for iteration in 1..=10 {
+            let (y, p) = self.unscale(&u);
+            let Evaluation { f, a, shooting } = self.evaluate(&y, p)?;
+            let mut j = DMatrix::zeros(N + 1, N + 1);
+            let mut h = DVector::zeros(N + 1);
+            for i in 0..N {
+                for k in 0..=N {
+                    j[(i, k)] = a[(i, k)];
+                }
+                h[i] = -f[i];
+            }
+            for k in 0..=N {
+                j[(N, k)] = tangent[k];
+            }
+            h[N] = -tangent.dot(&(&u - pred));
+            let mut du = j
+                .clone()
+                .lu()
+                .solve(&h)
+                .ok_or(OrbitError::Singular { iteration })?;
+            // A Newton step longer than the predictor's is cut to it: far from the branch
+            // the linearization of a nonsmooth flow is not to be trusted.
+            let length = du.norm();
+            if length > reach {
+                du *= reach / length;
+            }
+            u += &du;
+            // Converged when the step is within 100× the integration tolerance.
+            let (y_new, p_new) = self.unscale(&u);
+            let tol = shooting.state_tolerances();
+            let small = (0..N).all(|i| {
+                (du[i] * self.sy[i]).abs() <= 100.0 * (tol.atol[i] + tol.rtol[i] * y_new[i].abs())
+            }) && (du[N] * self.sp).abs()
+                <= 100.0 * tol.rtol[0] * p_new.abs().max(self.sp);
+            if small && du.iter().all(|v| v.is_finite()) {
+                let Evaluation { a, shooting, .. } = self.evaluate(&y_new, p_new)?;
+                return Ok((
+                    self.point(u, y_new, p_new, &a, tangent, &shooting)?,
+                    iteration,
+                ));
+            }
+        }
+        Err(OrbitError::NotConverged {
+            iterations: 10,
+            step: f64::NAN,
+            residual: f64::NAN,
+        }
+        .into())
+    }
+
+    /// The point at a converged `u`: tangent, multipliers, tests.
+    fn point(
+        &self,
+        u: DVector<f64>,
+        y: SVector<f64, N>,
+        p: f64,
+        a: &DMatrix<f64>,
+        previous: &DVector<f64>,
+        shooting: &Shooting<f64, S, E, N, M>,
+    ) -> Result<Point<N>> {
+        let mut j = DMatrix::zeros(N + 1, N + 1);
+        for i in 0..N {
+            for k in 0..=N {
+                j[(i, k)] = a[(i, k)];
+            }
+        }
+        for k in 0..=N {
+            j[(N, k)] = previous[k];
+        }
+        let mut rhs = DVector::zeros(N + 1);
+        rhs[N] = 1.0;
+        let mut tangent = j
+            .lu()
+            .solve(&rhs)
+            .ok_or(OrbitError::Singular { iteration: 0 })?;
+        tangent /= tangent.norm();
+        // Φ from the scaled block: Φ_ij = a_ij s_i / s_j + δ_ij.
+        let mut phi = SMatrix::<f64, N, N>::zeros();
+        for i in 0..N {
+            for k in 0..N {
+                phi[(i, k)] = a[(i, k)] * self.sy[i] / self.sy[k] + if i == k { 1.0 } else { 0.0 };
+            }
+        }
+        let mu = multipliers(&phi);
+        let pd = mu
+            .iter()
+            .fold(Complex::new(1.0, 0.0), |acc, m| acc * (m + 1.0))
+            .re;
+        let mut ns = Complex::new(1.0, 0.0);
+        for i in 0..mu.len() {
+            for k in 0..i {
+                ns *= mu[i] * mu[k] - Complex::new(1.0, 0.0);
+            }
+        }
+        let margin = match self.grazing {
+            Some(g) => Some(
+                shooting.extremum(self.t0, (self.period)(p), y, g.component, g.extremum)? - g.level,
+            ),
+            None => None,
+        };
+        Ok(Point {
+            arclength: 0.0,
+            u,
+            p,
+            y,
+            tests: [tangent[N], pd, ns.re, margin.unwrap_or(1.0)],
+            tangent,
+            multipliers: mu,
+            margin,
+        })
+    }
+
+    /// The bifurcations between consecutive points `a` and `b` (`b` at arclength `ds` along
+    /// `a`'s tangent), located.
+    fn bifurcations(
+        &self,
+        a: &Point<N>,
+        b: &Point<N>,
+        ds: f64,
+        settings: &ContinuationSettings,
+    ) -> Result<Vec<Bifurcation<N>>> {
+        let mut found = Vec::new();
+        for which in [FOLD, PD, NS, GRAZE] {
+            if which == GRAZE && self.grazing.is_none() {
+                continue;
+            }
+            if a.tests[which].signum() == b.tests[which].signum() {
+                continue;
+            }
+            let at = self.locate(a, b, ds, which, settings.locate_tolerance)?;
+            let kind = match which {
+                FOLD => BifurcationKind::Fold,
+                PD => BifurcationKind::PeriodDoubling,
+                GRAZE => BifurcationKind::Grazing,
+                _ => {
+                    let on_circle = at
+                        .multipliers
+                        .iter()
+                        .any(|m| m.im != 0.0 && (modulus(m) - 1.0).abs() < 1e-3);
+                    if !on_circle {
+                        continue;
+                    }
+                    BifurcationKind::NeimarkSacker
+                }
+            };
+            found.push(Bifurcation {
+                kind,
+                p: at.p,
+                state: at.y,
+                multipliers: at.multipliers,
+                arclength: at.arclength,
+            });
+        }
+        found.sort_by(|x, y| x.arclength.total_cmp(&y.arclength));
+        Ok(found)
+    }
+
+    /// Locates the zero of test `which` between `a` (arclength 0) and the point at
+    /// arclength `ds` along `a`'s tangent, by the Illinois method.
+    fn locate(
+        &self,
+        a: &Point<N>,
+        b: &Point<N>,
+        ds: f64,
+        which: usize,
+        tolerance: f64,
+    ) -> Result<Point<N>> {
+        let (mut lo, mut hi) = (0.0, ds);
+        let (mut f_lo, mut f_hi) = (a.tests[which], b.tests[which]);
+        let mut best = b.clone();
+        let mut p_prev = b.p;
+        let mut side = 0i8;
+        for _ in 0..60 {
+            let s = (lo * f_hi - hi * f_lo) / (f_hi - f_lo);
+            let s = if s.is_finite() && s > lo && s < hi {
+                s
+            } else {
+                0.5 * (lo + hi)
+            };
+            let pred = &a.u + &a.tangent * s;
+            let (mut pt, _) = self.correct(&pred, &a.tangent, ds)?;
+            pt.arclength = a.arclength + s;
+            let f = pt.tests[which];
+            let done = (pt.p - p_prev).abs() <= tolerance || f == 0.0;
+            p_prev = pt.p;
+            best = pt;
+            if done {
+                break;
+            }
+            if f.signum() == f_lo.signum() {
+                lo = s;
+                f_lo = f;
+                if side == -1 {
+                    f_hi *= 0.5;
+                }
+                side = -1;
+            } else {
+                hi = s;
+                f_hi = f;
+                if side == 1 {
+                    f_lo *= 0.5;
+                }
+                side = 1;
+            }
+        }
+        Ok(best)
+    }
+}
+
+/// Follows the periodic orbit through `guess` at `p0` (period `period(p)`, section at `t0`)
+/// in the parameter `p`, with `build(p)` the shooting problem at `p` (system, events,
+/// tolerances); see the [module docs](self).
+///
+/// # Errors
+/// The errors of the first orbit's [`Shooting::find`]; invalid scales (wrong count). A
+/// corrector that fails down to the smallest step ends the branch
+/// ([`BranchEnd::StepTooSmall`]) rather than failing.
+pub fn follow<S, E, const N: usize, const M: usize, B, P>(
+    build: B,
+    period: P,
+    t0: f64,
+    p0: f64,
+    guess: SVector<f64, N>,
+    settings: &ContinuationSettings,
+) -> Result<Branch<N>>
+where
+    B: Fn(f64) -> Result<Shooting<f64, S, E, N, M>>,
+    P: Fn(f64) -> f64,
+    S: Dynamics<f64, N> + Clone,
+    E: EventSet<f64, N> + Clone,
+{
+    let first = build(p0)?.find(t0, period(p0), guess)?;
+    let (sy, sp) = match &settings.scales {
+        Some((s, sp)) => {
+            if s.len() != N {
+                return Err(invalid("the number of state scales", "N", s.len() as f64));
+            }
+            (SVector::<f64, N>::from_iterator(s.iter().copied()), *sp)
+        }
+        None => {
+            // Each component by its range over the first orbit (how far it moves), floored
+            // at 10⁻⁶ of its magnitude.
+            let shooting = build(p0)?;
+            let span = period(p0);
+            let mut sy = SVector::<f64, N>::zeros();
+            for i in 0..N {
+                let lo = shooting.extremum(t0, span, first.state, i, Extremum::Min)?;
+                let hi = shooting.extremum(t0, span, first.state, i, Extremum::Max)?;
+                sy[i] = (hi - lo)
+                    .max(1e-6 * lo.abs().max(hi.abs()))
+                    .max(f64::MIN_POSITIVE);
+            }
+            (sy, p0.abs().max(1.0))
+        }
+    };
+    let problem = Problem {
+        build: &build,
+        period: &period,
+        t0,
+        sy,
+        sp,
+        grazing: settings.grazing,
+    };
+    // The first point: its tangent from the direction of p.
+    let mut seed = DVector::zeros(N + 1);
+    seed[N] = settings.direction;
+    let u0 = problem.scale(&first.state, p0);
+    let at_start = problem.evaluate(&first.state, p0)?;
+    let start = problem.point(u0, first.state, p0, &at_start.a, &seed, &at_start.shooting)?;
+    let mut points = vec![start];
+    let mut bifurcations = Vec::new();
+    let mut ds = settings.step;
+    let end = loop {
+        if points.len() >= settings.max_points {
+            break BranchEnd::MaxPoints;
+        }
+        let a = points.last().expect("the branch has its first point");
+        let pred = &a.u + &a.tangent * ds;
+        let step = problem
+            .correct(&pred, &a.tangent, ds)
+            .and_then(|(b, iterations)| {
+                let found = problem.bifurcations(a, &b, ds, settings)?;
+                Ok((b, iterations, found))
+            });
+        match step {
+            Ok((mut b, iterations, found)) => {
+                b.arclength = a.arclength + ds;
+                bifurcations.extend(found);
+                let outside = b.p < settings.range.0 || b.p > settings.range.1;
+                points.push(b);
+                if outside {
+                    break BranchEnd::ParameterRange;
+                }
+                if iterations <= 3 {
+                    ds = (ds * 1.5).min(settings.max_step);
+                }
+            }
+            Err(_) => {
+                ds *= 0.5;
+                if ds < settings.min_step {
+                    break BranchEnd::StepTooSmall {
+                        p: points.last().map_or(p0, |q| q.p),
+                    };
+                }
+            }
+        }
+    };
+    Ok(Branch {
+        points: points
+            .into_iter()
+            .map(|q| BranchPoint {
+                arclength: q.arclength,
+                p: q.p,
+                state: q.y,
+                stable: q.multipliers.iter().all(|m| modulus(m) < 1.0),
+                multipliers: q.multipliers,
+                grazing_margin: q.margin,
+            })
+            .collect(),
+        bifurcations,
+        end,
+    })
+}

@@ -1,0 +1,255 @@
+//! Continuation of periodic orbits: the hardening Duffing oscillator's frequency response
+//! through its two folds, against harmonic balance and against brute-force sweeps.
+
+use nalgebra::SVector;
+use nonsmooth::drive::Simulation;
+use nonsmooth::excite::Harmonic;
+use nonsmooth::force::{CubicSpring, ViscousDamper};
+use nonsmooth::integrate::{Dopri5, Tolerances};
+use nonsmooth::lyapunov::tangent_tolerances;
+use nonsmooth::model::{Element, Load, Mechanical};
+use nonsmooth::orbit::{BifurcationKind, BranchEnd, ContinuationSettings, Shooting, follow};
+use nonsmooth::sample::Stroboscopic;
+
+const C: f64 = 0.1;
+const F: f64 = 0.5;
+
+type Duffing = Mechanical<
+    f64,
+    1,
+    2,
+    Element<f64, 1, (CubicSpring<f64>, ViscousDamper<f64>)>,
+    Load<f64, 1, Harmonic<f64>>,
+>;
+
+fn duffing(omega: f64) -> nonsmooth::Result<Duffing> {
+    Ok(Mechanical::<f64, 1, 2>::with_masses([1.0])?
+        .with_elements(Element::on_dof(
+            0,
+            (CubicSpring::new(1.0, 1.0)?, ViscousDamper::new(C)?),
+        )?)
+        .with_loads(Load::on_dof(0, Harmonic::cosine(F, omega)?)?))
+}
+
+fn tol() -> Tolerances<f64, 2> {
+    Tolerances::new(1e-10, 1e-12).unwrap()
+}
+
+/// Folds of the one-harmonic balance: `ω` where the cubic in `u = A²`,
+/// `(9/16)u³ + (3/2)a u² + (a² + c²ω²)u − F² = 0` (`a = 1 − ω²`), gains or loses two real
+/// roots (its discriminant changes sign).
+fn harmonic_balance_folds() -> Vec<f64> {
+    let disc = |w: f64| {
+        let a = 1.0 - w * w;
+        let (ca, cb, cc, cd) = (0.5625, 1.5 * a, a * a + (C * w).powi(2), -F * F);
+        18.0 * ca * cb * cc * cd - 4.0 * cb.powi(3) * cd + cb * cb * cc * cc
+            - 4.0 * ca * cc.powi(3)
+            - 27.0 * ca * ca * cd * cd
+    };
+    let mut folds = Vec::new();
+    let mut w = 1.0;
+    while w < 3.0 {
+        let (mut lo, mut hi) = (w, w + 1e-3);
+        if disc(lo).signum() != disc(hi).signum() {
+            for _ in 0..60 {
+                let mid = 0.5 * (lo + hi);
+                if disc(lo).signum() == disc(mid).signum() {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            folds.push(0.5 * (lo + hi));
+        }
+        w += 1e-3;
+    }
+    folds
+}
+
+/// Stroboscopic x after each ω of a sweep (each value starts from the previous end).
+fn sweep(omegas: &[f64]) -> Vec<f64> {
+    let mut y = SVector::<f64, 2>::zeros();
+    let mut xs = Vec::new();
+    for &w in omegas {
+        let period = std::f64::consts::TAU / w;
+        let mut sim = Simulation::new(duffing(w).unwrap(), Dopri5::new(tol()));
+        let mut strobe = Stroboscopic::<f64, 2>::periodic(0.0, period, 0.0, 1000).unwrap();
+        let out = sim.run(0.0, y, 150.0 * period, &mut strobe).unwrap();
+        y = out.y;
+        xs.push(y[0].hypot(y[1] / w));
+    }
+    xs
+}
+
+#[test]
+fn duffing_frequency_response_two_folds() {
+    let tol = tol();
+    let build = |w: f64| -> nonsmooth::Result<_> {
+        Ok(Shooting::new(
+            duffing(w)?,
+            (),
+            tangent_tolerances::<f64, 2, 2, 6>(&tol, 1e-10, 1e-12)?,
+        ))
+    };
+    let period = |w: f64| std::f64::consts::TAU / w;
+    let settings = ContinuationSettings::new(1.0, 2.5, 0.02).unwrap();
+    let branch = follow(
+        build,
+        period,
+        0.0,
+        1.0,
+        SVector::from([0.0, 0.0]),
+        &settings,
+    )
+    .unwrap();
+    assert_eq!(branch.end, BranchEnd::ParameterRange);
+    let folds: Vec<f64> = branch
+        .bifurcations
+        .iter()
+        .filter(|b| b.kind == BifurcationKind::Fold)
+        .map(|b| b.p)
+        .collect();
+    let hb = harmonic_balance_folds();
+    println!(
+        "{} points; folds {folds:?}; harmonic balance {hb:?}; other: {:?}",
+        branch.points.len(),
+        branch
+            .bifurcations
+            .iter()
+            .filter(|b| b.kind != BifurcationKind::Fold)
+            .map(|b| (b.kind, b.p))
+            .collect::<Vec<_>>()
+    );
+    assert_eq!(folds.len(), 2, "{folds:?}");
+    assert_eq!(hb.len(), 2, "{hb:?}");
+    // Along the branch: upper fold first (the large-amplitude branch ends), then the lower.
+    let (upper, lower) = (folds[0], folds[1]);
+    assert!(upper > lower);
+    for (got, want) in [(lower, hb[0]), (upper, hb[1])] {
+        assert!(
+            (got - want).abs() < 0.02 * want,
+            "fold {got} vs harmonic balance {want}"
+        );
+    }
+    // Between the folds (in arclength) the orbit is a saddle; before the first and after
+    // the second it is stable (away from the folds themselves).
+    let fold_s: Vec<f64> = branch
+        .bifurcations
+        .iter()
+        .filter(|b| b.kind == BifurcationKind::Fold)
+        .map(|b| b.arclength)
+        .collect();
+    let near_fold = |p: f64| (p - upper).abs() < 1e-4 || (p - lower).abs() < 1e-4;
+    let mut middle = 0;
+    for q in branch.points.iter().filter(|q| !near_fold(q.p)) {
+        if q.arclength > fold_s[0] && q.arclength < fold_s[1] {
+            assert!(!q.stable, "middle segment at {} should be a saddle", q.p);
+            assert!(q.multipliers[0].re > 1.0 && q.multipliers[0].im == 0.0);
+            middle += 1;
+        } else {
+            assert!(q.stable, "outer segment at {} should be stable", q.p);
+        }
+    }
+    assert!(middle >= 3, "{middle} points on the middle segment");
+    // Brute-force sweeps up and down jump where the folds are: the amplitude drops on the
+    // way up right after the upper fold, and rises on the way down right after the lower.
+    let step = 0.01;
+    let up: Vec<f64> = (0..=150).map(|i| 1.0 + step * i as f64).collect();
+    let a_up = sweep(&up);
+    let jump_up = (1..up.len())
+        .max_by(|&i, &j| {
+            (a_up[i - 1] - a_up[i])
+                .partial_cmp(&(a_up[j - 1] - a_up[j]))
+                .unwrap()
+        })
+        .unwrap();
+    let down: Vec<f64> = up.iter().rev().copied().collect();
+    let a_down = sweep(&down);
+    let jump_down = (1..down.len())
+        .max_by(|&i, &j| {
+            (a_down[i] - a_down[i - 1])
+                .partial_cmp(&(a_down[j] - a_down[j - 1]))
+                .unwrap()
+        })
+        .unwrap();
+    println!(
+        "sweep up jumps between {} and {}; down between {} and {}",
+        up[jump_up - 1],
+        up[jump_up],
+        down[jump_down - 1],
+        down[jump_down]
+    );
+    assert!(up[jump_up - 1] <= upper && upper <= up[jump_up] + 1e-9);
+    assert!(down[jump_down] - 1e-9 <= lower && lower <= down[jump_down - 1]);
+}
+
+#[test]
+fn paper_period_one_orbit_first_grazing() {
+    use nonsmooth::analysis::first_grazing;
+    use nonsmooth::orbit::{Extremum, Grazing};
+    use nonsmooth::systems::paper::PAPER;
+    let tol = Tolerances::per_component(1e-10, [1e-14, 1e-12]).unwrap();
+    let build = |w: f64| -> nonsmooth::Result<_> {
+        Ok(Shooting::new(
+            PAPER.oscillator::<f64>(w)?,
+            (),
+            tangent_tolerances::<f64, 2, 2, 6>(&tol, 1e-10, 1e-12)?,
+        ))
+    };
+    let period = |w: f64| std::f64::consts::TAU / w;
+    let settings = ContinuationSettings::new(10.0, 14.3, 0.005)
+        .unwrap()
+        .with_max_step(0.02)
+        .unwrap()
+        .with_grazing(Grazing {
+            component: 0,
+            level: PAPER.x_i,
+            extremum: Extremum::Min,
+        });
+    let rest = SVector::from([PAPER.static_equilibrium().unwrap(), 0.0]);
+    let branch = follow(build, period, 0.0, 10.0, rest, &settings).unwrap();
+    let grazing: Vec<f64> = branch
+        .bifurcations
+        .iter()
+        .filter(|b| b.kind == BifurcationKind::Grazing)
+        .map(|b| b.p)
+        .collect();
+    // The simulation-based estimate (steady response sampled 2000 times per period).
+    let x0 = PAPER.static_equilibrium().unwrap();
+    let by_simulation = first_grazing(
+        |w: f64| {
+            Ok((
+                PAPER.oscillator::<f64>(w)?,
+                period(w),
+                SVector::from([x0, 0.0]),
+            ))
+        },
+        || Dopri5::new(tol),
+        0,
+        PAPER.x_i,
+        14.0,
+        14.1,
+        1e-9,
+        100,
+        2,
+    )
+    .unwrap();
+    println!(
+        "{} points, all stable: {}; grazing by continuation {grazing:?}, by simulation {by_simulation}; other {:?}",
+        branch.points.len(),
+        branch.points.iter().all(|q| q.stable),
+        branch
+            .bifurcations
+            .iter()
+            .filter(|b| b.kind != BifurcationKind::Grazing)
+            .map(|b| (b.kind, b.p))
+            .collect::<Vec<_>>()
+    );
+    assert_eq!(grazing.len(), 1);
+    assert!((grazing[0] - 14.045).abs() < 1e-3);
+    assert!(
+        (grazing[0] - by_simulation).abs() < 1e-5,
+        "{} vs {by_simulation}",
+        grazing[0]
+    );
+}
