@@ -253,3 +253,96 @@ fn paper_period_one_orbit_first_grazing() {
         grazing[0]
     );
 }
+
+type DoubleWell = Mechanical<
+    f64,
+    1,
+    2,
+    Element<f64, 1, (CubicSpring<f64>, ViscousDamper<f64>)>,
+    Load<f64, 1, Harmonic<f64>>,
+>;
+
+/// The double-well Duffing oscillator `ẍ + 0.3ẋ − x + x³ = γ cos 1.2t`.
+fn double_well(gamma: f64) -> nonsmooth::Result<DoubleWell> {
+    Ok(Mechanical::<f64, 1, 2>::with_masses([1.0])?
+        .with_elements(Element::on_dof(
+            0,
+            (CubicSpring::new(-1.0, 1.0)?, ViscousDamper::new(0.3)?),
+        )?)
+        .with_loads(Load::on_dof(0, Harmonic::cosine(gamma, 1.2)?)?))
+}
+
+#[test]
+fn double_well_duffing_period_doubling_cascade() {
+    use nonsmooth::orbit::period_doubled;
+    let tol = tol();
+    let build = |g: f64| -> nonsmooth::Result<_> {
+        Ok(Shooting::new(
+            double_well(g)?,
+            (),
+            tangent_tolerances::<f64, 2, 2, 6>(&tol, 1e-10, 1e-12)?,
+        ))
+    };
+    let t = std::f64::consts::TAU / 1.2;
+    // Follow period 1 from γ = 0.2 (right well), switch to the doubled branch at each
+    // period doubling, follow it to its own doubling: periods 1, 2, 4, 8.
+    let mut k = 1.0;
+    let (mut p, mut y) = (0.2, SVector::from([1.0, 0.0]));
+    let mut hi = 0.4;
+    let mut doublings = Vec::new();
+    for _ in 0..4 {
+        let period = move |_g: f64| k * t;
+        let settings = ContinuationSettings::new(0.1, hi, 0.01)
+            .unwrap()
+            .with_max_points(400)
+            .unwrap();
+        let branch = follow(build, period, 0.0, p, y, &settings).unwrap();
+        let pd = branch
+            .bifurcations
+            .iter()
+            .find(|b| b.kind == BifurcationKind::PeriodDoubling)
+            .expect("a period doubling on each branch of the cascade")
+            .clone();
+        // The critical multiplier is −1 there.
+        assert!(
+            pd.multipliers
+                .iter()
+                .any(|m| (m.re + 1.0).abs() < 1e-5 && m.im == 0.0),
+            "{:?}",
+            pd.multipliers
+        );
+        doublings.push(pd.p);
+        let (p2, orbit) = period_doubled(build, period, 0.0, &pd, 1e-5, 1.0).unwrap();
+        if let [.., a, b] = doublings[..] {
+            hi = b + 0.5 * (b - a); // the next doubling comes well before this
+        }
+        p = p2;
+        y = orbit.state;
+        k *= 2.0;
+    }
+    let d1 = (doublings[1] - doublings[0]) / (doublings[2] - doublings[1]);
+    let d2 = (doublings[2] - doublings[1]) / (doublings[3] - doublings[2]);
+    println!("period doublings at γ = {doublings:?}; ratios {d1:.4}, {d2:.4} (Feigenbaum 4.6692)");
+    // Measured: γ = 0.2655818, 0.2866932, 0.2910899, 0.2920310; ratios 4.802, 4.672.
+    assert!((d1 - 4.6692).abs() < 0.2, "{d1}");
+    assert!((d2 - 4.6692).abs() < 0.05, "{d2}");
+    // Independent check by simulation: period 1 just below the first doubling, period 2 just
+    // above (stroboscopic points after a transient).
+    for (gamma, want) in [(doublings[0] - 2e-3, 1), (doublings[0] + 2e-3, 2)] {
+        let mut sim = Simulation::new(double_well(gamma).unwrap(), Dopri5::new(tol));
+        let mut strobe = Stroboscopic::<f64, 2>::periodic(0.0, t, 3000.0 * t, 100).unwrap();
+        sim.run(0.0, SVector::from([1.0, 0.0]), 3010.0 * t, &mut strobe)
+            .unwrap();
+        let pts = strobe.points();
+        let distinct = if (pts[0].y - pts[1].y).amax() < 1e-6 {
+            1
+        } else {
+            2
+        };
+        assert_eq!(distinct, want, "γ = {gamma}");
+        assert!(
+            (pts[0].y - pts[2].y).amax() < 1e-6,
+            "period ≤ 2 at γ = {gamma}"
+        );
+    }
+}

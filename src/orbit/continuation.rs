@@ -236,6 +236,85 @@ pub struct Bifurcation<const N: usize> {
     pub state: SVector<f64, N>,
     /// The Floquet multipliers there.
     pub multipliers: Vec<Complex<f64>>,
+    /// The monodromy matrix there.
+    pub monodromy: SMatrix<f64, N, N>,
+}
+
+impl<const N: usize> Bifurcation<N> {
+    /// The unit eigenvector of the monodromy matrix for its multiplier nearest `mu` (the
+    /// smallest singular vector of `Φ − μI`): the critical direction, e.g. `mu = −1` for a
+    /// period doubling.
+    pub fn critical_direction(&self, mu: f64) -> SVector<f64, N> {
+        let m = DMatrix::from_iterator(
+            N,
+            N,
+            (self.monodromy - SMatrix::<f64, N, N>::identity() * mu)
+                .iter()
+                .copied(),
+        );
+        let svd = m.svd(false, true);
+        let (k, _) =
+            svd.singular_values
+                .iter()
+                .enumerate()
+                .fold(
+                    (0, f64::INFINITY),
+                    |b, (i, &v)| if v < b.1 { (i, v) } else { b },
+                );
+        match svd.v_t {
+            Some(vt) => SVector::<f64, N>::from_iterator(vt.row(k).iter().copied()),
+            None => SVector::<f64, N>::zeros(),
+        }
+    }
+}
+
+/// The period-doubled orbit born at a period doubling `at` of a branch with period
+/// `period(p)`: tries `p = at.p ± dp` (the side where it exists is not known in advance)
+/// and starting points `y ± ε v` (`v` the critical direction, `ε` from `10⁻³` to `10⁻¹` of
+/// `scale`), shooting with period `2·period(p)`, and returns the first orbit within
+/// `0.1·scale` of the bifurcation that is not the original one (`‖P(y) − y‖` over one
+/// original period above `10⁻⁶·scale`).
+///
+/// # Errors
+/// [`OrbitError::NotConverged`] if no start converges to a period-doubled orbit.
+pub fn period_doubled<S, E, const N: usize, const M: usize, B, P>(
+    build: B,
+    period: P,
+    t0: f64,
+    at: &Bifurcation<N>,
+    dp: f64,
+    scale: f64,
+) -> Result<(f64, super::PeriodicOrbit<f64, N>)>
+where
+    B: Fn(f64) -> Result<Shooting<f64, S, E, N, M>>,
+    P: Fn(f64) -> f64,
+    S: Dynamics<f64, N> + Clone,
+    E: EventSet<f64, N> + Clone,
+{
+    let v = at.critical_direction(-1.0);
+    for side in [1.0, -1.0] {
+        let p = at.p + side * dp;
+        let shooting = build(p)?;
+        for eps in [1e-3, 3e-3, 1e-2, 3e-2, 1e-1] {
+            for sign in [1.0, -1.0] {
+                let guess = at.state + v * (sign * eps * scale);
+                let Ok(orbit) = shooting.find(t0, 2.0 * period(p), guess) else {
+                    continue;
+                };
+                let (once, _) = shooting.flow(t0, orbit.state, period(p))?;
+                let near = (orbit.state - at.state).amax() < 0.1 * scale;
+                if near && (once - orbit.state).amax() > 1e-6 * scale {
+                    return Ok((p, orbit));
+                }
+            }
+        }
+    }
+    Err(OrbitError::NotConverged {
+        iterations: 0,
+        step: f64::NAN,
+        residual: f64::NAN,
+    }
+    .into())
 }
 
 /// A point of a branch.
@@ -288,6 +367,7 @@ struct Point<const N: usize> {
     u: DVector<f64>,
     p: f64,
     y: SVector<f64, N>,
+    phi: SMatrix<f64, N, N>,
     tangent: DVector<f64>,
     multipliers: Vec<Complex<f64>>,
     tests: [f64; 4],
@@ -477,6 +557,7 @@ where
             u,
             p,
             y,
+            phi,
             tests: [tangent[N], pd, ns.re, margin.unwrap_or(1.0)],
             tangent,
             multipliers: mu,
@@ -522,6 +603,7 @@ where
                 p: at.p,
                 state: at.y,
                 multipliers: at.multipliers,
+                monodromy: at.phi,
                 arclength: at.arclength,
             });
         }

@@ -69,7 +69,7 @@ pub mod continuation;
 
 pub use continuation::{
     Bifurcation, BifurcationKind, Branch, BranchEnd, BranchPoint, ContinuationSettings, Grazing,
-    follow,
+    follow, period_doubled,
 };
 
 /// Why a periodic-orbit computation failed.
