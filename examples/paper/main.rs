@@ -221,6 +221,19 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         0.1 / 14.0,
         "the paper gives ≈ 14 (between 14 and 14.1)",
     );
+    let cg = first_grazing_continuation(rtol)?;
+    s.compare(
+        "cont_first_grazing",
+        "first grazing: grazing bifurcation of the period-1 orbit, located by continuation",
+        "rad/s",
+        14.0,
+        Some(cg),
+        0.1 / 14.0,
+        &format!(
+            "a grazing bifurcation (the orbit's smallest x reaches x_I), located on the branch; \
+             the simulation estimate above gives {fg:.6}"
+        ),
+    );
     step("first grazing", t0);
 
     // Impact adding (Figs. 2d, 8).

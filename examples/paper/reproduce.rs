@@ -139,6 +139,41 @@ pub fn first_grazing_omega(rtol: f64) -> Res<f64> {
     )?)
 }
 
+/// The first grazing as a bifurcation: the period-1 orbit followed by pseudo-arclength
+/// continuation from ω = 13 until its smallest x reaches x_I (located on the branch).
+pub fn first_grazing_continuation(rtol: f64) -> Res<f64> {
+    use nonsmooth::lyapunov::tangent_tolerances;
+    use nonsmooth::orbit::{
+        BifurcationKind, ContinuationSettings, Extremum, Grazing, Shooting, follow,
+    };
+    let tol = tolerances(rtol);
+    let tangent = tangent_tolerances::<f64, 2, 2, 6>(&tol, rtol, rtol * 1e-2)?;
+    let build = |w: f64| -> nonsmooth::Result<_> {
+        Ok(Shooting::new(PAPER.oscillator::<f64>(w)?, (), tangent))
+    };
+    let settings = ContinuationSettings::new(13.0, 14.3, 0.005)?
+        .with_max_step(0.02)?
+        .with_grazing(Grazing {
+            component: 0,
+            level: PAPER.x_i,
+            extremum: Extremum::Min,
+        });
+    let branch = follow(build, |w| TAU / w, 0.0, 13.0, rest()?, &settings)?;
+    branch
+        .bifurcations
+        .iter()
+        .find(|b| b.kind == BifurcationKind::Grazing)
+        .map(|b| b.p)
+        .ok_or_else(|| {
+            nonsmooth::orbit::OrbitError::InvalidSetting {
+                what: "the continuation range [13, 14.3]",
+                requirement: "to contain the first grazing",
+                value: 14.3,
+            }
+            .into()
+        })
+}
+
 /// One frequency from rest with the paper's transients (100) and `record` periods.
 pub fn from_rest(omega: f64, record: u32, rtol: f64) -> Res<SweepPoint<2>> {
     let cfg = SweepConfig::new(vec![omega])?.record(record)?;
