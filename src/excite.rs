@@ -132,7 +132,11 @@ impl<T: Real> Excitation<T> for Constant<T> {
 /// # Model
 /// $$f(t) = F_0 \sin(\omega t + \varphi_0), \qquad \varphi(t) = \omega t + \varphi_0 .$$
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(remote = "Self")
+)]
 pub struct Harmonic<T> {
     amplitude: T,
     omega: T,
@@ -225,7 +229,11 @@ impl<T: Real> Excitation<T> for Harmonic<T> {
 /// # References
 /// The paper's eq. (1), right-hand side; `m0·e = 0.01805 kg·m`.
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(remote = "Self")
+)]
 pub struct UnbalancedRotor<T> {
     m0e: T,
     omega: T,
@@ -305,7 +313,11 @@ impl<T: Real> Excitation<T> for UnbalancedRotor<T> {
 /// For `r = 0` it is [`UnbalancedRotor`]. Stroboscopic sections are at `φ = 2πi`, found
 /// from the quadratic for `t` (no accumulated time).
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(remote = "Self")
+)]
 pub struct RampedRotor<T> {
     m0e: T,
     omega0: T,
@@ -372,6 +384,30 @@ impl<T: Real> Excitation<T> for RampedRotor<T> {
         Some(self.omega_at(t))
     }
 }
+
+#[cfg(feature = "serde")]
+crate::validate::serde_validated!(
+    [T: Real] Harmonic<T>,
+    [T: serde::Serialize],
+    [T: serde::Deserialize<'de>],
+    |v| Harmonic::new(v.amplitude, v.omega, v.phase0)
+);
+
+#[cfg(feature = "serde")]
+crate::validate::serde_validated!(
+    [T: Real] UnbalancedRotor<T>,
+    [T: serde::Serialize],
+    [T: serde::Deserialize<'de>],
+    |v| UnbalancedRotor::new(v.m0e, v.omega)
+);
+
+#[cfg(feature = "serde")]
+crate::validate::serde_validated!(
+    [T: Real] RampedRotor<T>,
+    [T: serde::Serialize],
+    [T: serde::Deserialize<'de>],
+    |v| RampedRotor::new(v.m0e, v.omega0, v.rate)
+);
 
 #[cfg(test)]
 mod tests {

@@ -188,7 +188,11 @@ pub fn check_index(index: usize, n: usize) -> Result<(), EventError> {
 
 /// The hyperplane `g = y[index] − level` (e.g. the stop `x = x_I`), with rate `ẏ[index]`.
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(remote = "Self")
+)]
 pub struct Level<T> {
     index: usize,
     level: T,
@@ -411,7 +415,11 @@ impl<T: Real, const N: usize> ResetMap<T, N> for () {
 
 /// Newton's restitution law `ẏ[velocity]⁺ = −r·ẏ[velocity]⁻`.
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(remote = "Self")
+)]
 pub struct Restitution<T> {
     velocity: usize,
     r: T,
@@ -1054,6 +1062,22 @@ impl<T: Real> EventHistory<T> {
         }
     }
 }
+
+#[cfg(feature = "serde")]
+crate::validate::serde_validated!(
+    [T: Real] Level<T>,
+    [T: serde::Serialize],
+    [T: serde::Deserialize<'de>],
+    |v| Level::new(v.index, v.level)
+);
+
+#[cfg(feature = "serde")]
+crate::validate::serde_validated!(
+    [T: Real] Restitution<T>,
+    [T: serde::Serialize],
+    [T: serde::Deserialize<'de>],
+    |v| Restitution::new(v.velocity, v.r)
+);
 
 #[cfg(test)]
 mod tests {

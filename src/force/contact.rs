@@ -41,7 +41,11 @@ pub enum Side {
 /// The paper's eq. (1), impact force `F_I`; `n1 = n2 = 3/2`, `n3 = 0.18667`,
 /// `k_I = 2.3983·10⁸ N/m^{3/2}`, `b = 0.8485 m^{−n3}s^{n3}`.
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(remote = "Self")
+)]
 pub struct HertzContact<T> {
     x_i: T,
     side: Side,
@@ -264,6 +268,18 @@ impl<T: Real> ForceLaw<T> for HertzContact<T> {
         (clamp(self.k_i * fd), clamp(self.k_i * fw))
     }
 }
+
+#[cfg(feature = "serde")]
+crate::validate::serde_validated!(
+    [T: Real] HertzContact<T>,
+    [T: serde::Serialize],
+    [T: serde::Deserialize<'de>],
+    |v| HertzContact::new(v.x_i, v.k_i)
+        .map(|h| h.with_side(v.side))
+        .and_then(|h| h.with_stiffness_exponent(v.n1.value()))
+        .and_then(|h| h.with_damping(v.b, v.n2.value(), v.n3))
+        .and_then(|h| h.with_rate_regularization(v.eta))
+);
 
 #[cfg(test)]
 mod tests {

@@ -26,7 +26,11 @@ pub enum Regularization {
 /// # References
 /// The paper's eq. (1), resistance force `F_R`.
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(remote = "Self")
+)]
 pub struct DryFriction<T> {
     t: T,
     eps: T,
@@ -104,6 +108,14 @@ impl<T: Real> ForceLaw<T> for DryFriction<T> {
         (T::zero(), dv)
     }
 }
+
+#[cfg(feature = "serde")]
+crate::validate::serde_validated!(
+    [T: Real] DryFriction<T>,
+    [T: serde::Serialize],
+    [T: serde::Deserialize<'de>],
+    |v| DryFriction::new(v.t, v.eps, v.reg)
+);
 
 #[cfg(test)]
 mod tests {

@@ -16,7 +16,11 @@ use crate::{ForceLaw, Real};
 /// assert_eq!(s.force(1e-3, 5.0), 1.4189);
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(remote = "Self")
+)]
 pub struct LinearSpring<T> {
     k: T,
     x0: T,
@@ -65,7 +69,11 @@ impl<T: Real> ForceLaw<T> for LinearSpring<T> {
 /// # Model
 /// $$F(x, \dot x) = c\,\dot x, \qquad c \ge 0 .$$
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(remote = "Self")
+)]
 pub struct ViscousDamper<T> {
     c: T,
 }
@@ -97,6 +105,22 @@ impl<T: Real> ForceLaw<T> for ViscousDamper<T> {
         (T::zero(), self.c)
     }
 }
+
+#[cfg(feature = "serde")]
+crate::validate::serde_validated!(
+    [T: Real] LinearSpring<T>,
+    [T: serde::Serialize],
+    [T: serde::Deserialize<'de>],
+    |v| LinearSpring::new(v.k).and_then(|s| s.with_rest_position(v.x0))
+);
+
+#[cfg(feature = "serde")]
+crate::validate::serde_validated!(
+    [T: Real] ViscousDamper<T>,
+    [T: serde::Serialize],
+    [T: serde::Deserialize<'de>],
+    |v| ViscousDamper::new(v.c)
+);
 
 #[cfg(test)]
 mod tests {

@@ -31,7 +31,11 @@ use crate::{ForceLaw, Real};
 /// assert_eq!(stop.force(1.0, 0.0), 1.0 + 9.0 * 0.5);
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(remote = "Self")
+)]
 pub struct Bilinear<T> {
     k_in: T,
     k_out: T,
@@ -119,6 +123,14 @@ impl<T: Real> ForceLaw<T> for Bilinear<T> {
         }
     }
 }
+
+#[cfg(feature = "serde")]
+crate::validate::serde_validated!(
+    [T: Real] Bilinear<T>,
+    [T: serde::Serialize],
+    [T: serde::Deserialize<'de>],
+    |v| Bilinear::new(v.k_in, v.k_out, v.lo, v.hi)
+);
 
 #[cfg(test)]
 mod tests {

@@ -21,7 +21,11 @@ use crate::{ForceLaw, Real};
 /// assert_eq!(s.partials(2.0, 0.0), (-1.0 + 12.0, 0.0));
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(remote = "Self")
+)]
 pub struct CubicSpring<T> {
     k1: T,
     k3: T,
@@ -151,6 +155,14 @@ impl<T: Real, const D: usize> ForceLaw<T> for Polynomial<T, D> {
         (acc, T::zero())
     }
 }
+
+#[cfg(feature = "serde")]
+crate::validate::serde_validated!(
+    [T: Real] CubicSpring<T>,
+    [T: serde::Serialize],
+    [T: serde::Deserialize<'de>],
+    |v| CubicSpring::new(v.k1, v.k3).and_then(|s| s.with_rest_position(v.x0))
+);
 
 #[cfg(test)]
 mod tests {

@@ -29,7 +29,11 @@ use crate::{Dynamics, ForceLaw, Real};
 /// # Ok::<(), nonsmooth::Error>(())
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(remote = "Self")
+)]
 pub struct Oscillator<T, L, E> {
     mass: T,
     inv_mass: T,
@@ -136,6 +140,14 @@ impl<T: Real, L, E> Oscillator<T, L, E> {
         lit::<T>(0.5) * self.mass * v * v
     }
 }
+
+#[cfg(feature = "serde")]
+crate::validate::serde_validated!(
+    [T: Real, L: ForceLaw<T>, E: Excitation<T>] Oscillator<T, L, E>,
+    [T: serde::Serialize, L: serde::Serialize, E: serde::Serialize],
+    [T: serde::Deserialize<'de>, L: serde::Deserialize<'de>, E: serde::Deserialize<'de>],
+    |v| Oscillator::new(v.mass, v.laws, v.excitation)
+);
 
 #[cfg(test)]
 mod tests {

@@ -57,7 +57,11 @@ pub struct Crossing<T> {
 /// # Ok::<(), nonsmooth::signal::SignalError>(())
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(remote = "Self")
+)]
 pub struct ThresholdCrossing<T> {
     level: T,
     direction: Direction,
@@ -253,6 +257,17 @@ pub fn intervals<T: Real>(times: &[T]) -> Vec<T> {
     intervals_into(times, &mut out);
     out
 }
+
+#[cfg(feature = "serde")]
+crate::validate::serde_validated!(
+    [T: Real] ThresholdCrossing<T>,
+    [T: serde::Serialize],
+    [T: serde::Deserialize<'de>],
+    |v| ThresholdCrossing::new(v.level)
+        .map(|c| c.with_direction(v.direction))
+        .and_then(|c| c.with_hysteresis(v.hysteresis))
+        .and_then(|c| c.with_min_separation(v.min_separation))
+);
 
 #[cfg(test)]
 mod tests {

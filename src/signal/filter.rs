@@ -51,7 +51,11 @@ pub enum InitialState<T> {
 /// # Ok::<(), nonsmooth::signal::SignalError>(())
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(remote = "Self")
+)]
 pub struct LowPass<T> {
     theta: T,
     initial: InitialState<T>,
@@ -205,6 +209,14 @@ fn blend<T: Real>(y: T, u: T, b: T) -> T {
         ((T::one() - b) * y + b * u).max(lo).min(hi)
     }
 }
+
+#[cfg(feature = "serde")]
+crate::validate::serde_validated!(
+    [T: Real] LowPass<T>,
+    [T: serde::Serialize],
+    [T: serde::Deserialize<'de>],
+    |v| LowPass::new(v.theta).map(|f| f.with_initial(v.initial))
+);
 
 #[cfg(test)]
 mod tests {

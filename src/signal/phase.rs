@@ -60,7 +60,11 @@ pub struct PoincarePoint<T> {
 /// # Ok::<(), nonsmooth::signal::SignalError>(())
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(remote = "Self")
+)]
 pub struct PhaseSection<T> {
     offset: T,
     input: PhaseInput,
@@ -333,6 +337,16 @@ pub fn section_frequencies<T: Real>(points: &[PoincarePoint<T>]) -> Result<Vec<T
     }
     Ok(out)
 }
+
+#[cfg(feature = "serde")]
+crate::validate::serde_validated!(
+    [T: Real] PhaseSection<T>,
+    [T: serde::Serialize],
+    [T: serde::Deserialize<'de>],
+    |v| PhaseSection::new()
+        .with_offset(v.offset)
+        .map(|s| s.with_input(v.input))
+);
 
 #[cfg(test)]
 mod tests {

@@ -46,7 +46,11 @@ pub type Table<T> = Gap<T, 1, Harmonic<T>>;
 
 /// The parameters of the ball on the vibrating table (SI units).
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(remote = "Self")
+)]
 pub struct BouncingBallTable {
     /// Gravity `g` (m/s²).
     pub g: f64,
@@ -140,3 +144,11 @@ impl BouncingBallTable {
         std::f64::consts::TAU / self.omega
     }
 }
+
+#[cfg(feature = "serde")]
+crate::validate::serde_validated!(
+    [] BouncingBallTable,
+    [],
+    [],
+    |v| v.model::<f64>().and(v.impact::<f64>()).map(|_| v)
+);

@@ -29,7 +29,11 @@ pub type DuffingUedaModel<T> = Mechanical<T, 1, 2, DuffingUedaElements<T>, Load<
 
 /// The parameters of the Duffing–Ueda oscillator `ẍ + kẋ + x³ = B cos ωt`.
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(remote = "Self")
+)]
 pub struct DuffingUeda {
     /// Damping `k ≥ 0`.
     pub k: f64,
@@ -87,6 +91,14 @@ impl DuffingUeda {
             )?))
     }
 }
+
+#[cfg(feature = "serde")]
+crate::validate::serde_validated!(
+    [] DuffingUeda,
+    [],
+    [],
+    |v| v.model::<f64>().map(|_| v)
+);
 
 #[cfg(test)]
 mod tests {

@@ -40,7 +40,11 @@ pub type RampedPaperOscillator<T> = Oscillator<T, PaperLaws<T>, RampedRotor<T>>;
 
 /// The parameters of the paper's model (SI units).
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(remote = "Self")
+)]
 pub struct PaperParameters {
     /// Total mass of the cart `m` (kg).
     pub m: f64,
@@ -188,6 +192,14 @@ impl PaperParameters {
 pub fn omega_of<T: Real, E: Excitation<T>>(e: &E) -> Option<T> {
     e.angular_frequency(T::zero())
 }
+
+#[cfg(feature = "serde")]
+crate::validate::serde_validated!(
+    [] PaperParameters,
+    [],
+    [],
+    |v| v.oscillator::<f64>(1.0).map(|_| v)
+);
 
 #[cfg(test)]
 mod tests {

@@ -41,7 +41,11 @@ pub type TwoDofImpactModel<T> = Mechanical<T, 2, 4, TwoDofElements<T>, Load<T, 2
 
 /// The parameters of the 2-DOF impact oscillator (nondimensional).
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(remote = "Self")
+)]
 pub struct TwoDofImpact {
     /// Primary mass `m_1`.
     pub m1: f64,
@@ -153,3 +157,11 @@ impl TwoDofImpact {
         std::f64::consts::TAU / omega
     }
 }
+
+#[cfg(feature = "serde")]
+crate::validate::serde_validated!(
+    [] TwoDofImpact,
+    [],
+    [],
+    |v| v.model::<f64>(1.0).map(|_| v)
+);
