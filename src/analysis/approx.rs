@@ -392,7 +392,7 @@ impl TurningPoint {
 /// The paper's Sect. 5, eqs. (5)–(6) and the grazing estimate after them; the method after
 /// its refs. [34, 35].
 #[derive(Debug, Clone, PartialEq)]
-pub struct AmplitudePhase<T, L, E> {
+pub struct AmplitudePhase<T: Real, L, E> {
     osc: Oscillator<T, L, E>,
     x0: T,
     damping: T,

@@ -144,6 +144,13 @@ impl<T: Real, const N: usize> Coordinate<T, N> {
         Ok(Self::from_weights(weights))
     }
 
+    /// `q₀` (infallible: every system has a first DOF).
+    pub(crate) fn first() -> Self {
+        let mut weights = SVector::zeros();
+        weights[0] = T::one();
+        Self::from_weights(weights)
+    }
+
     fn from_weights(weights: SVector<T, N>) -> Self {
         Self {
             weights,

@@ -2,6 +2,7 @@ use nalgebra::{SMatrix, SVector};
 
 use crate::error::{ParameterError, Result};
 use crate::excite::Excitation;
+use crate::model::{Coordinate, Element, Load, Mechanical};
 use crate::roots::brent;
 use crate::scalar::lit;
 use crate::validate::positive;
@@ -28,18 +29,19 @@ use crate::{Dynamics, ForceLaw, Real};
 /// assert_eq!(dy, Vector2::new(0.0, -4.0));
 /// # Ok::<(), nonsmooth::Error>(())
 /// ```
+///
+/// # Implementation
+/// The oscillator is the one-DOF [`Mechanical`] system with the laws as one element on
+/// `q₀` and the excitation as one load on it (a thin layer: the same right-hand side,
+/// Jacobian and `∂f/∂t`, to the bit); it keeps the scalar constructor, the accessors and
+/// the bracketing static equilibrium.
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(
-    feature = "serde",
-    derive(serde::Serialize, serde::Deserialize),
-    serde(remote = "Self")
-)]
-pub struct Oscillator<T, L, E> {
-    mass: T,
-    inv_mass: T,
-    laws: L,
-    excitation: E,
+pub struct Oscillator<T: Real, L, E> {
+    model: OneDof<T, L, E>,
 }
+
+/// The one-DOF mechanical system behind an [`Oscillator`].
+type OneDof<T, L, E> = Mechanical<T, 1, 2, Element<T, 1, L>, Load<T, 1, E>>;
 
 impl<T: Real, L: ForceLaw<T>, E: Excitation<T>> Oscillator<T, L, E> {
     /// Assembles the oscillator.
@@ -47,49 +49,57 @@ impl<T: Real, L: ForceLaw<T>, E: Excitation<T>> Oscillator<T, L, E> {
     /// # Errors
     /// [`ParameterError`] unless `mass` is finite and > 0.
     pub fn new(mass: T, laws: L, excitation: E) -> Result<Self, ParameterError> {
-        let mass = positive("mass", mass)?;
+        let q = Coordinate::first();
         Ok(Self {
-            mass,
-            inv_mass: T::one() / mass,
-            laws,
-            excitation,
+            model: Mechanical::with_masses([positive("mass", mass)?])?
+                .with_elements(Element::new(q, laws))
+                .with_loads(Load {
+                    coordinate: q,
+                    excitation,
+                }),
         })
     }
 
     /// The mass `m`.
     pub fn mass(&self) -> T {
-        self.mass
+        self.model.mass_matrix()[(0, 0)]
     }
 
     /// The force laws.
     pub fn laws(&self) -> &L {
-        &self.laws
+        &self.model.elements().law
     }
 
     /// The excitation.
     pub fn excitation(&self) -> &E {
-        &self.excitation
+        &self.model.loads().excitation
+    }
+
+    /// The same oscillator as a one-DOF [`Mechanical`] system.
+    pub fn mechanical(&self) -> &OneDof<T, L, E> {
+        &self.model
     }
 
     /// The same oscillator with another excitation (e.g. another forcing frequency).
     pub fn with_excitation<E2: Excitation<T>>(self, excitation: E2) -> Oscillator<T, L, E2> {
+        let coordinate = self.model.loads().coordinate;
         Oscillator {
-            mass: self.mass,
-            inv_mass: self.inv_mass,
-            laws: self.laws,
-            excitation,
+            model: self.model.with_loads(Load {
+                coordinate,
+                excitation,
+            }),
         }
     }
 
     /// The restoring force `ΣF(x, 0)` (all velocity-dependent terms vanish at rest for
     /// odd dampers and friction).
     pub fn restoring_force(&self, x: T) -> T {
-        self.laws.force(x, T::zero())
+        self.laws().force(x, T::zero())
     }
 
     /// The static stiffness `∂ΣF/∂x` at `(x, 0)`.
     pub fn static_stiffness(&self, x: T) -> T {
-        self.laws.partials(x, T::zero()).0
+        self.laws().partials(x, T::zero()).0
     }
 
     /// The static equilibrium `X0` with `ΣF(X0, 0) = 0`, bracketed in `[lo, hi]`, solved
@@ -108,46 +118,64 @@ impl<T: Real, L: ForceLaw<T>, E: Excitation<T>> Oscillator<T, L, E> {
 impl<T: Real, L: ForceLaw<T>, E: Excitation<T>> Dynamics<T, 2> for Oscillator<T, L, E> {
     #[inline(always)]
     fn rhs(&self, t: T, y: &SVector<T, 2>, dy: &mut SVector<T, 2>) {
-        let x = y[0];
-        let v = y[1];
-        dy[0] = v;
-        dy[1] = (self.excitation.force(t) - self.laws.force(x, v)) * self.inv_mass;
+        self.model.rhs(t, y, dy);
     }
 
-    fn jacobian(&self, _t: T, y: &SVector<T, 2>) -> Option<SMatrix<T, 2, 2>> {
-        let (fx, fv) = self.laws.partials(y[0], y[1]);
-        Some(SMatrix::<T, 2, 2>::new(
-            T::zero(),
-            T::one(),
-            -fx * self.inv_mass,
-            -fv * self.inv_mass,
-        ))
+    fn jacobian(&self, t: T, y: &SVector<T, 2>) -> Option<SMatrix<T, 2, 2>> {
+        self.model.jacobian(t, y)
     }
 
-    fn time_derivative(&self, t: T, _y: &SVector<T, 2>) -> Option<SVector<T, 2>> {
-        Some(SVector::<T, 2>::new(
-            T::zero(),
-            self.excitation.force_rate(t) * self.inv_mass,
-        ))
+    fn time_derivative(&self, t: T, y: &SVector<T, 2>) -> Option<SVector<T, 2>> {
+        self.model.time_derivative(t, y)
     }
 }
 
-/// Total mechanical energy helper for tests: `½m·v² + ∫₀ˣ F(s, 0) ds` is not generally
-/// available, so only the kinetic part is offered.
-impl<T: Real, L, E> Oscillator<T, L, E> {
+impl<T: Real, L: ForceLaw<T>, E: Excitation<T>> Oscillator<T, L, E> {
     /// Kinetic energy `½·m·v²`.
     pub fn kinetic_energy(&self, v: T) -> T {
-        lit::<T>(0.5) * self.mass * v * v
+        lit::<T>(0.5) * self.mass() * v * v
+    }
+}
+
+/// The serialized form of an [`Oscillator`]: mass, laws, excitation (rebuilt through
+/// [`Oscillator::new`] on deserialize).
+#[cfg(feature = "serde")]
+#[derive(serde::Serialize, serde::Deserialize)]
+struct OscillatorData<T, L, E> {
+    mass: T,
+    laws: L,
+    excitation: E,
+}
+
+#[cfg(feature = "serde")]
+impl<T, L, E> serde::Serialize for Oscillator<T, L, E>
+where
+    T: Real + serde::Serialize,
+    L: ForceLaw<T> + serde::Serialize + Clone,
+    E: Excitation<T> + serde::Serialize + Clone,
+{
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        OscillatorData {
+            mass: self.mass(),
+            laws: self.laws().clone(),
+            excitation: self.excitation().clone(),
+        }
+        .serialize(serializer)
     }
 }
 
 #[cfg(feature = "serde")]
-crate::validate::serde_validated!(
-    [T: Real, L: ForceLaw<T>, E: Excitation<T>] Oscillator<T, L, E>,
-    [T: serde::Serialize, L: serde::Serialize, E: serde::Serialize],
-    [T: serde::Deserialize<'de>, L: serde::Deserialize<'de>, E: serde::Deserialize<'de>],
-    |v| Oscillator::new(v.mass, v.laws, v.excitation)
-);
+impl<'de, T, L, E> serde::Deserialize<'de> for Oscillator<T, L, E>
+where
+    T: Real + serde::Deserialize<'de>,
+    L: ForceLaw<T> + serde::Deserialize<'de>,
+    E: Excitation<T> + serde::Deserialize<'de>,
+{
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        let v = OscillatorData::<T, L, E>::deserialize(deserializer)?;
+        Oscillator::new(v.mass, v.laws, v.excitation).map_err(serde::de::Error::custom)
+    }
+}
 
 #[cfg(test)]
 mod tests {
