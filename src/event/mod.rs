@@ -187,11 +187,19 @@ pub fn check_index(index: usize, n: usize) -> Result<(), EventError> {
 }
 
 /// The hyperplane `g = y[index] − level` (e.g. the stop `x = x_I`), with rate `ẏ[index]`.
+///
+/// Deserialization (feature `serde`) applies the constructor's check of the level (the index
+/// is checked against the state when a run starts).
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Level<T> {
     index: usize,
     level: T,
+}
+
+crate::serde_check::deserialize_checked! {
+    "Level", Level<T: Real> { index: usize, level: T },
+    |raw| -> ParameterError { Level::new(raw.index, raw.level)? }
 }
 
 impl<T: Real> Level<T> {
@@ -410,11 +418,19 @@ impl<T: Real, const N: usize> ResetMap<T, N> for () {
 }
 
 /// Newton's restitution law `ẏ[velocity]⁺ = −r·ẏ[velocity]⁻`.
+///
+/// Deserialization (feature `serde`) applies the constructor's check of `r` (the index is
+/// checked against the state when a run starts).
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Restitution<T> {
     velocity: usize,
     r: T,
+}
+
+crate::serde_check::deserialize_checked! {
+    "Restitution", Restitution<T: Real> { velocity: usize, r: T },
+    |raw| -> ParameterError { Restitution::new(raw.velocity, raw.r)? }
 }
 
 impl<T: Real> Restitution<T> {

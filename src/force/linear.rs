@@ -6,6 +6,8 @@ use crate::{ForceLaw, Real};
 
 /// A linear spring `F = k·(x − x₀)`.
 ///
+/// Deserialization (feature `serde`) applies the constructors' checks.
+///
 /// # Model
 /// $$F(x, \dot x) = k\,(x - x_0), \qquad k \ge 0 .$$
 ///
@@ -16,10 +18,15 @@ use crate::{ForceLaw, Real};
 /// assert_eq!(s.force(1e-3, 5.0), 1.4189);
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct LinearSpring<T> {
     k: T,
     x0: T,
+}
+
+crate::serde_check::deserialize_checked! {
+    "LinearSpring", LinearSpring<T: Real> { k: T, x0: T },
+    |raw| -> ParameterError { LinearSpring::new(raw.k)?.with_rest_position(raw.x0)? }
 }
 
 impl<T: Real> LinearSpring<T> {
@@ -62,12 +69,19 @@ impl<T: Real> ForceLaw<T> for LinearSpring<T> {
 
 /// A linear viscous damper `F = c·ẋ`.
 ///
+/// Deserialization (feature `serde`) applies the constructor's checks.
+///
 /// # Model
 /// $$F(x, \dot x) = c\,\dot x, \qquad c \ge 0 .$$
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct ViscousDamper<T> {
     c: T,
+}
+
+crate::serde_check::deserialize_checked! {
+    "ViscousDamper", ViscousDamper<T: Real> { c: T },
+    |raw| -> ParameterError { ViscousDamper::new(raw.c)? }
 }
 
 impl<T: Real> ViscousDamper<T> {

@@ -9,6 +9,9 @@ use crate::{Dynamics, ForceLaw, Real};
 
 /// A 1-DOF oscillator `m·ẍ + ΣF(x, ẋ) = f(t)` with state `y = (x, ẋ)`.
 ///
+/// Deserialization (feature `serde`) applies the constructor's check of the mass (`1/m` is
+/// recomputed); the laws and the excitation check themselves.
+///
 /// # Model
 /// $$\dot y_0 = y_1, \qquad \dot y_1 = \frac{f(t) - F(y_0, y_1)}{m},$$
 /// with `F` the (summed) force law and `f` the excitation. The Jacobian follows from the
@@ -29,12 +32,31 @@ use crate::{Dynamics, ForceLaw, Real};
 /// # Ok::<(), nonsmooth::Error>(())
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Oscillator<T, L, E> {
     mass: T,
     inv_mass: T,
     laws: L,
     excitation: E,
+}
+
+crate::serde_check::deserialize_checked! {
+    "Oscillator",
+    Oscillator<T: Real, L, E> { mass: T, inv_mass: T, laws: L, excitation: E },
+    |raw| -> ParameterError { Oscillator::assemble(raw.mass, raw.laws, raw.excitation)? }
+}
+
+impl<T: Real, L, E> Oscillator<T, L, E> {
+    /// The checks and the assembly of [`new`](Self::new), shared with deserialization.
+    fn assemble(mass: T, laws: L, excitation: E) -> Result<Self, ParameterError> {
+        let mass = positive("mass", mass)?;
+        Ok(Self {
+            mass,
+            inv_mass: T::one() / mass,
+            laws,
+            excitation,
+        })
+    }
 }
 
 impl<T: Real, L: ForceLaw<T>, E: Excitation<T>> Oscillator<T, L, E> {
@@ -43,13 +65,7 @@ impl<T: Real, L: ForceLaw<T>, E: Excitation<T>> Oscillator<T, L, E> {
     /// # Errors
     /// [`ParameterError`] unless `mass` is finite and > 0.
     pub fn new(mass: T, laws: L, excitation: E) -> Result<Self, ParameterError> {
-        let mass = positive("mass", mass)?;
-        Ok(Self {
-            mass,
-            inv_mass: T::one() / mass,
-            laws,
-            excitation,
-        })
+        Self::assemble(mass, laws, excitation)
     }
 
     /// The mass `m`.
