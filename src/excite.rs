@@ -129,18 +129,21 @@ impl<T: Real> Excitation<T> for Constant<T> {
 
 /// Harmonic forcing `F0·sin(ωt + φ0)`.
 ///
+/// Deserialization (feature `serde`) applies the constructor's checks.
+///
 /// # Model
 /// $$f(t) = F_0 \sin(\omega t + \varphi_0), \qquad \varphi(t) = \omega t + \varphi_0 .$$
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(
-    feature = "serde",
-    derive(serde::Serialize, serde::Deserialize),
-    serde(remote = "Self")
-)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Harmonic<T> {
     amplitude: T,
     omega: T,
     phase0: T,
+}
+
+crate::serde_check::deserialize_checked! {
+    "Harmonic", Harmonic<T: Real> { amplitude: T, omega: T, phase0: T },
+    |raw| -> ParameterError { Harmonic::new(raw.amplitude, raw.omega, raw.phase0)? }
 }
 
 impl<T: Real> Harmonic<T> {
@@ -224,20 +227,24 @@ impl<T: Real> Excitation<T> for Harmonic<T> {
 
 /// An unbalanced rotor at constant speed: `m0·e·ω²·sin(ωt)` (the paper's forcing).
 ///
+/// Deserialization (feature `serde`) applies the constructor's checks; the amplitude
+/// `m0e·ω²` is recomputed.
+///
 /// # Model
 /// $$f(t) = m_0 e\,\omega^2 \sin\omega t .$$
 /// # References
 /// The paper's eq. (1), right-hand side; `m0·e = 0.01805 kg·m`.
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(
-    feature = "serde",
-    derive(serde::Serialize, serde::Deserialize),
-    serde(remote = "Self")
-)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct UnbalancedRotor<T> {
     m0e: T,
     omega: T,
     amp: T,
+}
+
+crate::serde_check::deserialize_checked! {
+    "UnbalancedRotor", UnbalancedRotor<T: Real> { m0e: T, omega: T, amp: T },
+    |raw| -> ParameterError { UnbalancedRotor::new(raw.m0e, raw.omega)? }
 }
 
 impl<T: Real> UnbalancedRotor<T> {
@@ -305,6 +312,8 @@ impl<T: Real> Excitation<T> for UnbalancedRotor<T> {
 /// An unbalanced rotor whose speed ramps linearly, `ω(t) = ω0 + r·t` (the experiment's
 /// continuous sweep, `r = 8.0905·10⁻³ rad/s²`).
 ///
+/// Deserialization (feature `serde`) applies the constructor's checks.
+///
 /// # Model
 /// The rotor angle is integrated exactly, `φ(t) = ω0·t + r·t²/2`, and the force is that of
 /// an unbalance `m0e` at angle `φ`, including the tangential term of the angular
@@ -313,15 +322,16 @@ impl<T: Real> Excitation<T> for UnbalancedRotor<T> {
 /// For `r = 0` it is [`UnbalancedRotor`]. Stroboscopic sections are at `φ = 2πi`, found
 /// from the quadratic for `t` (no accumulated time).
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(
-    feature = "serde",
-    derive(serde::Serialize, serde::Deserialize),
-    serde(remote = "Self")
-)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct RampedRotor<T> {
     m0e: T,
     omega0: T,
     rate: T,
+}
+
+crate::serde_check::deserialize_checked! {
+    "RampedRotor", RampedRotor<T: Real> { m0e: T, omega0: T, rate: T },
+    |raw| -> ParameterError { RampedRotor::new(raw.m0e, raw.omega0, raw.rate)? }
 }
 
 impl<T: Real> RampedRotor<T> {
@@ -384,30 +394,6 @@ impl<T: Real> Excitation<T> for RampedRotor<T> {
         Some(self.omega_at(t))
     }
 }
-
-#[cfg(feature = "serde")]
-crate::validate::serde_validated!(
-    [T: Real] Harmonic<T>,
-    [T: serde::Serialize],
-    [T: serde::Deserialize<'de>],
-    |v| Harmonic::new(v.amplitude, v.omega, v.phase0)
-);
-
-#[cfg(feature = "serde")]
-crate::validate::serde_validated!(
-    [T: Real] UnbalancedRotor<T>,
-    [T: serde::Serialize],
-    [T: serde::Deserialize<'de>],
-    |v| UnbalancedRotor::new(v.m0e, v.omega)
-);
-
-#[cfg(feature = "serde")]
-crate::validate::serde_validated!(
-    [T: Real] RampedRotor<T>,
-    [T: serde::Serialize],
-    [T: serde::Deserialize<'de>],
-    |v| RampedRotor::new(v.m0e, v.omega0, v.rate)
-);
 
 #[cfg(test)]
 mod tests {

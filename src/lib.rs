@@ -63,6 +63,7 @@ pub mod output;
 pub mod roots;
 pub mod sample;
 pub mod scalar;
+mod serde_check;
 pub mod signal;
 pub mod sweep;
 pub mod systems;

@@ -63,38 +63,3 @@ pub(crate) fn normal_square<T: crate::Real>(
         ))
     }
 }
-
-/// Serde for a type whose constructor validates: `Serialize` is the derived code, and
-/// `Deserialize` is the derived code followed by `$check`, an expression of the raw value
-/// `$v` that rebuilds it through the constructors (so deserialization applies exactly the
-/// constructor's checks) and returns `Result<Self, impl Display>`.
-///
-/// The type derives `Serialize, Deserialize` with `#[serde(remote = "Self")]`, which makes
-/// the derive generate inherent `serialize`/`deserialize` functions instead of the trait
-/// impls; this macro writes the trait impls around them.
-#[cfg(feature = "serde")]
-macro_rules! serde_validated {
-    ([$($gen:tt)*] $ty:ty, [$($ser:tt)*], [$($de:tt)*], |$v:ident| $check:expr) => {
-        impl<$($gen)*> serde::Serialize for $ty
-        where
-            $($ser)*
-        {
-            fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-                <$ty>::serialize(self, serializer)
-            }
-        }
-
-        impl<'de, $($gen)*> serde::Deserialize<'de> for $ty
-        where
-            $($de)*
-        {
-            fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-                let $v = <$ty>::deserialize(deserializer)?;
-                $check.map_err(serde::de::Error::custom)
-            }
-        }
-    };
-}
-
-#[cfg(feature = "serde")]
-pub(crate) use serde_validated;

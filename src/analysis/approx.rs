@@ -127,6 +127,9 @@ fn equilibrium<T: Real, L: ForceLaw<T>, E: Excitation<T>>(
 
 /// The linearized steady response about the static equilibrium `X0` (the paper's eq. 4).
 ///
+/// Deserialization (feature `serde`) applies the checks of
+/// [`from_parts`](Self::from_parts).
+///
 /// # Model
 /// Linearizing `m ẍ + ΣF(x, ẋ) = F0(ω) sin ωt` about `(X0, 0)`, keeping the static stiffness
 /// and the viscous coefficient only,
@@ -165,13 +168,40 @@ fn equilibrium<T: Real, L: ForceLaw<T>, E: Excitation<T>>(
 /// # References
 /// The paper's Sect. 5, eq. (4) and the grazing estimate that follows it.
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct LinearizedResponse<T, F = Forcing<T>> {
     mass: T,
     stiffness: T,
     damping: T,
     x0: T,
     forcing: F,
+}
+
+crate::serde_check::deserialize_checked! {
+    "LinearizedResponse",
+    LinearizedResponse<T: Real, F> { mass: T, stiffness: T, damping: T, x0: T, forcing: F },
+    |raw| -> AnalysisError {
+        LinearizedResponse::checked(raw.mass, raw.stiffness, raw.damping, raw.x0, raw.forcing)?
+    }
+}
+
+impl<T: Real, F> LinearizedResponse<T, F> {
+    /// The checks of [`from_parts`](Self::from_parts), shared with deserialization.
+    fn checked(
+        mass: T,
+        stiffness: T,
+        damping: T,
+        x0: T,
+        forcing: F,
+    ) -> Result<Self, AnalysisError> {
+        Ok(Self {
+            mass: positive("mass", mass)?,
+            stiffness: finite("stiffness", stiffness)?,
+            damping: non_negative("damping", damping)?,
+            x0: finite("x0", x0)?,
+            forcing,
+        })
+    }
 }
 
 impl<T: Real, F: ForcingAmplitude<T>> LinearizedResponse<T, F> {
@@ -229,13 +259,7 @@ impl<T: Real, F: ForcingAmplitude<T>> LinearizedResponse<T, F> {
         x0: T,
         forcing: F,
     ) -> Result<Self, AnalysisError> {
-        Ok(Self {
-            mass: positive("mass", mass)?,
-            stiffness: finite("stiffness", stiffness)?,
-            damping: non_negative("damping", damping)?,
-            x0: finite("x0", x0)?,
-            forcing,
-        })
+        Self::checked(mass, stiffness, damping, x0, forcing)
     }
 
     /// The equilibrium `X0`.

@@ -187,15 +187,19 @@ pub fn check_index(index: usize, n: usize) -> Result<(), EventError> {
 }
 
 /// The hyperplane `g = y[index] − level` (e.g. the stop `x = x_I`), with rate `ẏ[index]`.
+///
+/// Deserialization (feature `serde`) applies the constructor's check of the level (the index
+/// is checked against the state when a run starts).
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(
-    feature = "serde",
-    derive(serde::Serialize, serde::Deserialize),
-    serde(remote = "Self")
-)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Level<T> {
     index: usize,
     level: T,
+}
+
+crate::serde_check::deserialize_checked! {
+    "Level", Level<T: Real> { index: usize, level: T },
+    |raw| -> ParameterError { Level::new(raw.index, raw.level)? }
 }
 
 impl<T: Real> Level<T> {
@@ -414,15 +418,19 @@ impl<T: Real, const N: usize> ResetMap<T, N> for () {
 }
 
 /// Newton's restitution law `ẏ[velocity]⁺ = −r·ẏ[velocity]⁻`.
+///
+/// Deserialization (feature `serde`) applies the constructor's check of `r` (the index is
+/// checked against the state when a run starts).
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(
-    feature = "serde",
-    derive(serde::Serialize, serde::Deserialize),
-    serde(remote = "Self")
-)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Restitution<T> {
     velocity: usize,
     r: T,
+}
+
+crate::serde_check::deserialize_checked! {
+    "Restitution", Restitution<T: Real> { velocity: usize, r: T },
+    |raw| -> ParameterError { Restitution::new(raw.velocity, raw.r)? }
 }
 
 impl<T: Real> Restitution<T> {
@@ -1062,22 +1070,6 @@ impl<T: Real> EventHistory<T> {
         }
     }
 }
-
-#[cfg(feature = "serde")]
-crate::validate::serde_validated!(
-    [T: Real] Level<T>,
-    [T: serde::Serialize],
-    [T: serde::Deserialize<'de>],
-    |v| Level::new(v.index, v.level)
-);
-
-#[cfg(feature = "serde")]
-crate::validate::serde_validated!(
-    [T: Real] Restitution<T>,
-    [T: serde::Serialize],
-    [T: serde::Deserialize<'de>],
-    |v| Restitution::new(v.velocity, v.r)
-);
 
 #[cfg(test)]
 mod tests {

@@ -19,6 +19,9 @@ pub enum Side {
 
 /// The generalized Hertz contact law with nonlinear damping of the paper's eq. (1).
 ///
+/// Deserialization (feature `serde`) applies the constructor's and the builders' checks
+/// (the value is rebuilt from its parameters).
+///
 /// # Model
 /// With the penetration `δ = x − x_I` and its rate `δ̇ = ẋ` (for [`Side::Upper`]; mirrored for
 /// [`Side::Lower`]):
@@ -41,11 +44,7 @@ pub enum Side {
 /// The paper's eq. (1), impact force `F_I`; `n1 = n2 = 3/2`, `n3 = 0.18667`,
 /// `k_I = 2.3983·10⁸ N/m^{3/2}`, `b = 0.8485 m^{−n3}s^{n3}`.
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(
-    feature = "serde",
-    derive(serde::Serialize, serde::Deserialize),
-    serde(remote = "Self")
-)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct HertzContact<T> {
     x_i: T,
     side: Side,
@@ -57,6 +56,29 @@ pub struct HertzContact<T> {
     eta: T,
     /// `(n3 − 1)/2`, cached for the regularized rate term.
     half_n3_minus_1: T,
+}
+
+crate::serde_check::deserialize_checked! {
+    "HertzContact",
+    HertzContact<T: Real> {
+        x_i: T,
+        side: Side,
+        k_i: T,
+        b: T,
+        n1: Exponent<T>,
+        n2: Exponent<T>,
+        n3: T,
+        eta: T,
+        half_n3_minus_1: T,
+    },
+    // The cached `(n3 − 1)/2` is recomputed by `with_damping`.
+    |raw| -> ParameterError {
+        HertzContact::new(raw.x_i, raw.k_i)?
+            .with_side(raw.side)
+            .with_stiffness_exponent(raw.n1.value())?
+            .with_damping(raw.b, raw.n2.value(), raw.n3)?
+            .with_rate_regularization(raw.eta)?
+    }
 }
 
 impl<T: Real> HertzContact<T> {
@@ -268,18 +290,6 @@ impl<T: Real> ForceLaw<T> for HertzContact<T> {
         (clamp(self.k_i * fd), clamp(self.k_i * fw))
     }
 }
-
-#[cfg(feature = "serde")]
-crate::validate::serde_validated!(
-    [T: Real] HertzContact<T>,
-    [T: serde::Serialize],
-    [T: serde::Deserialize<'de>],
-    |v| HertzContact::new(v.x_i, v.k_i)
-        .map(|h| h.with_side(v.side))
-        .and_then(|h| h.with_stiffness_exponent(v.n1.value()))
-        .and_then(|h| h.with_damping(v.b, v.n2.value(), v.n3))
-        .and_then(|h| h.with_rate_regularization(v.eta))
-);
 
 #[cfg(test)]
 mod tests {

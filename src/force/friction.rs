@@ -16,6 +16,8 @@ pub enum Regularization {
 
 /// Dry friction of magnitude `T` with a regularized sign function.
 ///
+/// Deserialization (feature `serde`) applies the constructor's checks.
+///
 /// # Model
 /// $$F(\dot x) = T\,\frac{\dot x}{\sqrt{\dot x^2+\varepsilon^2}} \quad\text{(Sqrt)},\qquad
 ///   F(\dot x) = T\tanh(\dot x/\varepsilon) \quad\text{(Tanh)} .$$
@@ -26,15 +28,16 @@ pub enum Regularization {
 /// # References
 /// The paper's eq. (1), resistance force `F_R`.
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(
-    feature = "serde",
-    derive(serde::Serialize, serde::Deserialize),
-    serde(remote = "Self")
-)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct DryFriction<T> {
     t: T,
     eps: T,
     reg: Regularization,
+}
+
+crate::serde_check::deserialize_checked! {
+    "DryFriction", DryFriction<T: Real> { t: T, eps: T, reg: Regularization },
+    |raw| -> ParameterError { DryFriction::new(raw.t, raw.eps, raw.reg)? }
 }
 
 impl<T: Real> DryFriction<T> {
@@ -108,14 +111,6 @@ impl<T: Real> ForceLaw<T> for DryFriction<T> {
         (T::zero(), dv)
     }
 }
-
-#[cfg(feature = "serde")]
-crate::validate::serde_validated!(
-    [T: Real] DryFriction<T>,
-    [T: serde::Serialize],
-    [T: serde::Deserialize<'de>],
-    |v| DryFriction::new(v.t, v.eps, v.reg)
-);
 
 #[cfg(test)]
 mod tests {

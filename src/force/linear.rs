@@ -6,6 +6,8 @@ use crate::{ForceLaw, Real};
 
 /// A linear spring `F = k·(x − x₀)`.
 ///
+/// Deserialization (feature `serde`) applies the constructors' checks.
+///
 /// # Model
 /// $$F(x, \dot x) = k\,(x - x_0), \qquad k \ge 0 .$$
 ///
@@ -16,14 +18,15 @@ use crate::{ForceLaw, Real};
 /// assert_eq!(s.force(1e-3, 5.0), 1.4189);
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(
-    feature = "serde",
-    derive(serde::Serialize, serde::Deserialize),
-    serde(remote = "Self")
-)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct LinearSpring<T> {
     k: T,
     x0: T,
+}
+
+crate::serde_check::deserialize_checked! {
+    "LinearSpring", LinearSpring<T: Real> { k: T, x0: T },
+    |raw| -> ParameterError { LinearSpring::new(raw.k)?.with_rest_position(raw.x0)? }
 }
 
 impl<T: Real> LinearSpring<T> {
@@ -66,16 +69,19 @@ impl<T: Real> ForceLaw<T> for LinearSpring<T> {
 
 /// A linear viscous damper `F = c·ẋ`.
 ///
+/// Deserialization (feature `serde`) applies the constructor's checks.
+///
 /// # Model
 /// $$F(x, \dot x) = c\,\dot x, \qquad c \ge 0 .$$
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(
-    feature = "serde",
-    derive(serde::Serialize, serde::Deserialize),
-    serde(remote = "Self")
-)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct ViscousDamper<T> {
     c: T,
+}
+
+crate::serde_check::deserialize_checked! {
+    "ViscousDamper", ViscousDamper<T: Real> { c: T },
+    |raw| -> ParameterError { ViscousDamper::new(raw.c)? }
 }
 
 impl<T: Real> ViscousDamper<T> {
@@ -105,22 +111,6 @@ impl<T: Real> ForceLaw<T> for ViscousDamper<T> {
         (T::zero(), self.c)
     }
 }
-
-#[cfg(feature = "serde")]
-crate::validate::serde_validated!(
-    [T: Real] LinearSpring<T>,
-    [T: serde::Serialize],
-    [T: serde::Deserialize<'de>],
-    |v| LinearSpring::new(v.k).and_then(|s| s.with_rest_position(v.x0))
-);
-
-#[cfg(feature = "serde")]
-crate::validate::serde_validated!(
-    [T: Real] ViscousDamper<T>,
-    [T: serde::Serialize],
-    [T: serde::Deserialize<'de>],
-    |v| ViscousDamper::new(v.c)
-);
 
 #[cfg(test)]
 mod tests {

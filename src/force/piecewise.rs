@@ -7,6 +7,8 @@ use crate::{ForceLaw, Real};
 /// A continuous piecewise-linear spring: stiffness `k_in` on `[lo, hi]` and `k_in + k_out`
 /// outside.
 ///
+/// Deserialization (feature `serde`) applies the constructor's checks, `lo ≤ hi` included.
+///
 /// # Model
 /// $$F(x,\dot x) = k_{in}\,x + k_{out}\big[(x - x_{hi})^+ - (x_{lo} - x)^+\big],$$
 /// with `(·)⁺ = max(·, 0)`. Special cases:
@@ -31,16 +33,17 @@ use crate::{ForceLaw, Real};
 /// assert_eq!(stop.force(1.0, 0.0), 1.0 + 9.0 * 0.5);
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(
-    feature = "serde",
-    derive(serde::Serialize, serde::Deserialize),
-    serde(remote = "Self")
-)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Bilinear<T> {
     k_in: T,
     k_out: T,
     lo: T,
     hi: T,
+}
+
+crate::serde_check::deserialize_checked! {
+    "Bilinear", Bilinear<T: Real> { k_in: T, k_out: T, lo: T, hi: T },
+    |raw| -> ParameterError { Bilinear::new(raw.k_in, raw.k_out, raw.lo, raw.hi)? }
 }
 
 impl<T: Real> Bilinear<T> {
@@ -123,14 +126,6 @@ impl<T: Real> ForceLaw<T> for Bilinear<T> {
         }
     }
 }
-
-#[cfg(feature = "serde")]
-crate::validate::serde_validated!(
-    [T: Real] Bilinear<T>,
-    [T: serde::Serialize],
-    [T: serde::Deserialize<'de>],
-    |v| Bilinear::new(v.k_in, v.k_out, v.lo, v.hi)
-);
 
 #[cfg(test)]
 mod tests {

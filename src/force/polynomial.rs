@@ -6,6 +6,8 @@ use crate::{ForceLaw, Real};
 
 /// A cubic (Duffing) spring `F = k₁·u + k₃·u³`, `u = x − x₀`.
 ///
+/// Deserialization (feature `serde`) applies the constructors' checks.
+///
 /// # Model
 /// $$F(x, \dot x) = k_1 u + k_3 u^3, \qquad u = x - x_0,\qquad
 /// \partial_x F = k_1 + 3 k_3 u^2 .$$
@@ -21,15 +23,16 @@ use crate::{ForceLaw, Real};
 /// assert_eq!(s.partials(2.0, 0.0), (-1.0 + 12.0, 0.0));
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(
-    feature = "serde",
-    derive(serde::Serialize, serde::Deserialize),
-    serde(remote = "Self")
-)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct CubicSpring<T> {
     k1: T,
     k3: T,
     x0: T,
+}
+
+crate::serde_check::deserialize_checked! {
+    "CubicSpring", CubicSpring<T: Real> { k1: T, k3: T, x0: T },
+    |raw| -> ParameterError { CubicSpring::new(raw.k1, raw.k3)?.with_rest_position(raw.x0)? }
 }
 
 impl<T: Real> CubicSpring<T> {
@@ -155,14 +158,6 @@ impl<T: Real, const D: usize> ForceLaw<T> for Polynomial<T, D> {
         (acc, T::zero())
     }
 }
-
-#[cfg(feature = "serde")]
-crate::validate::serde_validated!(
-    [T: Real] CubicSpring<T>,
-    [T: serde::Serialize],
-    [T: serde::Deserialize<'de>],
-    |v| CubicSpring::new(v.k1, v.k3).and_then(|s| s.with_rest_position(v.x0))
-);
 
 #[cfg(test)]
 mod tests {

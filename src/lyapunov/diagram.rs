@@ -58,8 +58,12 @@ impl<T: Real> IntervalRule<T> {
 }
 
 /// The schedule of a diagram: transients and averaging lengths, in intervals.
+///
+/// Deserialization (feature `serde`) applies the checks of [`new`](Self::new) and
+/// [`with_blocks`](Self::with_blocks); `t0`, which they do not take, is checked when a
+/// diagram starts.
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[non_exhaustive]
 pub struct DiagramSettings<T> {
     /// The renormalization interval.
@@ -75,6 +79,28 @@ pub struct DiagramSettings<T> {
     /// The time at which every value's run starts (the clock restarts there; 0 for the
     /// paper's Poincaré section `t = 2πi/ω`).
     pub t0: T,
+}
+
+crate::serde_check::deserialize_checked! {
+    "DiagramSettings",
+    DiagramSettings<T: Real> {
+        interval: IntervalRule<T>,
+        first_transient: usize,
+        step_transient: usize,
+        intervals: usize,
+        blocks: usize,
+        t0: T,
+    },
+    |raw| -> LyapunovError {
+        let settings = DiagramSettings::new(
+            raw.interval,
+            raw.first_transient,
+            raw.step_transient,
+            raw.intervals,
+        )?
+        .with_blocks(raw.blocks)?;
+        DiagramSettings { t0: raw.t0, ..settings }
+    }
 }
 
 impl<T: Real> DiagramSettings<T> {

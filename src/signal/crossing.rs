@@ -25,6 +25,8 @@ pub struct Crossing<T> {
 /// Detects crossings of a level in sampled data, e.g. impacts as the upward crossings of
 /// `x_I − 0.01 mm` ([`paper_impacts`](Self::paper_impacts)).
 ///
+/// Deserialization (feature `serde`) applies the constructor's and the builders' checks.
+///
 /// # Formula
 /// A rising crossing lies in the interval `[t_n, t_{n+1}]` when `x_n < L ≤ x_{n+1}`
 /// (falling: `x_n > L ≥ x_{n+1}`); its time is the root of the linear interpolant,
@@ -57,16 +59,28 @@ pub struct Crossing<T> {
 /// # Ok::<(), nonsmooth::signal::SignalError>(())
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(
-    feature = "serde",
-    derive(serde::Serialize, serde::Deserialize),
-    serde(remote = "Self")
-)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct ThresholdCrossing<T> {
     level: T,
     direction: Direction,
     hysteresis: T,
     min_separation: T,
+}
+
+crate::serde_check::deserialize_checked! {
+    "ThresholdCrossing",
+    ThresholdCrossing<T: Real> {
+        level: T,
+        direction: Direction,
+        hysteresis: T,
+        min_separation: T,
+    },
+    |raw| -> SignalError {
+        ThresholdCrossing::new(raw.level)?
+            .with_direction(raw.direction)
+            .with_hysteresis(raw.hysteresis)?
+            .with_min_separation(raw.min_separation)?
+    }
 }
 
 impl<T: Real> ThresholdCrossing<T> {
@@ -257,17 +271,6 @@ pub fn intervals<T: Real>(times: &[T]) -> Vec<T> {
     intervals_into(times, &mut out);
     out
 }
-
-#[cfg(feature = "serde")]
-crate::validate::serde_validated!(
-    [T: Real] ThresholdCrossing<T>,
-    [T: serde::Serialize],
-    [T: serde::Deserialize<'de>],
-    |v| ThresholdCrossing::new(v.level)
-        .map(|c| c.with_direction(v.direction))
-        .and_then(|c| c.with_hysteresis(v.hysteresis))
-        .and_then(|c| c.with_min_separation(v.min_separation))
-);
 
 #[cfg(test)]
 mod tests {

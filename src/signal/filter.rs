@@ -22,6 +22,8 @@ pub enum InitialState<T> {
 /// The first-order low-pass filter with transfer function `1/(θs + 1)`, the paper's smoothing
 /// of the measured cart position (`θ = 1 ms`, Sect. 3).
 ///
+/// Deserialization (feature `serde`) applies the constructor's check of `θ`.
+///
 /// # Formula
 /// The filter is the ODE `θ·ẏ = u − y`. Holding the input constant over each sample interval
 /// (zero-order hold, `u(t) = u_n` on `[t_n, t_{n+1})`) the ODE is solved exactly:
@@ -51,14 +53,15 @@ pub enum InitialState<T> {
 /// # Ok::<(), nonsmooth::signal::SignalError>(())
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(
-    feature = "serde",
-    derive(serde::Serialize, serde::Deserialize),
-    serde(remote = "Self")
-)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct LowPass<T> {
     theta: T,
     initial: InitialState<T>,
+}
+
+crate::serde_check::deserialize_checked! {
+    "LowPass", LowPass<T: Real> { theta: T, initial: InitialState<T> },
+    |raw| -> SignalError { LowPass::new(raw.theta)?.with_initial(raw.initial) }
 }
 
 impl<T: Real> LowPass<T> {
@@ -209,14 +212,6 @@ fn blend<T: Real>(y: T, u: T, b: T) -> T {
         ((T::one() - b) * y + b * u).max(lo).min(hi)
     }
 }
-
-#[cfg(feature = "serde")]
-crate::validate::serde_validated!(
-    [T: Real] LowPass<T>,
-    [T: serde::Serialize],
-    [T: serde::Deserialize<'de>],
-    |v| LowPass::new(v.theta).map(|f| f.with_initial(v.initial))
-);
 
 #[cfg(test)]
 mod tests {

@@ -33,6 +33,9 @@ pub struct PoincarePoint<T> {
 /// Samples a signal where the (unwrapped) forcing phase passes `2πi + φ_0`, `i ∈ ℤ`: the
 /// paper's section `t = 2πi/ω` generalized to a measured or ramped phase.
 ///
+/// Deserialization (feature `serde`) applies the check of
+/// [`with_offset`](Self::with_offset).
+///
 /// # Formula
 /// Wrapped input is unwrapped by adding the multiple of `2π` that keeps every increment in
 /// `[−π, π]`: `φ̃_n = φ_n + 2πk_n`, `k_n = k_{n−1} − round((φ_n + 2πk_{n−1} − φ̃_{n−1})/2π)`
@@ -60,14 +63,15 @@ pub struct PoincarePoint<T> {
 /// # Ok::<(), nonsmooth::signal::SignalError>(())
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(
-    feature = "serde",
-    derive(serde::Serialize, serde::Deserialize),
-    serde(remote = "Self")
-)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct PhaseSection<T> {
     offset: T,
     input: PhaseInput,
+}
+
+crate::serde_check::deserialize_checked! {
+    "PhaseSection", PhaseSection<T: Real> { offset: T, input: PhaseInput },
+    |raw| -> SignalError { PhaseSection::new().with_offset(raw.offset)?.with_input(raw.input) }
 }
 
 impl<T: Real> Default for PhaseSection<T> {
@@ -337,16 +341,6 @@ pub fn section_frequencies<T: Real>(points: &[PoincarePoint<T>]) -> Result<Vec<T
     }
     Ok(out)
 }
-
-#[cfg(feature = "serde")]
-crate::validate::serde_validated!(
-    [T: Real] PhaseSection<T>,
-    [T: serde::Serialize],
-    [T: serde::Deserialize<'de>],
-    |v| PhaseSection::new()
-        .with_offset(v.offset)
-        .map(|s| s.with_input(v.input))
-);
 
 #[cfg(test)]
 mod tests {

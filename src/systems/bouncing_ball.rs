@@ -45,12 +45,10 @@ pub type BallModel<T> = Mechanical<T, 1, 2, (), Load<T, 1, Constant<T>>>;
 pub type Table<T> = Gap<T, 1, Harmonic<T>>;
 
 /// The parameters of the ball on the vibrating table (SI units).
+///
+/// Deserialization (feature `serde`) applies [`validate`](Self::validate).
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(
-    feature = "serde",
-    derive(serde::Serialize, serde::Deserialize),
-    serde(remote = "Self")
-)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct BouncingBallTable {
     /// Gravity `g` (m/s²).
     pub g: f64,
@@ -60,6 +58,14 @@ pub struct BouncingBallTable {
     pub omega: f64,
     /// Restitution coefficient `e ∈ [0, 1]`.
     pub e: f64,
+}
+
+crate::serde_check::deserialize_checked! {
+    "BouncingBallTable", BouncingBallTable { g: f64, amplitude: f64, omega: f64, e: f64 },
+    |raw| -> ParameterError {
+        raw.validate()?;
+        raw
+    }
 }
 
 impl BouncingBallTable {
@@ -145,10 +151,3 @@ impl BouncingBallTable {
     }
 }
 
-#[cfg(feature = "serde")]
-crate::validate::serde_validated!(
-    [] BouncingBallTable,
-    [],
-    [],
-    |v| v.model::<f64>().and(v.impact::<f64>()).map(|_| v)
-);

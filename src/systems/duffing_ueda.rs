@@ -28,12 +28,10 @@ pub type DuffingUedaElements<T> = Element<T, 1, (CubicSpring<T>, ViscousDamper<T
 pub type DuffingUedaModel<T> = Mechanical<T, 1, 2, DuffingUedaElements<T>, Load<T, 1, Harmonic<T>>>;
 
 /// The parameters of the Duffing–Ueda oscillator `ẍ + kẋ + x³ = B cos ωt`.
+///
+/// Deserialization (feature `serde`) applies [`validate`](Self::validate).
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(
-    feature = "serde",
-    derive(serde::Serialize, serde::Deserialize),
-    serde(remote = "Self")
-)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct DuffingUeda {
     /// Damping `k ≥ 0`.
     pub k: f64,
@@ -41,6 +39,14 @@ pub struct DuffingUeda {
     pub b: f64,
     /// Forcing frequency `ω > 0`.
     pub omega: f64,
+}
+
+crate::serde_check::deserialize_checked! {
+    "DuffingUeda", DuffingUeda { k: f64, b: f64, omega: f64 },
+    |raw| -> ParameterError {
+        raw.validate()?;
+        raw
+    }
 }
 
 impl Default for DuffingUeda {
@@ -91,14 +97,6 @@ impl DuffingUeda {
             )?))
     }
 }
-
-#[cfg(feature = "serde")]
-crate::validate::serde_validated!(
-    [] DuffingUeda,
-    [],
-    [],
-    |v| v.model::<f64>().map(|_| v)
-);
 
 #[cfg(test)]
 mod tests {

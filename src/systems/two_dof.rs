@@ -40,12 +40,10 @@ pub type TwoDofElements<T> = (
 pub type TwoDofImpactModel<T> = Mechanical<T, 2, 4, TwoDofElements<T>, Load<T, 2, Harmonic<T>>>;
 
 /// The parameters of the 2-DOF impact oscillator (nondimensional).
+///
+/// Deserialization (feature `serde`) applies [`validate`](Self::validate).
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(
-    feature = "serde",
-    derive(serde::Serialize, serde::Deserialize),
-    serde(remote = "Self")
-)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct TwoDofImpact {
     /// Primary mass `m_1`.
     pub m1: f64,
@@ -67,6 +65,26 @@ pub struct TwoDofImpact {
     pub k_contact: f64,
     /// Contact damping `b` (Hunt–Crossley, per velocity).
     pub b_contact: f64,
+}
+
+crate::serde_check::deserialize_checked! {
+    "TwoDofImpact",
+    TwoDofImpact {
+        m1: f64,
+        m2: f64,
+        k1: f64,
+        k2: f64,
+        c1: f64,
+        c2: f64,
+        force: f64,
+        gap: f64,
+        k_contact: f64,
+        b_contact: f64,
+    },
+    |raw| -> ParameterError {
+        raw.validate()?;
+        raw
+    }
 }
 
 impl Default for TwoDofImpact {
@@ -158,10 +176,3 @@ impl TwoDofImpact {
     }
 }
 
-#[cfg(feature = "serde")]
-crate::validate::serde_validated!(
-    [] TwoDofImpact,
-    [],
-    [],
-    |v| v.model::<f64>(1.0).map(|_| v)
-);
