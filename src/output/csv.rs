@@ -11,6 +11,8 @@
 //! | [`write_ramp_impacts`] | `t_s, omega_rad_s, interval_s, velocity_m_s` |
 //! | [`write_section_points`] | `t_s, x_m, v_m_s` (section points or trajectory samples) |
 //! | [`write_impacts`] | `t_s, velocity_m_s, interval_s, max_penetration_m` |
+//! | [`write_branch`] | `param, arclength, stable, <state>, max_multiplier, grazing_margin_m` — one row per point of a continued orbit branch |
+//! | [`write_bifurcations`] | `param, kind, <state>, max_multiplier` — one row per located bifurcation |
 //! | [`write_table`] | any header, any rows of [`Cell`]s |
 //!
 //! The parameter and state column names are configurable ([`SweepColumns`], the `state`
@@ -44,6 +46,7 @@ use std::fs::File;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+use crate::orbit::{BifurcationKind, Branch, modulus};
 use crate::sample::{Impact, SectionPoint};
 use crate::scalar::to_f64;
 use crate::sweep::{RampRecord, SweepDirection, SweepResult};
@@ -391,6 +394,73 @@ pub fn write_sweep_summary<W: Write, const N: usize>(
                 Cell::Number(p.grazing_margin),
             ])?;
         }
+    }
+    t.finish().map(|_| ())
+}
+
+/// The name of a bifurcation kind in tables: `fold`, `period_doubling`, `neimark_sacker`,
+/// `grazing`.
+pub fn bifurcation_name(kind: BifurcationKind) -> &'static str {
+    match kind {
+        BifurcationKind::Fold => "fold",
+        BifurcationKind::PeriodDoubling => "period_doubling",
+        BifurcationKind::NeimarkSacker => "neimark_sacker",
+        BifurcationKind::Grazing => "grazing",
+    }
+}
+
+/// One row per point of a continued branch ([`crate::orbit::follow`]): parameter,
+/// arclength, stability (`1`/`0`), the orbit's state at the section, the largest
+/// multiplier modulus and the grazing margin (empty if not tested).
+///
+/// # Errors
+/// [`Error::Output`] if a write fails.
+pub fn write_branch<W: Write, const N: usize>(
+    out: W,
+    branch: &Branch<N>,
+    columns: &SweepColumns<'_, N>,
+) -> Result<()> {
+    let mut header = vec![columns.param, "arclength", "stable"];
+    header.extend(columns.state);
+    header.extend(["max_multiplier", "grazing_margin_m"]);
+    let mut t = TableWriter::new(out, &header)?;
+    for q in &branch.points {
+        let mut row = vec![
+            Cell::Number(q.p),
+            Cell::Number(q.arclength),
+            Cell::Integer(i128::from(q.stable)),
+        ];
+        row.extend(q.state.iter().map(|&v| Cell::Number(v)));
+        row.push(Cell::Number(
+            q.multipliers.first().map_or(f64::NAN, modulus),
+        ));
+        row.push(q.grazing_margin.map_or(Cell::Empty, Cell::Number));
+        t.row(row)?;
+    }
+    t.finish().map(|_| ())
+}
+
+/// One row per located bifurcation of a branch: parameter, kind
+/// ([`bifurcation_name`]), the orbit's state, the largest multiplier modulus.
+///
+/// # Errors
+/// [`Error::Output`] if a write fails.
+pub fn write_bifurcations<W: Write, const N: usize>(
+    out: W,
+    branch: &Branch<N>,
+    columns: &SweepColumns<'_, N>,
+) -> Result<()> {
+    let mut header = vec![columns.param, "kind"];
+    header.extend(columns.state);
+    header.push("max_multiplier");
+    let mut t = TableWriter::new(out, &header)?;
+    for b in &branch.bifurcations {
+        let mut row = vec![Cell::Number(b.p), Cell::Text(bifurcation_name(b.kind))];
+        row.extend(b.state.iter().map(|&v| Cell::Number(v)));
+        row.push(Cell::Number(
+            b.multipliers.first().map_or(f64::NAN, modulus),
+        ));
+        t.row(row)?;
     }
     t.finish().map(|_| ())
 }

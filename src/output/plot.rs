@@ -39,6 +39,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::FontStyle;
 
+use crate::orbit::Branch;
 use crate::sample::{Impact, SectionPoint};
 use crate::sweep::{SweepDirection, SweepResult};
 use crate::{Error, Result};
@@ -868,6 +869,64 @@ pub fn plot_time_profile<P: AsRef<Path>>(
     stop: Option<f64>,
 ) -> Result<()> {
     plot_series(path, &time_profile_panel(samples, stop))
+}
+
+/// A continued branch ([`crate::orbit::follow`]) as series of component `component` of
+/// the orbit's section state over the parameter: stable stretches as solid lines,
+/// unstable stretches as dashed lines, bifurcations as large dots, in `color`.
+pub fn branch_series<const N: usize>(
+    branch: &Branch<N>,
+    component: usize,
+    color: Rgb,
+) -> Vec<Series> {
+    let mut out = Vec::new();
+    let mut start = 0;
+    let points = &branch.points;
+    for i in 1..=points.len() {
+        if i == points.len() || points[i].stable != points[start].stable {
+            // Each stretch includes the next point so the curve is unbroken.
+            let end = (i + 1).min(points.len());
+            let xy = points[start..end]
+                .iter()
+                .map(|q| (q.p, q.state.get(component).copied().unwrap_or(f64::NAN)));
+            let series = if points[start].stable {
+                Series::line(xy).mark(Mark::Line { width: 2 })
+            } else {
+                Series::line(dashed(&xy.collect::<Vec<_>>())).mark(Mark::Line { width: 1 })
+            };
+            out.push(series.color(color));
+            start = i;
+        }
+    }
+    if !branch.bifurcations.is_empty() {
+        out.push(
+            Series::dots(
+                branch
+                    .bifurcations
+                    .iter()
+                    .map(|b| (b.p, b.state.get(component).copied().unwrap_or(f64::NAN))),
+            )
+            .mark(Mark::Dots { radius: 4.0 })
+            .color(color),
+        );
+    }
+    out
+}
+
+/// A polyline cut into dashes: each segment in six parts, every other one drawn (the gaps
+/// are non-finite points, which break a line series).
+fn dashed(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
+    let mut out = Vec::new();
+    for w in points.windows(2) {
+        let ((x0, y0), (x1, y1)) = (w[0], w[1]);
+        for k in (0..6).step_by(2) {
+            let (a, b) = (k as f64 / 6.0, (k + 1) as f64 / 6.0);
+            out.push((x0 + a * (x1 - x0), y0 + a * (y1 - y0)));
+            out.push((x0 + b * (x1 - x0), y0 + b * (y1 - y0)));
+            out.push((f64::NAN, f64::NAN));
+        }
+    }
+    out
 }
 
 #[cfg(test)]

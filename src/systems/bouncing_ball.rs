@@ -150,4 +150,3 @@ impl BouncingBallTable {
         std::f64::consts::TAU / self.omega
     }
 }
-

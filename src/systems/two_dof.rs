@@ -175,4 +175,3 @@ impl TwoDofImpact {
         std::f64::consts::TAU / omega
     }
 }
-
