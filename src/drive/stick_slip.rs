@@ -163,8 +163,7 @@ where
 {
     /// `M⁻¹f` and the force `λ` that keeps `v_r` at zero (damping its drift at rate `α`).
     fn multiplier(&self, t: T, y: &SVector<T, M>) -> (SVector<T, N>, T) {
-        let (q, qd) = y.as_slice().split_at(N);
-        let a = self.model.inverse_mass_matrix() * self.model.generalized_force(t, q, qd);
+        let a = self.model.acceleration(t, y);
         let w = self.friction.coordinate.weights();
         let drift = self.friction.slip_velocity(t, y);
         let target = self.friction.surface_velocity.force_rate(t) - self.alpha * drift;
@@ -182,11 +181,7 @@ where
 {
     fn rhs(&self, t: T, y: &SVector<T, M>, dy: &mut SVector<T, M>) {
         let (a, force) = match self.slip_force {
-            Some(f) => {
-                let (q, qd) = y.as_slice().split_at(N);
-                let a = self.model.inverse_mass_matrix() * self.model.generalized_force(t, q, qd);
-                (a, f)
-            }
+            Some(f) => (self.model.acceleration(t, y), f),
             None => self.multiplier(t, y),
         };
         for k in 0..N {
@@ -245,8 +240,7 @@ where
         friction: Coulomb<T, N, U>,
         stepper: F,
     ) -> Self {
-        let m_w = model.inverse_mass_matrix() * friction.coordinate.weights();
-        let w_m_w = friction.coordinate.weights().dot(&m_w);
+        let (m_w, w_m_w) = model.mobility(friction.coordinate.weights());
         Self {
             model,
             friction,

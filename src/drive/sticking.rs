@@ -69,8 +69,7 @@ where
 {
     /// The constrained motion of `model` on `gap`.
     pub fn new(model: &'a Mechanical<T, N, M, El, Ld>, gap: &'a Gap<T, N, S>) -> Self {
-        let m_w = model.inverse_mass_matrix() * gap.coordinate().weights();
-        let w_m_w = gap.coordinate().weights().dot(&m_w);
+        let (m_w, w_m_w) = model.mobility(gap.coordinate().weights());
         // Drift of the constraint (integration error) decays at rate α: four surface
         // radians per radian, or 1/s for a fixed surface.
         let alpha = EventFunction::<T, M>::time_scale(gap, T::zero()).map_or(T::one(), |h| {
@@ -93,10 +92,9 @@ where
 
     /// The free acceleration `M⁻¹f` and the constraint multiplier `λ` at `(t, y)`.
     pub fn multiplier(&self, t: T, y: &SVector<T, M>) -> (SVector<T, N>, T) {
-        let (q, qd) = y.as_slice().split_at(N);
-        let f = self.model.generalized_force(t, q, qd);
-        let a = self.model.inverse_mass_matrix() * f;
+        let a = self.model.acceleration(t, y);
         let w = self.gap.coordinate().weights();
+        let (q, qd) = y.as_slice().split_at(N);
         // Baumgarte stabilization: w·q̈ = s̈ − 2α(ċ − ṡ) − α²(c − s).
         let (s, sd) = self.gap.surface(t);
         let e = self.gap.coordinate().value(q) - s;

@@ -780,6 +780,21 @@ impl<T: Real, const N: usize, const M: usize, El: Elements<T, N>, Ld: Loads<T, N
         load - r
     }
 
+    /// The unconstrained acceleration `q̈ = M⁻¹ f(t, q, q̇)` at the state `y = (q, q̇)`.
+    pub fn acceleration(&self, t: T, y: &SVector<T, M>) -> SVector<T, N> {
+        let (q, qd) = y.as_slice().split_at(N);
+        self.inv_mass * self.generalized_force(t, q, qd)
+    }
+
+    /// `(M⁻¹w, wᵀM⁻¹w)` for a direction `w` (a coordinate's weights): the accelerations a
+    /// unit generalized force along `w` causes, and their component along `w` (the inverse
+    /// effective mass of the coordinate).
+    pub fn mobility(&self, w: &SVector<T, N>) -> (SVector<T, N>, T) {
+        let m_w = self.inv_mass * w;
+        let w_m_w = w.dot(&m_w);
+        (m_w, w_m_w)
+    }
+
     /// The tangent stiffness `K_t` and damping `C_t` at `(q, q̇)`.
     pub fn tangent(&self, q: &[T], qd: &[T]) -> (SMatrix<T, N, N>, SMatrix<T, N, N>) {
         let mut k = self.stiffness.unwrap_or_else(SMatrix::zeros);
