@@ -27,19 +27,7 @@ const F: f64 = 0.5;
 const OMEGA: f64 = 1.6;
 
 fn duffing() -> impl Dynamics<f64, 2> + Clone {
-    Mechanical::<f64, 1, 2>::with_masses([1.0])
-        .unwrap()
-        .with_elements(
-            Element::on_dof(
-                0,
-                (
-                    CubicSpring::new(1.0, 1.0).unwrap(),
-                    ViscousDamper::new(C).unwrap(),
-                ),
-            )
-            .unwrap(),
-        )
-        .with_loads(Load::on_dof(0, Harmonic::cosine(F, OMEGA).unwrap()).unwrap())
+    duffing_at(OMEGA)
 }
 
 /// One-harmonic balance `x ≈ a cos ωt + b sin ωt` of `ẍ + cẋ + x + x³ = F cos ωt`: with
@@ -254,4 +242,77 @@ fn impact_oscillator_orbit_through_restitution() {
     for l in orbit.exponents() {
         assert!((l - exact.ln() / (2.0 * period)).abs() < 1e-7);
     }
+}
+
+#[test]
+fn invalid_settings_are_errors() {
+    use nonsmooth::Error;
+    use nonsmooth::orbit::{ContinuationSettings, Extremum, OrbitError, follow};
+    let tol = Tolerances::new(1e-9, 1e-11).unwrap();
+    let shooting = Shooting::new(
+        duffing(),
+        (),
+        tangent_tolerances::<f64, 2, 2, 6>(&tol, 1e-9, 1e-11).unwrap(),
+    );
+    let y = SVector::from([0.1, 0.0]);
+    for period in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+        assert!(matches!(
+            shooting.find(0.0, period, y),
+            Err(Error::Orbit(OrbitError::InvalidSetting { .. }))
+        ));
+    }
+    assert!(shooting.clone().with_max_iterations(0).is_err());
+    assert!(shooting.clone().with_newton_tolerance(0.0).is_err());
+    assert!(shooting.clone().with_newton_tolerance(f64::NAN).is_err());
+    assert!(matches!(
+        shooting.extremum(0.0, 1.0, y, 2, Extremum::Min),
+        Err(Error::Orbit(OrbitError::InvalidSetting { .. }))
+    ));
+    // One Newton iteration from far away does not converge: a clear error, not a wrong orbit.
+    let once = shooting.clone().with_max_iterations(1).unwrap();
+    assert!(matches!(
+        once.find(
+            0.0,
+            std::f64::consts::TAU / OMEGA,
+            SVector::from([5.0, 5.0])
+        ),
+        Err(Error::Orbit(OrbitError::NotConverged { .. }))
+    ));
+    assert!(ContinuationSettings::new(1.0, 0.0, 0.1).is_err());
+    assert!(ContinuationSettings::new(0.0, 1.0, 0.0).is_err());
+    assert!(ContinuationSettings::new(0.0, f64::INFINITY, 0.1).is_err());
+    let s = ContinuationSettings::new(0.0, 1.0, 0.1).unwrap();
+    assert!(s.clone().with_max_points(1).is_err());
+    assert!(s.clone().with_max_step(0.01).is_err());
+    assert!(s.clone().with_locate_tolerance(-1.0).is_err());
+    assert!(s.clone().with_scales(vec![1.0, 0.0], 1.0).is_err());
+    // Scales for the wrong number of components.
+    let wrong = s.with_scales(vec![1.0], 1.0).unwrap();
+    let build = |w: f64| -> nonsmooth::Result<_> {
+        Ok(Shooting::new(
+            duffing_at(w),
+            (),
+            tangent_tolerances::<f64, 2, 2, 6>(&tol, 1e-9, 1e-11)?,
+        ))
+    };
+    assert!(matches!(
+        follow(build, |w| std::f64::consts::TAU / w, 0.0, 0.5, y, &wrong),
+        Err(Error::Orbit(OrbitError::InvalidSetting { .. }))
+    ));
+}
+
+fn duffing_at(omega: f64) -> impl Dynamics<f64, 2> + Clone {
+    Mechanical::<f64, 1, 2>::with_masses([1.0])
+        .unwrap()
+        .with_elements(
+            Element::on_dof(
+                0,
+                (
+                    CubicSpring::new(1.0, 1.0).unwrap(),
+                    ViscousDamper::new(C).unwrap(),
+                ),
+            )
+            .unwrap(),
+        )
+        .with_loads(Load::on_dof(0, Harmonic::cosine(F, omega).unwrap()).unwrap())
 }
