@@ -316,3 +316,56 @@ fn duffing_at(omega: f64) -> impl Dynamics<f64, 2> + Clone {
         )
         .with_loads(Load::on_dof(0, Harmonic::cosine(F, omega).unwrap()).unwrap())
 }
+
+#[test]
+fn extrema_along_an_orbit_are_exact() {
+    // ẍ + 2ζẋ + x = cos ωt: the steady state x = A cos(ωt − δ), A = 1/√d, has one minimum
+    // −A and one maximum A per period.
+    use nonsmooth::force::LinearSpring;
+    use nonsmooth::orbit::Extremum;
+    let (zeta, omega) = (0.05_f64, 1.3_f64);
+    let model = Mechanical::<f64, 1, 2>::with_masses([1.0])
+        .unwrap()
+        .with_elements(
+            Element::on_dof(
+                0,
+                (
+                    LinearSpring::new(1.0).unwrap(),
+                    ViscousDamper::new(2.0 * zeta).unwrap(),
+                ),
+            )
+            .unwrap(),
+        )
+        .with_loads(Load::on_dof(0, Harmonic::cosine(1.0, omega).unwrap()).unwrap());
+    let tol = Tolerances::new(1e-11, 1e-13).unwrap();
+    let shooting = Shooting::new(
+        model,
+        (),
+        tangent_tolerances::<f64, 2, 2, 6>(&tol, 1e-11, 1e-13).unwrap(),
+    );
+    let period = std::f64::consts::TAU / omega;
+    let orbit = shooting.find(0.0, period, SVector::zeros()).unwrap();
+    let d = (1.0 - omega * omega).powi(2) + (2.0 * zeta * omega).powi(2);
+    let a = 1.0 / d.sqrt();
+    let minima = shooting
+        .local_extrema(0.0, period, orbit.state, 0, Extremum::Min)
+        .unwrap();
+    let maxima = shooting
+        .local_extrema(0.0, period, orbit.state, 0, Extremum::Max)
+        .unwrap();
+    assert_eq!((minima.len(), maxima.len()), (1, 1));
+    assert!((minima[0].1 + a).abs() < 1e-9, "{minima:?} vs −{a}");
+    assert!((maxima[0].1 - a).abs() < 1e-9, "{maxima:?} vs {a}");
+    // The minimum is at ωt − δ = π, δ = atan2(2ζω, 1 − ω²).
+    let delta = (2.0 * zeta * omega).atan2(1.0 - omega * omega);
+    let t_min = (std::f64::consts::PI + delta) / omega % period;
+    assert!(
+        (minima[0].0 - t_min).abs() < 1e-8,
+        "{} vs {t_min}",
+        minima[0].0
+    );
+    let global = shooting
+        .extremum(0.0, period, orbit.state, 0, Extremum::Min)
+        .unwrap();
+    assert_eq!(global, minima[0].1);
+}

@@ -345,6 +345,8 @@ struct Extrema<T> {
     event: usize,
     which: Extremum,
     best: Option<T>,
+    /// Every extremum at the rate event, `(t, value)`.
+    all: Vec<(T, T)>,
 }
 
 impl<T: Real> Extrema<T> {
@@ -367,6 +369,7 @@ impl<T: Real, const N: usize> crate::drive::Observer<T, N> for Extrema<T> {
     fn on_event(&mut self, event: &crate::drive::EventRecord<T, N>) -> crate::drive::Control {
         if event.index == self.event {
             self.offer(event.y[self.component]);
+            self.all.push((event.t, event.y[self.component]));
         }
         crate::drive::Control::Continue
     }
@@ -394,6 +397,24 @@ where
         tol
     }
 
+    /// Every local minimum (or maximum) of component `component` along the trajectory from
+    /// `(t0, y)` over `span`, as `(t, value)` in time order: the zeros of its rate `ẏ_c`
+    /// located on the dense output (the ends are not included).
+    ///
+    /// # Errors
+    /// As [`extremum`](Self::extremum).
+    pub fn local_extrema(
+        &self,
+        t0: T,
+        span: T,
+        y: SVector<T, N>,
+        component: usize,
+        which: Extremum,
+    ) -> Result<Vec<(T, T)>> {
+        let mut observer = self.extrema_run(t0, span, y, component, which)?;
+        Ok(std::mem::take(&mut observer.all))
+    }
+
     /// The smallest or largest value of component `component` along the trajectory from
     /// `(t0, y)` over `span` (an orbit's period): at the zeros of its rate `ẏ_c` located on
     /// the dense output (to the event time tolerance), and at both ends. With `component` a
@@ -410,6 +431,19 @@ where
         component: usize,
         which: Extremum,
     ) -> Result<T> {
+        let observer = self.extrema_run(t0, span, y, component, which)?;
+        Ok(observer.best.unwrap_or(y[component]))
+    }
+
+    /// Runs the trajectory with the rate event of `component`, collecting its extrema.
+    fn extrema_run(
+        &self,
+        t0: T,
+        span: T,
+        y: SVector<T, N>,
+        component: usize,
+        which: Extremum,
+    ) -> Result<Extrema<T>> {
         if component >= N {
             return Err(OrbitError::InvalidSetting {
                 what: "the component",
@@ -434,11 +468,12 @@ where
             event: E::LEN,
             which,
             best: None,
+            all: Vec::new(),
         };
         let mut sim = Simulation::new(self.system.clone(), Dopri5::new(self.state_tolerances()))
             .with_events((self.events.clone(), rate));
         sim.run(t0, y, t0 + span, &mut observer)?;
-        Ok(observer.best.unwrap_or(y[component]))
+        Ok(observer)
     }
 }
 
