@@ -234,7 +234,7 @@ fn main() -> nonsmooth::Result<()> {
     let ptangent = tangent_tolerances::<f64, 2, 2, 6>(&ptol, 1e-10, 1e-12)?;
     let build = |w: f64| Ok(Shooting::new(PAPER.oscillator::<f64>(w)?, (), ptangent));
     let settings = ContinuationSettings::new(13.0, 14.3, 0.005)?
-        .with_max_step(0.02)?
+        .with_max_step(0.2)?
         .with_grazing(Grazing {
             component: 0,
             level: PAPER.x_i,

@@ -199,7 +199,7 @@ fn paper_period_one_orbit_first_grazing() {
     let period = |w: f64| std::f64::consts::TAU / w;
     let settings = ContinuationSettings::new(10.0, 14.3, 0.005)
         .unwrap()
-        .with_max_step(0.02)
+        .with_max_step(0.2)
         .unwrap()
         .with_grazing(Grazing {
             component: 0,

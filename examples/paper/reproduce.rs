@@ -152,7 +152,7 @@ pub fn first_grazing_continuation(rtol: f64) -> Res<f64> {
         Ok(Shooting::new(PAPER.oscillator::<f64>(w)?, (), tangent))
     };
     let settings = ContinuationSettings::new(13.0, 14.3, 0.005)?
-        .with_max_step(0.02)?
+        .with_max_step(0.2)?
         .with_grazing(Grazing {
             component: 0,
             level: PAPER.x_i,

@@ -10,8 +10,9 @@
 //!    J = \begin{pmatrix} \Phi - I & F_p \\ \tau^{\mathsf T} \end{pmatrix}, $$
 //! `Φ` the monodromy matrix (integrated with the orbit, through resets) and `F_p` a central
 //! difference in `p`. The new tangent solves `(Φ − I, F_p)τ = 0`, `τ·τ_prev = 1`
-//! (normalized), so folds are passed without turning back. The step grows after easy
-//! corrections (≤ 3 Newton steps) and is halved after failed ones.
+//! (normalized), so folds are passed without turning back. The step is controlled by the
+//! corrector's effort: ×1.5 after at most 3 Newton steps, ×1.1 after 4–5, ×0.7 after more
+//! than 7, halved after a failure.
 //!
 //! # Bifurcations and grazing
 //! Test functions are evaluated at every point and a sign change between two points is
@@ -747,9 +748,15 @@ where
                 if outside {
                     break BranchEnd::ParameterRange;
                 }
-                if iterations <= 3 {
-                    ds = (ds * 1.5).min(settings.max_step);
-                }
+                // Step control on the corrector's effort: grow after easy corrections,
+                // hold after moderate ones, shrink after hard ones.
+                let factor = match iterations {
+                    0..=3 => 1.5,
+                    4..=5 => 1.1,
+                    6..=7 => 1.0,
+                    _ => 0.7,
+                };
+                ds = (ds * factor).clamp(settings.min_step, settings.max_step);
             }
             Err(_) => {
                 ds *= 0.5;
