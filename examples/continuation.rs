@@ -6,12 +6,14 @@
 //! - the double-well Duffing oscillator `ẍ + 0.3ẋ − x + x³ = γ cos 1.2t`: the
 //!   period-doubling cascade to period 8 by branch switching, and Feigenbaum's ratio;
 //! - the paper's cart: the first grazing of its period-1 orbit, against the steady-state
-//!   simulation estimate (`analysis::first_grazing`).
+//!   simulation estimate (`analysis::first_grazing`); and every impact adding along it
+//!   (a local minimum of x reaching the stop), each checked by simulation on both sides.
 //!
 //! `cargo run --release [--features plot] --example continuation -- [--quick] [--out DIR]`
 //!
 //! Writes `duffing_branch.csv`, `duffing_bifurcations.csv`, `duffing_sweep.csv`,
-//! `cascade.csv`, `paper_branch.csv` (and `continuation.png` with `plot`) into
+//! `cascade.csv`, `paper_branch.csv`, `paper_impact_adding.csv` (and `continuation.png` with
+//! `plot`) into
 //! `out/continuation`. Exits non-zero if a check fails.
 
 mod common;
@@ -264,6 +266,51 @@ fn main() -> nonsmooth::Result<()> {
         &mut ok,
         grazing.len() == 1 && (grazing[0] - by_simulation).abs() < 1e-6,
         "grazing by continuation within 1e-6 rad/s of the simulation estimate",
+    );
+
+    // 4. The paper's cart: impact adding along the period-1 orbit. Each local minimum of x
+    //    that reaches x_I adds a contact per period; located by following that minimum.
+    let start = Instant::now();
+    let hi = if args.quick { 15.0 } else { 17.6 };
+    let g = Grazing {
+        component: 0,
+        level: PAPER.x_i,
+        extremum: Extremum::Min,
+    };
+    let settings = ContinuationSettings::new(13.5, hi, 0.005)?
+        .with_max_step(0.2)?
+        .with_contact_changes(g);
+    let adding = follow(build, |w| TAU / w, 0.0, 13.5, rest, &settings)?;
+    let added = kinds(&adding, BifurcationKind::Grazing);
+    write_bifurcations(file(&out, "paper_impact_adding.csv")?, &adding, &columns)?;
+    println!(
+        "paper: contacts added at ω = {added:?} ({} points, {:.2} s)",
+        adding.points.len(),
+        start.elapsed().as_secs_f64()
+    );
+    // Independent check: steady impacts per period by simulation just below and above each
+    // located point differ by one.
+    let impacts_per_period = |w: f64| -> nonsmooth::Result<f64> {
+        use nonsmooth::event::{Direction, Event, Level};
+        use nonsmooth::sample::ImpactSequence;
+        let period = TAU / w;
+        let ev = Event::new(Level::new(0, PAPER.x_i)?, Direction::Rising);
+        let mut sim =
+            Simulation::new(PAPER.oscillator::<f64>(w)?, Dopri5::new(ptol)).with_events(ev);
+        let mut imp = ImpactSequence::new(0, 0, 1, PAPER.x_i, 100.0 * period, 10_000)?;
+        sim.run(0.0, rest, 120.0 * period, &mut imp)?;
+        Ok(imp.count() as f64 / 20.0)
+    };
+    let mut adding_ok = added.len() == if args.quick { 2 } else { 5 };
+    for &w in &added {
+        let (below, above) = (impacts_per_period(w - 2e-3)?, impacts_per_period(w + 2e-3)?);
+        println!("    ω = {w:.9}: {below} impacts per period at −0.002, {above} at +0.002");
+        adding_ok &= above == below + 1.0;
+    }
+    check(
+        &mut ok,
+        adding_ok,
+        "each located contact adds one impact per period in simulation",
     );
 
     #[cfg(feature = "plot")]

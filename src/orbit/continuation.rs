@@ -92,6 +92,7 @@ pub struct ContinuationSettings {
     locate_tolerance: f64,
     scales: Option<(Vec<f64>, f64)>,
     grazing: Option<Grazing>,
+    contacts: Option<Grazing>,
 }
 
 impl ContinuationSettings {
@@ -124,6 +125,7 @@ impl ContinuationSettings {
             locate_tolerance: 1e-9 * lo.abs().max(hi.abs()).max(1.0),
             scales: None,
             grazing: None,
+            contacts: None,
         })
     }
 
@@ -198,6 +200,18 @@ impl ContinuationSettings {
     #[must_use]
     pub fn with_grazing(mut self, grazing: Grazing) -> Self {
         self.grazing = Some(grazing);
+        self
+    }
+
+    /// Also locates every change of the number of contacts per period: each local
+    /// extremum of the component ([`Shooting::local_extrema`]) that crosses the level is a
+    /// grazing (e.g. impact adding, where the orbit touches the stop at a new place while it
+    /// is already in contact elsewhere, which [`with_grazing`](Self::with_grazing)'s global
+    /// extremum does not see). Located by following that one extremum (the one nearest in
+    /// time to where the count changed) onto the level.
+    #[must_use]
+    pub fn with_contact_changes(mut self, grazing: Grazing) -> Self {
+        self.contacts = Some(grazing);
         self
     }
 }
@@ -373,6 +387,8 @@ struct Point<const N: usize> {
     multipliers: Vec<Complex<f64>>,
     tests: [f64; 4],
     margin: Option<f64>,
+    /// The local extrema `(t, value − level)` of the contact-change test.
+    extrema: Vec<(f64, f64)>,
 }
 
 const FOLD: usize = 0;
@@ -397,6 +413,7 @@ struct Problem<'a, B, P, const N: usize> {
     sy: SVector<f64, N>,
     sp: f64,
     grazing: Option<Grazing>,
+    contacts: Option<Grazing>,
 }
 
 impl<B, P, S, E, const N: usize, const M: usize> Problem<'_, B, P, N>
@@ -553,7 +570,16 @@ where
             ),
             None => None,
         };
+        let extrema = match self.contacts {
+            Some(g) => shooting
+                .local_extrema(self.t0, (self.period)(p), y, g.component, g.extremum)?
+                .into_iter()
+                .map(|(t, v)| (t - self.t0, v - g.level))
+                .collect(),
+            None => Vec::new(),
+        };
         Ok(Point {
+            extrema,
             arclength: 0.0,
             u,
             p,
@@ -608,8 +634,68 @@ where
                 arclength: at.arclength,
             });
         }
+        if let Some(g) = self.contacts {
+            found.extend(self.contact_changes(a, b, ds, g, settings.locate_tolerance)?);
+        }
         found.sort_by(|x, y| x.arclength.total_cmp(&y.arclength));
         Ok(found)
+    }
+
+    /// The contact changes between `a` and `b`: while the number of local extrema beyond
+    /// the level differs, the extremum nearest the level (at the point with more of them,
+    /// or fewer) is followed by its time in the period and located on the level.
+    fn contact_changes(
+        &self,
+        a: &Point<N>,
+        b: &Point<N>,
+        ds: f64,
+        g: Grazing,
+        tolerance: f64,
+    ) -> Result<Vec<Bifurcation<N>>> {
+        let beyond = |q: &Point<N>| {
+            q.extrema
+                .iter()
+                .filter(|e| beyond_side(e.1, g.extremum))
+                .count()
+        };
+        if beyond(a) == beyond(b) {
+            return Ok(Vec::new());
+        }
+        // The extremum that crossed: nearest the level at the end where it is beyond it.
+        let ref_point = if beyond(b) > beyond(a) { b } else { a };
+        let Some(&(t_star, _)) = ref_point.extrema.iter().min_by(|x, y| {
+            let beyond_x = beyond_side(x.1, g.extremum);
+            let beyond_y = beyond_side(y.1, g.extremum);
+            // Prefer extrema beyond the level, then the one nearest it.
+            beyond_y
+                .cmp(&beyond_x)
+                .then(x.1.abs().total_cmp(&y.1.abs()))
+        }) else {
+            return Ok(Vec::new());
+        };
+        let period = (self.period)(a.p);
+        let slot = move |q: &Point<N>| {
+            q.extrema
+                .iter()
+                .min_by(|x, y| {
+                    phase_distance(x.0, t_star, period)
+                        .total_cmp(&phase_distance(y.0, t_star, period))
+                })
+                .map_or(f64::NAN, |e| e.1)
+        };
+        let (fa, fb) = (slot(a), slot(b));
+        if !(fa.is_finite() && fb.is_finite()) || fa.signum() == fb.signum() {
+            return Ok(Vec::new());
+        }
+        let at = self.locate_by(a, b, ds, tolerance, slot)?;
+        Ok(vec![Bifurcation {
+            kind: BifurcationKind::Grazing,
+            p: at.p,
+            state: at.y,
+            multipliers: at.multipliers,
+            monodromy: at.phi,
+            arclength: at.arclength,
+        }])
     }
 
     /// Locates the zero of test `which` between `a` (arclength 0) and the point at
@@ -622,8 +708,21 @@ where
         which: usize,
         tolerance: f64,
     ) -> Result<Point<N>> {
+        self.locate_by(a, b, ds, tolerance, |q: &Point<N>| q.tests[which])
+    }
+
+    /// Locates the zero of `test` between `a` (arclength 0) and `b` (arclength `ds` along
+    /// `a`'s tangent), `test(a)` and `test(b)` of opposite signs, by the Illinois method.
+    fn locate_by(
+        &self,
+        a: &Point<N>,
+        b: &Point<N>,
+        ds: f64,
+        tolerance: f64,
+        test: impl Fn(&Point<N>) -> f64,
+    ) -> Result<Point<N>> {
         let (mut lo, mut hi) = (0.0, ds);
-        let (mut f_lo, mut f_hi) = (a.tests[which], b.tests[which]);
+        let (mut f_lo, mut f_hi) = (test(a), test(b));
         let mut best = b.clone();
         let mut p_prev = b.p;
         let mut side = 0i8;
@@ -637,7 +736,7 @@ where
             let pred = &a.u + &a.tangent * s;
             let (mut pt, _) = self.correct(&pred, &a.tangent, ds)?;
             pt.arclength = a.arclength + s;
-            let f = pt.tests[which];
+            let f = test(&pt);
             let done = (pt.p - p_prev).abs() <= tolerance || f == 0.0;
             p_prev = pt.p;
             best = pt;
@@ -717,6 +816,7 @@ where
         sy,
         sp,
         grazing: settings.grazing,
+        contacts: settings.contacts,
     };
     // The first point: its tangent from the direction of p.
     let mut seed = DVector::zeros(N + 1);
@@ -783,4 +883,18 @@ where
         bifurcations,
         end,
     })
+}
+
+/// Whether a value relative to the level is beyond it for this kind of extremum.
+fn beyond_side(v: f64, which: Extremum) -> bool {
+    match which {
+        Extremum::Min => v < 0.0,
+        Extremum::Max => v > 0.0,
+    }
+}
+
+/// The distance of two times modulo `period`.
+fn phase_distance(t: f64, u: f64, period: f64) -> f64 {
+    let d = (t - u).rem_euclid(period);
+    d.min(period - d)
 }
