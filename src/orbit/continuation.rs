@@ -203,12 +203,15 @@ impl ContinuationSettings {
         self
     }
 
-    /// Also locates every change of the number of contacts per period: each local
-    /// extremum of the component ([`Shooting::local_extrema`]) that crosses the level is a
-    /// grazing (e.g. impact adding, where the orbit touches the stop at a new place while it
-    /// is already in contact elsewhere, which [`with_grazing`](Self::with_grazing)'s global
-    /// extremum does not see). Located by following that one extremum (the one nearest in
-    /// time to where the count changed) onto the level.
+    /// Also locates each local extremum of the component ([`Shooting::local_extrema`]) that
+    /// crosses the level: for a stop below the motion, a local minimum of the position
+    /// reaching the stop adds a contact per period (impact adding, where the orbit touches
+    /// the stop at a new place while it is already in contact elsewhere, which
+    /// [`with_grazing`](Self::with_grazing)'s global extremum does not see). Located by
+    /// following that one extremum (the one nearest in time to where the count of extrema
+    /// beyond the level changed) onto the level. Extrema born beyond the level are not
+    /// crossings and are not reported; a local maximum rising out of a contact (a contact
+    /// splitting in two) is not tested.
     #[must_use]
     pub fn with_contact_changes(mut self, grazing: Grazing) -> Self {
         self.contacts = Some(grazing);
