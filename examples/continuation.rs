@@ -31,8 +31,7 @@ use nonsmooth::lyapunov::tangent_tolerances;
 use nonsmooth::model::paper::PAPER;
 use nonsmooth::model::{Element, Load, Mechanical};
 use nonsmooth::orbit::{
-    BifurcationKind, Branch, ContinuationSettings, Extremum, Grazing, Shooting, follow,
-    period_doubled,
+    BifurcationKind, Branch, ContinuationSettings, Shooting, follow, period_doubled,
 };
 use nonsmooth::output::csv::{
     Cell, SweepColumns, write_bifurcations, write_branch, write_table_path,
@@ -237,11 +236,7 @@ fn main() -> nonsmooth::Result<()> {
     let build = |w: f64| Ok(Shooting::new(PAPER.oscillator::<f64>(w)?, (), ptangent));
     let settings = ContinuationSettings::new(13.0, 14.3, 0.005)?
         .with_max_step(0.2)?
-        .with_grazing(Grazing {
-            component: 0,
-            level: PAPER.x_i,
-            extremum: Extremum::Min,
-        });
+        .with_grazing(PAPER.grazing());
     let rest = SVector::from([PAPER.static_equilibrium()?, 0.0]);
     let branch = follow(build, |w| TAU / w, 0.0, 13.0, rest, &settings)?;
     write_branch(file(&out, "paper_branch.csv")?, &branch, &columns)?;
@@ -272,11 +267,7 @@ fn main() -> nonsmooth::Result<()> {
     //    that reaches x_I adds a contact per period; located by following that minimum.
     let start = Instant::now();
     let hi = if args.quick { 15.0 } else { 17.6 };
-    let g = Grazing {
-        component: 0,
-        level: PAPER.x_i,
-        extremum: Extremum::Min,
-    };
+    let g = PAPER.grazing();
     let settings = ContinuationSettings::new(13.5, hi, 0.005)?
         .with_max_step(0.2)?
         .with_contact_changes(g);

@@ -186,7 +186,7 @@ fn duffing_frequency_response_two_folds() {
 #[test]
 fn paper_period_one_orbit_first_grazing() {
     use nonsmooth::analysis::first_grazing;
-    use nonsmooth::orbit::{Extremum, Grazing};
+
     use nonsmooth::systems::paper::PAPER;
     let tol = Tolerances::per_component(1e-10, [1e-14, 1e-12]).unwrap();
     let build = |w: f64| -> nonsmooth::Result<_> {
@@ -201,11 +201,7 @@ fn paper_period_one_orbit_first_grazing() {
         .unwrap()
         .with_max_step(0.2)
         .unwrap()
-        .with_grazing(Grazing {
-            component: 0,
-            level: PAPER.x_i,
-            extremum: Extremum::Min,
-        });
+        .with_grazing(PAPER.grazing());
     let rest = SVector::from([PAPER.static_equilibrium().unwrap(), 0.0]);
     let branch = follow(build, period, 0.0, 10.0, rest, &settings).unwrap();
     let grazing: Vec<f64> = branch

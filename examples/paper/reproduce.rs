@@ -143,9 +143,7 @@ pub fn first_grazing_omega(rtol: f64) -> Res<f64> {
 /// continuation from ω = 13 until its smallest x reaches x_I (located on the branch).
 pub fn first_grazing_continuation(rtol: f64) -> Res<f64> {
     use nonsmooth::lyapunov::tangent_tolerances;
-    use nonsmooth::orbit::{
-        BifurcationKind, ContinuationSettings, Extremum, Grazing, Shooting, follow,
-    };
+    use nonsmooth::orbit::{BifurcationKind, ContinuationSettings, Shooting, follow};
     let tol = tolerances(rtol);
     let tangent = tangent_tolerances::<f64, 2, 2, 6>(&tol, rtol, rtol * 1e-2)?;
     let build = |w: f64| -> nonsmooth::Result<_> {
@@ -153,11 +151,7 @@ pub fn first_grazing_continuation(rtol: f64) -> Res<f64> {
     };
     let settings = ContinuationSettings::new(13.0, 14.3, 0.005)?
         .with_max_step(0.2)?
-        .with_grazing(Grazing {
-            component: 0,
-            level: PAPER.x_i,
-            extremum: Extremum::Min,
-        });
+        .with_grazing(PAPER.grazing());
     let branch = follow(build, |w| TAU / w, 0.0, 13.0, rest()?, &settings)?;
     branch
         .bifurcations

@@ -121,9 +121,7 @@ impl<T: Real, const N: usize> Coordinate<T, N> {
     /// [`ModelError::DofOutOfRange`] unless `i < N`.
     pub fn dof(i: usize) -> Result<Self, ModelError> {
         check_dof::<N>(i)?;
-        let mut weights = SVector::zeros();
-        weights[i] = T::one();
-        Ok(Self::from_weights(weights))
+        Ok(Self::unit(i))
     }
 
     /// The relative coordinate `q_i − q_j` (e.g. the extension of a spring from mass `j` to
@@ -146,8 +144,13 @@ impl<T: Real, const N: usize> Coordinate<T, N> {
 
     /// `q₀` (infallible: every system has a first DOF).
     pub(crate) fn first() -> Self {
+        Self::unit(0)
+    }
+
+    /// `q_i` for a checked `i < N`.
+    fn unit(i: usize) -> Self {
         let mut weights = SVector::zeros();
-        weights[0] = T::one();
+        weights[i] = T::one();
         Self::from_weights(weights)
     }
 

@@ -319,7 +319,7 @@ where
                 let Ok(orbit) = shooting.find(t0, 2.0 * period(p), guess) else {
                     continue;
                 };
-                let (once, _) = shooting.flow(t0, orbit.state, period(p))?;
+                let once = shooting.map(t0, orbit.state, period(p))?;
                 let near = (orbit.state - at.state).amax() < 0.1 * scale;
                 if near && (once - orbit.state).amax() > 1e-6 * scale {
                     return Ok((p, orbit));
@@ -448,8 +448,9 @@ where
         let shooting = (self.build)(p)?;
         let (py, phi) = shooting.flow(self.t0, *y, (self.period)(p))?;
         let h = 1e-6 * p.abs().max(self.sp);
-        let (pp, _) = (self.build)(p + h)?.flow(self.t0, *y, (self.period)(p + h))?;
-        let (pm, _) = (self.build)(p - h)?.flow(self.t0, *y, (self.period)(p - h))?;
+        // F_p needs the map only, not its Jacobian.
+        let pp = (self.build)(p + h)?.map(self.t0, *y, (self.period)(p + h))?;
+        let pm = (self.build)(p - h)?.map(self.t0, *y, (self.period)(p - h))?;
         let fp = (pp - pm) / (2.0 * h);
         let mut f = DVector::zeros(N);
         let mut a = DMatrix::zeros(N, N + 1);

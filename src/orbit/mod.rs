@@ -242,6 +242,18 @@ where
         Ok((y, phi))
     }
 
+    /// The state after `span` from `(t0, y0)` through the events' resets, without the
+    /// monodromy matrix (the map `P` alone: `N` instead of `N + N²` components, at the
+    /// state's tolerances).
+    ///
+    /// # Errors
+    /// Integration and event errors of the run.
+    pub fn map(&self, t0: T, y0: SVector<T, N>, span: T) -> Result<SVector<T, N>> {
+        let mut sim = Simulation::new(self.system.clone(), Dopri5::new(self.state_tolerances()))
+            .with_events(self.events.clone());
+        Ok(sim.run(t0, y0, t0 + span, &mut ())?.y)
+    }
+
     /// The periodic orbit of period `period` (the forcing period `T` times `k` for a
     /// period-`k` orbit) through the section at `t0`, by Newton's method from `guess`.
     ///

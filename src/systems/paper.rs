@@ -142,6 +142,17 @@ impl PaperParameters {
         )
     }
 
+    /// The stop as a grazing test for [`crate::orbit`] continuation: the orbit's smallest
+    /// `x` against `x_I` (where it drops below `x_I` the cart leaves the stop once more per
+    /// period and hits it again).
+    pub fn grazing(&self) -> crate::orbit::Grazing {
+        crate::orbit::Grazing {
+            component: 0,
+            level: self.x_i,
+            extremum: crate::orbit::Extremum::Min,
+        }
+    }
+
     /// The same model as a 1-DOF [`Mechanical`] system forced at `omega`.
     ///
     /// # Errors
