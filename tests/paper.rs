@@ -60,6 +60,51 @@ fn grazing_points_of_fig3b() {
 }
 
 #[test]
+fn fig3b_window_ends_by_continuation() {
+    use nonsmooth::orbit::BifurcationKind;
+    // f3 (paper 21.5085, read off its sweep): the period-2 orbit (3 impacts per 2 periods)
+    // followed down from ω = 22 grazes the stop with a local maximum of x at 21.5142535 and
+    // doubles its period 3.5e-5 rad/s below (rtol 1e-10; at 1e-8 the branch shows spurious
+    // fold/grazing triplets from integration noise). f4 (paper 23.0702): the period-3 orbit
+    // followed up from 23 ends at a fold at 23.0636293. Our sweep places both transitions in
+    // the same grid steps ([21.51, 21.52], [23.06, 23.07]).
+    let kind = |b: &nonsmooth::orbit::Branch<2>, k: BifurcationKind| {
+        b.bifurcations
+            .iter()
+            .find(|x| x.kind == k)
+            .cloned()
+            .unwrap()
+    };
+    let b = window_branch(22.0, 2, false, 21.45, 22.0, 1e-10).unwrap();
+    let (g, pd) = (
+        kind(&b, BifurcationKind::Grazing),
+        kind(&b, BifurcationKind::PeriodDoubling),
+    );
+    assert!((g.p - 21.5085).abs() < 0.01, "{}", g.p);
+    assert!(g.p > pd.p && g.p - pd.p < 1e-4, "{} {}", g.p, pd.p);
+    assert!(
+        (pd.multipliers[0].re + 1.0).abs() < 1e-3,
+        "{:?}",
+        pd.multipliers
+    );
+    // Independently, by simulation from the orbit's state: period 2 just above, not below.
+    let period = |w: f64, y| from_state(w, y, 300, 60, 1e-10).unwrap().regime.period();
+    assert_eq!(period(g.p + 2e-3, g.state), Some(2));
+    assert_ne!(period(g.p - 2e-3, g.state), Some(2));
+
+    let b = window_branch(23.0, 3, true, 22.9, 23.2, 1e-10).unwrap();
+    let fold = kind(&b, BifurcationKind::Fold);
+    assert!((fold.p - 23.0702).abs() < 0.01, "{}", fold.p);
+    assert!(
+        (fold.multipliers[0].re - 1.0).abs() < 1e-2,
+        "{:?}",
+        fold.multipliers
+    );
+    assert_eq!(period(fold.p - 2e-3, fold.state), Some(3));
+    assert_eq!(period(fold.p + 2e-3, fold.state), Some(1));
+}
+
+#[test]
 fn entropy_index_at_20_465() {
     // Paper: q = 0.62. On a chaotic attractor q* is a statistic of a finite, trajectory-
     // dependent sample: over rtol ∈ {1e-8, 3e-9, 1e-9, 3e-10, 1e-10} and 1000 or 3000

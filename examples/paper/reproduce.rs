@@ -168,16 +168,67 @@ pub fn first_grazing_continuation(rtol: f64) -> Res<f64> {
         })
 }
 
+/// The period-`k` orbit of the attractor reached from rest at `omega` (400 forcing periods,
+/// then shooting with period `k·2π/ω`), followed in ω towards `upward`/downward within
+/// `[lo, hi]`, with its folds, period doublings and contact changes of local maxima of `x`
+/// at `x_I` (a local maximum of the flight reaching the stop, or a contact splitting)
+/// located to 1e-9 rad/s.
+pub fn window_branch(
+    omega: f64,
+    k: u32,
+    upward: bool,
+    lo: f64,
+    hi: f64,
+    rtol: f64,
+) -> Res<nonsmooth::orbit::Branch<2>> {
+    use nonsmooth::drive::Simulation;
+    use nonsmooth::lyapunov::tangent_tolerances;
+    use nonsmooth::orbit::{ContinuationSettings, Extremum, Grazing, Shooting, follow};
+    use nonsmooth::sample::Stroboscopic;
+    let tol = tolerances(rtol);
+    let tangent = tangent_tolerances::<f64, 2, 2, 6>(&tol, rtol, rtol * 1e-2)?;
+    let build = |w: f64| -> nonsmooth::Result<_> {
+        Ok(Shooting::new(PAPER.oscillator::<f64>(w)?, (), tangent))
+    };
+    let period = |w: f64| f64::from(k) * TAU / w;
+    let mut sim = Simulation::new(PAPER.oscillator::<f64>(omega)?, Dopri5::new(tol));
+    let mut none = Stroboscopic::<f64, 2>::periodic(0.0, TAU / omega, 0.0, 1)?;
+    let y = sim.run(0.0, rest()?, 400.0 * TAU / omega, &mut none)?.y;
+    let orbit = build(omega)?.find(0.0, period(omega), y)?;
+    let contacts = Grazing {
+        extremum: Extremum::Max,
+        ..PAPER.grazing()
+    };
+    let mut settings = ContinuationSettings::new(lo, hi, 0.002)?
+        .with_max_step(0.05)?
+        .with_contact_changes(contacts);
+    if !upward {
+        settings = settings.downward();
+    }
+    Ok(follow(build, period, 0.0, omega, orbit.state, &settings)?)
+}
+
 /// One frequency from rest with the paper's transients (100) and `record` periods.
 pub fn from_rest(omega: f64, record: u32, rtol: f64) -> Res<SweepPoint<2>> {
+    from_state(omega, rest()?, 100, record, rtol)
+}
+
+/// One frequency from the state `y0` at t = 0 with `transient` periods and `record` recorded.
+pub fn from_state(
+    omega: f64,
+    y0: Vector2<f64>,
+    transient: u32,
+    record: u32,
+    rtol: f64,
+) -> Res<SweepPoint<2>> {
     let cfg = SweepConfig::new(vec![omega])?.record(record)?;
     Ok(run_point(
         &cfg,
         omega,
         make(omega)?,
         Dopri5::new(tolerances(rtol)),
-        rest()?,
-        100,
+        y0,
+        transient,
     )?)
 }
 

@@ -70,6 +70,23 @@ impl Summary {
         });
     }
 
+    /// As [`compare`](Self::compare), with the verdict prefixed by what the value is (e.g.
+    /// the kind of a bifurcation).
+    pub fn compare_located(
+        &mut self,
+        id: &str,
+        quantity: &str,
+        paper: f64,
+        ours: Option<f64>,
+        rtol: f64,
+        what: &str,
+    ) {
+        self.compare(id, quantity, "rad/s", paper, ours, rtol, "");
+        if let Some(row) = self.rows.last_mut() {
+            row.verdict = format!("{what}; {}", row.verdict);
+        }
+    }
+
     /// A number the paper gives only as a sign or qualitatively.
     pub fn qualitative(
         &mut self,
