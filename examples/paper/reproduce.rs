@@ -205,7 +205,7 @@ pub fn window_branch(
     if !upward {
         settings = settings.downward();
     }
-    Ok(follow(build, period, 0.0, omega, orbit.state, &settings)?)
+    follow(build, period, 0.0, omega, orbit.state, &settings)
 }
 
 /// One frequency from rest with the paper's transients (100) and `record` periods.
