@@ -20,7 +20,11 @@
 //! `Π μ_j = det Φ = exp(∫ tr J dt) · Π det S` (e.g. `e^{−c kT/m}` for a linear damper).
 //!
 //! Newton does not care about stability: started near a saddle it converges to the saddle,
-//! an orbit no forward simulation shows.
+//! an orbit no forward simulation shows. On a strongly unstable orbit (`|μ| ≫ 1`) one shot
+//! over the whole period amplifies the start's error by `|μ|` into the nonlinear range;
+//! [`Shooting::find_multiple`] cuts the period into `m` segments, each amplifying it only by
+//! `|μ|^{1/m}`, and solves for all segment starts `yᵢ` at once:
+//! `φᵢ(yᵢ) − y₍ᵢ₊₁₎ mod m = 0`, Jacobian blocks `Φᵢ` and `−I`, `Φ = Φ_{m−1}⋯Φ₀`.
 //!
 //! # Example
 //! A forced linear oscillator `ẍ + 2ζẋ + x = cos ωt`: its periodic orbit is the steady state,
@@ -321,6 +325,134 @@ where
             iterations: self.max_iterations,
             step,
             residual: to_f64(residual.amax()),
+        }
+        .into())
+    }
+
+    /// The periodic orbit of period `period` by multiple shooting from `m = guesses.len()`
+    /// points: segment `i` runs over `[tᵢ, tᵢ + h]`, `tᵢ = t₀ + i·h`, `h = period/m`, from
+    /// `yᵢ = guesses[i]`, and Newton solves the `m·N` equations `φᵢ(yᵢ) − y₍ᵢ₊₁₎ mod m = 0`
+    /// at once, with the block-cyclic Jacobian (`Φᵢ` on the diagonal, `−I` right of it, and
+    /// `−I` in the top-right corner for the closing segment) and the same backtracking and
+    /// convergence test as [`find`](Self::find), on every segment.
+    ///
+    /// On an unstable orbit a single shot amplifies the error of its start by `|μ| ≈ e^{λ·period}`
+    /// before Newton sees it, and the nonlinear part of that error defeats the linear
+    /// model; each segment here amplifies it only by `e^{λh}`. The returned orbit is taken
+    /// at `t₀` (`state = y₀`), its monodromy matrix is the product `Φ_{m−1}⋯Φ₀` and its
+    /// residual the largest segment mismatch. `m = 1` is single shooting.
+    ///
+    /// # Errors
+    /// [`OrbitError::InvalidSetting`] for no guesses or a period that is not finite and
+    /// `> 0`; [`OrbitError::Singular`], [`OrbitError::NotConverged`], and the errors of
+    /// [`flow`](Self::flow).
+    pub fn find_multiple(
+        &self,
+        t0: T,
+        period: T,
+        guesses: &[SVector<T, N>],
+    ) -> Result<PeriodicOrbit<T, N>> {
+        let m = guesses.len();
+        if m == 0 {
+            return Err(OrbitError::InvalidSetting {
+                what: "the number of shooting points",
+                requirement: "at least 1",
+                value: 0.0,
+            }
+            .into());
+        }
+        if !(period.is_finite() && period > T::zero()) {
+            return Err(OrbitError::InvalidSetting {
+                what: "the period",
+                requirement: "finite and > 0",
+                value: to_f64(period),
+            }
+            .into());
+        }
+        let h = period / lit(m as f64);
+        let start = |i: usize| t0 + h * lit(i as f64);
+        // Every segment's end state and Jacobian, and the mismatches φᵢ(yᵢ) − yᵢ₊₁.
+        type Segments<T, const N: usize> = (Vec<SMatrix<T, N, N>>, Vec<SVector<T, N>>);
+        let segments = |ys: &[SVector<T, N>]| -> Result<Segments<T, N>> {
+            let mut phis = Vec::with_capacity(m);
+            let mut residuals = Vec::with_capacity(m);
+            for i in 0..m {
+                let (p, phi) = self.flow(start(i), ys[i], h)?;
+                phis.push(phi);
+                residuals.push(p - ys[(i + 1) % m]);
+            }
+            Ok((phis, residuals))
+        };
+        let largest = |r: &[SVector<T, N>]| r.iter().map(|v| v.amax()).fold(T::zero(), T::max);
+        let mut ys = guesses.to_vec();
+        let (mut phis, mut residuals) = segments(&ys)?;
+        let mut step = f64::INFINITY;
+        for iteration in 0..self.max_iterations {
+            let size = m * N;
+            let mut jac = DMatrix::<T>::zeros(size, size);
+            let mut rhs = nalgebra::DVector::<T>::zeros(size);
+            for i in 0..m {
+                let next = (i + 1) % m;
+                for r in 0..N {
+                    rhs[i * N + r] = -residuals[i][r];
+                    for c in 0..N {
+                        jac[(i * N + r, i * N + c)] += phis[i][(r, c)];
+                    }
+                    jac[(i * N + r, next * N + r)] -= T::one();
+                }
+            }
+            let delta = jac
+                .lu()
+                .solve(&rhs)
+                .ok_or(OrbitError::Singular { iteration })?;
+            let before = largest(&residuals);
+            let mut lambda = T::one();
+            let mut accepted = None;
+            for _ in 0..12 {
+                let trial: Vec<SVector<T, N>> = (0..m)
+                    .map(|i| ys[i] + delta.fixed_rows::<N>(i * N) * lambda)
+                    .collect();
+                if let Ok((phis_t, r_t)) = segments(&trial) {
+                    if largest(&r_t) < before || lambda < lit(1e-3) {
+                        accepted = Some((trial, phis_t, r_t));
+                        break;
+                    }
+                }
+                lambda *= lit(0.5);
+            }
+            let Some((trial, phis_t, r_t)) = accepted else {
+                break;
+            };
+            step = (0..m)
+                .flat_map(|i| (0..N).map(move |c| (i, c)))
+                .map(|(i, c)| {
+                    let scale =
+                        self.tolerances.atol[c] + self.tolerances.rtol[c] * trial[i][c].abs();
+                    to_f64((trial[i][c] - ys[i][c]).abs() / scale)
+                })
+                .fold(0.0, f64::max);
+            ys = trial;
+            phis = phis_t;
+            residuals = r_t;
+            if step <= self.newton_tolerance {
+                let monodromy = phis
+                    .iter()
+                    .fold(SMatrix::<T, N, N>::identity(), |acc, phi| phi * acc);
+                return Ok(PeriodicOrbit {
+                    t0,
+                    period,
+                    state: ys[0],
+                    monodromy,
+                    multipliers: multipliers(&monodromy),
+                    iterations: iteration + 1,
+                    residual: largest(&residuals),
+                });
+            }
+        }
+        Err(OrbitError::NotConverged {
+            iterations: self.max_iterations,
+            step,
+            residual: to_f64(largest(&residuals)),
         }
         .into())
     }
