@@ -47,6 +47,7 @@
 pub mod analysis;
 pub mod drive;
 pub mod dynamics;
+pub mod ensemble;
 pub mod entropy;
 pub mod error;
 pub mod event;

@@ -1,0 +1,114 @@
+//! Ensemble throughput on the paper's model at rtol 1e-8, one thread: 16 forcing
+//! frequencies in [17.5, 25] rad/s, 20 periods each from rest, every impact located, steps
+//! landing on the sections — the scalar path (`Simulation` + `Dopri5`, one trajectory
+//! after the other) against the ensemble in lanes of 4 and 8 (exact and vector math).
+//! After the group, the throughput ratio ensemble/scalar of the fastest configuration,
+//! measured in this run, is printed as `throughput ratio ensemble/scalar: R`.
+
+use std::hint::black_box;
+use std::time::Instant;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use nalgebra::Vector2;
+use nonsmooth::drive::Simulation;
+use nonsmooth::ensemble::{Ensemble, F64x4, F64x8, LaneMath, Lanes, Member, Trajectory};
+use nonsmooth::event::{Direction, Event, Stop};
+use nonsmooth::integrate::{Dopri5, Tolerances};
+use nonsmooth::model::paper::PAPER;
+
+struct Setup {
+    jobs: Vec<Trajectory>,
+    tol: Tolerances<f64, 2>,
+    impact: Event<Stop<f64>>,
+}
+
+fn setup() -> Setup {
+    let rtol = 1e-8;
+    let tol = Tolerances::per_component(rtol, [rtol * 1e-4, rtol * 1e-2]).unwrap();
+    let y0 = Vector2::new(PAPER.static_equilibrium().unwrap(), 0.0);
+    let jobs = (0..16)
+        .map(|i| {
+            let w = 17.5 + 0.5 * i as f64;
+            Trajectory::periods(Member::paper(w).unwrap(), y0, 20.0).unwrap()
+        })
+        .collect();
+    let impact = Event::new(
+        Stop {
+            position: 0,
+            velocity: 1,
+            level: PAPER.x_i,
+        },
+        Direction::Rising,
+    );
+    Setup { jobs, tol, impact }
+}
+
+fn scalar(s: &Setup) -> u64 {
+    let mut evals = 0;
+    for j in &s.jobs {
+        let mut sim = Simulation::new(*j.member.scalar(), Dopri5::new(s.tol))
+            .with_events(s.impact)
+            .landing_grid(j.grid)
+            .unwrap();
+        evals += sim
+            .run(j.t0, j.y0, j.t_end, &mut ())
+            .unwrap()
+            .stats
+            .rhs_evals;
+    }
+    evals
+}
+
+fn lanes<V: Lanes>(s: &Setup, math: LaneMath) -> u64 {
+    let e = Ensemble::new(s.tol)
+        .unwrap()
+        .with_event(s.impact)
+        .unwrap()
+        .with_math(math);
+    let mut obs = vec![(); s.jobs.len()];
+    e.run::<V, _>(&s.jobs, &mut obs)
+        .unwrap()
+        .into_iter()
+        .map(|o| o.unwrap().stats.rhs_evals)
+        .sum()
+}
+
+type Path = (&'static str, fn(&Setup) -> u64);
+
+const PATHS: [Path; 5] = [
+    ("scalar", scalar),
+    ("lanes4_exact", |s| lanes::<F64x4>(s, LaneMath::Exact)),
+    ("lanes8_exact", |s| lanes::<F64x8>(s, LaneMath::Exact)),
+    ("lanes4_vector", |s| lanes::<F64x4>(s, LaneMath::Vector)),
+    ("lanes8_vector", |s| lanes::<F64x8>(s, LaneMath::Vector)),
+];
+
+fn bench(c: &mut Criterion) {
+    let s = setup();
+    let mut g = c.benchmark_group("ensemble_16x20_periods");
+    g.sample_size(10);
+    for (name, f) in PATHS {
+        g.bench_function(name, |b| b.iter(|| black_box(f(&s))));
+    }
+    g.finish();
+    // The ratio in this run: the best of five timings of each path.
+    let time = |f: fn(&Setup) -> u64| {
+        (0..5)
+            .map(|_| {
+                let t = Instant::now();
+                black_box(f(&s));
+                t.elapsed().as_secs_f64()
+            })
+            .fold(f64::INFINITY, f64::min)
+    };
+    let t_scalar = time(PATHS[0].1);
+    let (best, name) = PATHS[1..]
+        .iter()
+        .map(|(n, f)| (t_scalar / time(*f), *n))
+        .fold((0.0, ""), |a, b| if b.0 > a.0 { b } else { a });
+    println!("fastest ensemble configuration: {name}");
+    println!("throughput ratio ensemble/scalar: {best:.2}");
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

@@ -1,0 +1,153 @@
+//! Throughput of many trajectories: the scalar path (`Simulation` + `Dopri5`, one
+//! trajectory after the other) against the ensemble (`ensemble::Ensemble`, trajectories in
+//! SIMD lanes), on one thread, on the paper's model at rtol 1e-8.
+//!
+//! The workload: 64 forcing frequencies in [17.5, 25] rad/s, 200 forcing periods each
+//! from rest in the static equilibrium, steps landing on the sections `t = 2πi/ω`, every
+//! impact located, section points and impacts collected per trajectory — the work of an
+//! independent-start bifurcation sweep. Throughput is trajectory-periods per second on
+//! one core; the last line is the ratio of the fastest ensemble configuration of this
+//! build (lane width and math mode, named on the line before) to the scalar path, both
+//! measured in this run.
+//!
+//! ```sh
+//! cargo run --release --example ensemble_throughput            # 64 × 200 periods
+//! cargo run --release --example ensemble_throughput -- --quick # 16 × 100 periods
+//! RUSTFLAGS="-C target-cpu=native" cargo run --release --example ensemble_throughput
+//! ```
+
+use std::time::Instant;
+
+use nalgebra::Vector2;
+use nonsmooth::drive::{Control, EventRecord, Observer, Simulation, StepView};
+use nonsmooth::ensemble::{Ensemble, F64x2, F64x4, F64x8, LaneMath, Lanes, Member, Trajectory};
+use nonsmooth::event::{Direction, Event, Stop};
+use nonsmooth::integrate::{DenseOutput, Dopri5, Tolerances};
+use nonsmooth::model::paper::PAPER;
+
+/// Section points (steps land on them: a step ending on a grid time is a section) and
+/// the number of impacts.
+#[derive(Debug, Clone, Default)]
+struct Collect {
+    period: f64,
+    sections: Vec<Vector2<f64>>,
+    impacts: usize,
+}
+
+impl Observer<f64, 2> for Collect {
+    fn on_step<D: DenseOutput<f64, 2>>(&mut self, s: &StepView<'_, f64, 2, D>) -> Control {
+        let k = (s.t1 / self.period).round();
+        if k >= 1.0 && s.t1 == k * self.period {
+            self.sections.push(s.y1);
+        }
+        Control::Continue
+    }
+    fn on_event(&mut self, _e: &EventRecord<f64, 2>) -> Control {
+        self.impacts += 1;
+        Control::Continue
+    }
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let quick = std::env::args().any(|a| a == "--quick");
+    let (n, periods) = if quick { (16, 100.0) } else { (64, 200.0) };
+    let rtol = 1e-8;
+    let tol = Tolerances::per_component(rtol, [rtol * 1e-4, rtol * 1e-2])?;
+    let y0 = Vector2::new(PAPER.static_equilibrium()?, 0.0);
+    let impact = Event::new(
+        Stop {
+            position: 0,
+            velocity: 1,
+            level: PAPER.x_i,
+        },
+        Direction::Rising,
+    );
+    let jobs: Vec<Trajectory> = (0..n)
+        .map(|i| {
+            let w = 17.5 + 7.5 * i as f64 / (n - 1) as f64;
+            Trajectory::periods(Member::paper(w)?, y0, periods)
+        })
+        .collect::<nonsmooth::Result<_>>()?;
+    let observers = || -> Vec<Collect> {
+        jobs.iter()
+            .map(|j| Collect {
+                period: j.member.period(),
+                ..Collect::default()
+            })
+            .collect()
+    };
+    let work = n as f64 * periods;
+    println!(
+        "{n} trajectories × {periods} periods of the paper's model (ω ∈ [17.5, 25]), rtol {rtol:e}, one thread"
+    );
+    println!(
+        "target features: avx2 {}, fma {}, avx512f {}",
+        cfg!(target_feature = "avx2"),
+        cfg!(target_feature = "fma"),
+        cfg!(target_feature = "avx512f")
+    );
+
+    // The scalar path.
+    let mut scalar_obs = observers();
+    let start = Instant::now();
+    let mut evals = 0u64;
+    for (j, o) in jobs.iter().zip(scalar_obs.iter_mut()) {
+        let mut sim = Simulation::new(*j.member.scalar(), Dopri5::new(tol))
+            .with_events(impact)
+            .landing_grid(j.grid)?;
+        evals += sim.run(j.t0, j.y0, j.t_end, o)?.stats.rhs_evals;
+    }
+    let scalar_s = start.elapsed().as_secs_f64();
+    let scalar_rate = work / scalar_s;
+    println!(
+        "scalar               {scalar_s:7.3} s  {scalar_rate:9.0} trajectory-periods/s  ({:.1} ns per evaluation)",
+        scalar_s * 1e9 / evals as f64
+    );
+
+    let ensemble = Ensemble::new(tol)?.with_event(impact)?;
+    let mut best = (0.0f64, String::new());
+    let mut run = |name: &str,
+                   f: &dyn Fn(&mut [Collect]) -> nonsmooth::Result<()>|
+     -> nonsmooth::Result<()> {
+        let mut obs = observers();
+        let start = Instant::now();
+        f(&mut obs)?;
+        let s = start.elapsed().as_secs_f64();
+        let ratio = scalar_s / s;
+        // Same impacts and sections as the scalar path (the vector math: within rounding).
+        let same = obs
+            .iter()
+            .zip(&scalar_obs)
+            .filter(|(a, b)| a.sections == b.sections && a.impacts == b.impacts)
+            .count();
+        println!(
+            "{name:<20} {s:7.3} s  {:9.0} trajectory-periods/s  ratio {ratio:5.2}  ({same}/{n} trajectories identical to scalar)",
+            work / s
+        );
+        if ratio > best.0 {
+            best = (ratio, name.to_string());
+        }
+        Ok(())
+    };
+    fn lanes<V: Lanes>(
+        e: &Ensemble<Stop<f64>>,
+        jobs: &[Trajectory],
+        obs: &mut [Collect],
+    ) -> nonsmooth::Result<()> {
+        for r in e.run::<V, _>(jobs, obs)? {
+            r?;
+        }
+        Ok(())
+    }
+    let exact = ensemble.clone();
+    let vector = ensemble.clone().with_math(LaneMath::Vector);
+    run("ensemble 2, exact", &|o| lanes::<F64x2>(&exact, &jobs, o))?;
+    run("ensemble 4, exact", &|o| lanes::<F64x4>(&exact, &jobs, o))?;
+    run("ensemble 8, exact", &|o| lanes::<F64x8>(&exact, &jobs, o))?;
+    run("ensemble 2, vector", &|o| lanes::<F64x2>(&vector, &jobs, o))?;
+    run("ensemble 4, vector", &|o| lanes::<F64x4>(&vector, &jobs, o))?;
+    run("ensemble 8, vector", &|o| lanes::<F64x8>(&vector, &jobs, o))?;
+    println!("fastest ensemble configuration: {}", best.1);
+    println!("throughput ratio ensemble/scalar: {:.2}", best.0);
+    Ok(())
+}

@@ -1,0 +1,961 @@
+//! The lane DOPRI5 engine: `L` trajectories stepped together, each with its own step.
+
+use nalgebra::SVector;
+
+use super::Lanes;
+use super::math::{LaneMath, exp, ln};
+use super::model::{Member, Packed, scalar_rhs};
+use crate::drive::{Control, EventRecord, Observer, Outcome, StepView, Termination};
+use crate::error::{ParameterError, Result};
+use crate::event::{Direction, Event, EventError, EventFunction, EventHistory, ZenoGuard, locate};
+use crate::integrate::{DenseOutput, IntegrateError, Stats, StepOptions, Tolerances};
+
+/// One trajectory of an ensemble: a [`Member`], its start and end, and an optional landing
+/// grid `origin + i·dt` that every step lands on (the sweeps' sections at `t = i·2π/ω`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Trajectory {
+    /// The model.
+    pub member: Member,
+    /// Start time.
+    pub t0: f64,
+    /// Initial state `(x, ẋ)`.
+    pub y0: SVector<f64, 2>,
+    /// End time.
+    pub t_end: f64,
+    /// Landing grid `(origin, dt)`.
+    pub grid: Option<(f64, f64)>,
+}
+
+impl Trajectory {
+    /// From `(t0, y0)` to `t_end`, without a landing grid.
+    ///
+    /// # Errors
+    /// [`IntegrateError::InvalidTimeSpan`] unless `t0 < t_end`, both finite;
+    /// [`IntegrateError::NonFiniteState`] for a non-finite `y0`.
+    pub fn new(member: Member, t0: f64, y0: SVector<f64, 2>, t_end: f64) -> Result<Self> {
+        if !(t0.is_finite() && t_end.is_finite() && t_end > t0) {
+            return Err(IntegrateError::InvalidTimeSpan { t0, t_end }.into());
+        }
+        crate::integrate::check_state(&y0)?;
+        Ok(Self {
+            member,
+            t0,
+            y0,
+            t_end,
+            grid: None,
+        })
+    }
+
+    /// `periods` forcing periods from `(0, y0)`, every step landing on `t = i·2π/ω` (the
+    /// sweeps' setting).
+    ///
+    /// # Errors
+    /// As [`new`](Self::new); [`ParameterError`] unless `periods` is finite and > 0.
+    pub fn periods(member: Member, y0: SVector<f64, 2>, periods: f64) -> Result<Self> {
+        crate::validate::positive("periods", periods)?;
+        let tau = member.period();
+        Self::new(member, 0.0, y0, periods * tau)?.with_grid(0.0, tau)
+    }
+
+    /// Makes every step land on `origin + i·dt` (computed from `i`, never accumulated).
+    ///
+    /// # Errors
+    /// [`ParameterError`] unless `origin` is finite and `dt` finite and > 0.
+    pub fn with_grid(mut self, origin: f64, dt: f64) -> Result<Self> {
+        crate::validate::finite("origin", origin)?;
+        crate::validate::positive("dt", dt)?;
+        self.grid = Some((origin, dt));
+        Ok(self)
+    }
+}
+
+/// The ensemble integrator: DOPRI5 with the scalar [`Dopri5`](crate::integrate::Dopri5)'s
+/// tableau, error norm, PI controller and first-step heuristic, one trajectory per lane,
+/// with the driver's event location and observers per lane (see the
+/// [module docs](super)).
+#[derive(Debug, Clone)]
+pub struct Ensemble<G = crate::event::Level<f64>> {
+    tol: Tolerances<f64, 2>,
+    opts: StepOptions<f64>,
+    math: LaneMath,
+    max_steps: usize,
+    event_tol: f64,
+    zeno: ZenoGuard<f64>,
+    event: Option<Event<G>>,
+}
+
+impl Ensemble {
+    /// An ensemble with the given tolerances, default [`StepOptions`], no event,
+    /// [`LaneMath::Exact`], the driver's defaults (step cap 10⁸ per trajectory, event time
+    /// tolerance 10⁻¹², the default [`ZenoGuard`]).
+    ///
+    /// # Errors
+    /// [`ParameterError`] for invalid tolerances (set through the public fields).
+    pub fn new(tol: Tolerances<f64, 2>) -> Result<Self> {
+        tol.validate()?;
+        Ok(Self {
+            tol,
+            opts: StepOptions::default(),
+            math: LaneMath::Exact,
+            max_steps: 100_000_000,
+            event_tol: 1e-12,
+            zeno: ZenoGuard::default(),
+            event: None,
+        })
+    }
+}
+
+impl<G: EventFunction<f64, 2>> Ensemble<G> {
+    /// Adds a detection event, located per lane on the step's dense output exactly as
+    /// [`Simulation`](crate::drive::Simulation) does (sign changes, grazing pairs from the
+    /// event's rate, the same bracketing solver and tolerance).
+    ///
+    /// # Errors
+    /// [`ParameterError`] for what the lanes do not support: resets, terminal events,
+    /// restarts, interior samples and step bounds (use the scalar driver for those).
+    pub fn with_event<G2: EventFunction<f64, 2>>(self, event: Event<G2>) -> Result<Ensemble<G2>> {
+        let unsupported = |requirement: &'static str| -> Result<Ensemble<G2>> {
+            Err(ParameterError::new("event", 0.0, requirement).into())
+        };
+        if event.terminal {
+            return unsupported("not terminal (terminal events are not supported in lanes)");
+        }
+        if event.restart {
+            return unsupported("without restart (not supported in lanes)");
+        }
+        if event.interior_samples > 0 {
+            return unsupported("without interior samples (not supported in lanes)");
+        }
+        if event.max_step.is_some() {
+            return unsupported("without a step bound (not supported in lanes)");
+        }
+        event.function.check()?;
+        Ok(Ensemble {
+            tol: self.tol,
+            opts: self.opts,
+            math: self.math,
+            max_steps: self.max_steps,
+            event_tol: self.event_tol,
+            zeno: self.zeno,
+            event: Some(event),
+        })
+    }
+
+    /// Sets how `exp` and `ln` are evaluated.
+    pub fn with_math(mut self, math: LaneMath) -> Self {
+        self.math = math;
+        self
+    }
+
+    /// Sets the step options.
+    ///
+    /// # Errors
+    /// [`ParameterError`] for invalid options, or the predictive correction (not in lanes).
+    pub fn with_options(mut self, opts: StepOptions<f64>) -> Result<Self> {
+        opts.validate()?;
+        if opts.predictive {
+            return Err(ParameterError::new("predictive", 1.0, "false in lanes").into());
+        }
+        self.opts = opts;
+        Ok(self)
+    }
+
+    /// Caps the accepted steps per trajectory.
+    ///
+    /// # Errors
+    /// [`ParameterError`] if `max_steps == 0`.
+    pub fn max_steps(mut self, max_steps: usize) -> Result<Self> {
+        if max_steps == 0 {
+            return Err(ParameterError::new("max_steps", 0.0, "> 0").into());
+        }
+        self.max_steps = max_steps;
+        Ok(self)
+    }
+
+    /// The tolerances.
+    pub fn tolerances(&self) -> &Tolerances<f64, 2> {
+        &self.tol
+    }
+
+    /// The math mode.
+    pub fn math(&self) -> LaneMath {
+        self.math
+    }
+
+    /// Integrates every trajectory in lanes of `V`, streaming trajectory `j` to
+    /// `observers[j]`, on the calling thread. A lane whose trajectory ends (or fails) takes
+    /// the next one in order; the result of each trajectory does not depend on `V`, on the
+    /// order of the slice or on what runs in the other lanes.
+    ///
+    /// # Errors
+    /// The outer error: [`ParameterError`] if `observers` and `trajectories` differ in
+    /// length. Each trajectory's own result is an element of the vector: its
+    /// [`Outcome`], or the error that stopped it (the scalar driver's errors).
+    pub fn run<V: Lanes, O: Observer<f64, 2>>(
+        &self,
+        trajectories: &[Trajectory],
+        observers: &mut [O],
+    ) -> Result<Vec<Result<Outcome<f64, 2>>>> {
+        if observers.len() != trajectories.len() {
+            return Err(ParameterError::new(
+                "observers",
+                observers.len() as f64,
+                "one per trajectory",
+            )
+            .into());
+        }
+        let mut out: Vec<Option<Result<Outcome<f64, 2>>>> = Vec::with_capacity(trajectories.len());
+        out.resize_with(trajectories.len(), || None);
+        if let Some(first) = trajectories.first() {
+            Engine::<V, G>::new(self, trajectories, first).run(observers, &mut out);
+        }
+        Ok(out
+            .into_iter()
+            .map(|r| r.unwrap_or_else(|| Err(IntegrateError::NotInitialized.into())))
+            .collect())
+    }
+
+    /// [`run`](Self::run) over the threads of the current rayon pool, `chunk` trajectories
+    /// per task (each task fills its own lanes): the results are the same, bit for bit, as
+    /// on one thread.
+    ///
+    /// # Errors
+    /// As [`run`](Self::run); [`ParameterError`] if `chunk == 0`.
+    #[cfg(feature = "parallel")]
+    pub fn run_parallel<V: Lanes, O: Observer<f64, 2> + Send>(
+        &self,
+        trajectories: &[Trajectory],
+        observers: &mut [O],
+        chunk: usize,
+    ) -> Result<Vec<Result<Outcome<f64, 2>>>>
+    where
+        G: Sync,
+    {
+        use rayon::prelude::*;
+        if chunk == 0 {
+            return Err(ParameterError::new("chunk", 0.0, "> 0").into());
+        }
+        if observers.len() != trajectories.len() {
+            return Err(ParameterError::new(
+                "observers",
+                observers.len() as f64,
+                "one per trajectory",
+            )
+            .into());
+        }
+        let parts: Vec<Vec<Result<Outcome<f64, 2>>>> = trajectories
+            .par_chunks(chunk)
+            .zip(observers.par_chunks_mut(chunk))
+            .map(|(t, o)| self.run::<V, O>(t, o))
+            .collect::<Result<_>>()?;
+        Ok(parts.into_iter().flatten().collect())
+    }
+}
+
+/// The dense output of one lane's accepted step (Hairer's continuous extension of
+/// DOPRI5, the same formula as [`Dopri5Dense`](crate::integrate::Dopri5Dense)).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LaneDense {
+    t0: f64,
+    t1: f64,
+    h: f64,
+    y0: SVector<f64, 2>,
+    y1: SVector<f64, 2>,
+    f0: SVector<f64, 2>,
+    f1: SVector<f64, 2>,
+    r2: SVector<f64, 2>,
+    r3: SVector<f64, 2>,
+    r4: SVector<f64, 2>,
+    r5: SVector<f64, 2>,
+}
+
+impl DenseOutput<f64, 2> for LaneDense {
+    fn span(&self) -> (f64, f64) {
+        (self.t0, self.t1)
+    }
+    fn endpoints(&self) -> (&SVector<f64, 2>, &SVector<f64, 2>) {
+        (&self.y0, &self.y1)
+    }
+    fn end_derivatives(&self) -> (&SVector<f64, 2>, &SVector<f64, 2>) {
+        (&self.f0, &self.f1)
+    }
+    #[inline(always)]
+    fn interpolate_unchecked(&self, t: f64, out: &mut SVector<f64, 2>) {
+        let th = (t - self.t0) / self.h;
+        let th1 = 1.0 - th;
+        for i in 0..2 {
+            out[i] = self.y0[i]
+                + th * (self.r2[i] + th1 * (self.r3[i] + th * (self.r4[i] + th1 * self.r5[i])));
+        }
+    }
+}
+
+/// Per-lane bookkeeping (scalar).
+struct Slot {
+    job: Option<usize>,
+    member: Option<Member>,
+    t_end: f64,
+    grid: Option<(f64, f64)>,
+    steps: usize,
+    nonfinite: u32,
+    side: i8,
+    history: EventHistory<f64>,
+    stats: Stats,
+}
+
+impl Slot {
+    fn idle() -> Self {
+        Self {
+            job: None,
+            member: None,
+            t_end: 0.0,
+            grid: None,
+            steps: 0,
+            nonfinite: 0,
+            side: 0,
+            history: EventHistory::new(),
+            stats: Stats::default(),
+        }
+    }
+}
+
+/// The vector state of all lanes.
+struct Engine<'a, V: Lanes, G> {
+    cfg: &'a Ensemble<G>,
+    jobs: &'a [Trajectory],
+    next: usize,
+    slots: Vec<Slot>,
+    packed: Packed<V>,
+    t: V,
+    x: V,
+    v: V,
+    fx: V,
+    fv: V,
+    h: V,
+    limit: V,
+    ln_err_old: V,
+    rej_last: V,
+    active: V,
+}
+
+const ALL: f64 = f64::from_bits(u64::MAX);
+
+#[inline(always)]
+fn sign_of(x: f64) -> i8 {
+    if x > 0.0 {
+        1
+    } else if x < 0.0 {
+        -1
+    } else {
+        0
+    }
+}
+
+/// The next landing point after `t` (the driver's rule), capped at `t_end`.
+fn next_limit(t: f64, t_end: f64, grid: Option<(f64, f64)>) -> f64 {
+    match grid {
+        Some((o, dt)) => {
+            let k = ((t - o) / dt).floor() + 1.0;
+            let mut next = o + k * dt;
+            if next <= t * (1.0 + 4.0 * f64::EPSILON) + f64::EPSILON * dt {
+                next = o + (k + 1.0) * dt;
+            }
+            next.min(t_end)
+        }
+        None => t_end,
+    }
+}
+
+impl<'a, V: Lanes, G: EventFunction<f64, 2>> Engine<'a, V, G> {
+    fn new(cfg: &'a Ensemble<G>, jobs: &'a [Trajectory], first: &Trajectory) -> Self {
+        let z = V::splat(0.0);
+        let packed = Packed::splat(&first.member);
+        // Idle lanes step from a benign state (the first job's start, h = 1e-6): their
+        // results are never used and their state never changes.
+        let (t, x, v) = (first.t0, first.y0[0], first.y0[1]);
+        Self {
+            cfg,
+            jobs,
+            next: 0,
+            slots: (0..V::LANES).map(|_| Slot::idle()).collect(),
+            packed,
+            t: V::splat(t),
+            x: V::splat(x),
+            v: V::splat(v),
+            fx: z,
+            fv: z,
+            h: V::splat(1e-6),
+            limit: V::splat(t + 1.0),
+            ln_err_old: V::splat(1e-4f64.ln()),
+            rej_last: z,
+            active: z,
+        }
+    }
+
+    /// Starts the next trajectory of the queue in lane `i` (skipping those that fail at
+    /// once); leaves the lane idle when the queue is empty.
+    fn fill<O: Observer<f64, 2>>(
+        &mut self,
+        i: usize,
+        observers: &mut [O],
+        out: &mut [Option<Result<Outcome<f64, 2>>>],
+    ) {
+        self.active = self.active.with_lane(i, 0.0);
+        self.slots[i].job = None;
+        while self.next < self.jobs.len() {
+            let j = self.next;
+            self.next += 1;
+            match self.start(i, j, &mut observers[j]) {
+                Ok(()) => {
+                    self.active = self.active.with_lane(i, ALL);
+                    return;
+                }
+                Err(e) => out[j] = Some(Err(e)),
+            }
+        }
+    }
+
+    fn start<O: Observer<f64, 2>>(&mut self, i: usize, j: usize, obs: &mut O) -> Result<()> {
+        let job = &self.jobs[j];
+        let cfg = self.cfg;
+        let (t0, y0, t_end) = (job.t0, job.y0, job.t_end);
+        if !(t0.is_finite() && t_end.is_finite() && t_end > t0) {
+            return Err(IntegrateError::InvalidTimeSpan { t0, t_end }.into());
+        }
+        crate::integrate::check_state(&y0)?;
+        cfg.opts
+            .validate()
+            .map_err(IntegrateError::InvalidSettings)?;
+        obs.check()?;
+        obs.check_span(t0, t_end)?;
+        // The work bound (the driver's check_work).
+        let mut hb = (cfg.opts.h_max.is_finite() && cfg.opts.h_max > 0.0).then_some(cfg.opts.h_max);
+        if let Some((_, dt)) = job.grid {
+            hb = Some(hb.map_or(dt, |h| h.min(dt)));
+        }
+        if let Some(hb) = hb {
+            let needed = (t_end - t0) / hb;
+            if !(needed <= cfg.max_steps as f64 + 1.0) {
+                return Err(IntegrateError::WorkExceedsCap {
+                    needed,
+                    span: t_end - t0,
+                    h: hb,
+                    max_steps: cfg.max_steps,
+                }
+                .into());
+            }
+        }
+        let m = job.member;
+        let mut stats = Stats::default();
+        obs.on_start(t0, &y0);
+        // The event's side at the start (the driver's rule).
+        let mut side = 0i8;
+        if let Some(ev) = &cfg.event {
+            let g = ev.function.value(t0, &y0);
+            if !g.is_finite() {
+                return Err(non_finite(t0, g));
+            }
+            side = sign_of(g);
+            if side == 0 {
+                let f = scalar_rhs(&m, t0, &y0);
+                if let Some(r) = ev.function.rate(t0, &y0, &f) {
+                    side = sign_of(r);
+                }
+            }
+        }
+        // The stepper's first derivative and first step.
+        let f0 = scalar_rhs(&m, t0, &y0);
+        stats.rhs_evals += 1;
+        if !(f0[0].is_finite() && f0[1].is_finite()) {
+            return Err(IntegrateError::NonFiniteRhs { t: t0 }.into());
+        }
+        let limit = next_limit(t0, t_end, job.grid);
+        let h = match cfg.opts.h_init {
+            Some(h) => h,
+            None => crate::integrate::initial_step(
+                m.scalar(),
+                t0,
+                &y0,
+                &f0,
+                5,
+                &cfg.tol,
+                cfg.opts.h_max,
+                limit - t0,
+                &mut stats.rhs_evals,
+            ),
+        };
+        self.packed.set(i, &m);
+        self.t = self.t.with_lane(i, t0);
+        self.x = self.x.with_lane(i, y0[0]);
+        self.v = self.v.with_lane(i, y0[1]);
+        self.fx = self.fx.with_lane(i, f0[0]);
+        self.fv = self.fv.with_lane(i, f0[1]);
+        self.h = self.h.with_lane(i, h);
+        self.limit = self.limit.with_lane(i, limit);
+        self.ln_err_old = self.ln_err_old.with_lane(i, 1e-4f64.ln());
+        self.rej_last = self.rej_last.with_lane(i, 0.0);
+        let s = &mut self.slots[i];
+        *s = Slot::idle();
+        s.job = Some(j);
+        s.member = Some(m);
+        s.t_end = t_end;
+        s.grid = job.grid;
+        s.side = side;
+        s.stats = stats;
+        Ok(())
+    }
+
+    fn finish<O: Observer<f64, 2>>(
+        &mut self,
+        i: usize,
+        result: Result<(f64, SVector<f64, 2>, Termination)>,
+        observers: &mut [O],
+        out: &mut [Option<Result<Outcome<f64, 2>>>],
+    ) {
+        if let Some(j) = self.slots[i].job {
+            out[j] = Some(result.map(|(t, y, termination)| {
+                let o = Outcome {
+                    t,
+                    y,
+                    termination,
+                    stats: self.slots[i].stats,
+                };
+                observers[j].on_finish(&o);
+                o
+            }));
+        }
+        self.fill(i, observers, out);
+    }
+
+    fn run<O: Observer<f64, 2>>(
+        &mut self,
+        observers: &mut [O],
+        out: &mut [Option<Result<Outcome<f64, 2>>>],
+    ) {
+        for i in 0..V::LANES {
+            self.fill(i, observers, out);
+        }
+        let cfg = self.cfg;
+        let s = V::splat;
+        let (a21, a31, a32) = (s(1.0 / 5.0), s(3.0 / 40.0), s(9.0 / 40.0));
+        let (a41, a42, a43) = (s(44.0 / 45.0), s(-56.0 / 15.0), s(32.0 / 9.0));
+        let (a51, a52, a53, a54) = (
+            s(19372.0 / 6561.0),
+            s(-25360.0 / 2187.0),
+            s(64448.0 / 6561.0),
+            s(-212.0 / 729.0),
+        );
+        let (a61, a62, a63, a64, a65) = (
+            s(9017.0 / 3168.0),
+            s(-355.0 / 33.0),
+            s(46732.0 / 5247.0),
+            s(49.0 / 176.0),
+            s(-5103.0 / 18656.0),
+        );
+        let (a71, a73, a74, a75, a76) = (
+            s(35.0 / 384.0),
+            s(500.0 / 1113.0),
+            s(125.0 / 192.0),
+            s(-2187.0 / 6784.0),
+            s(11.0 / 84.0),
+        );
+        let (e1, e3, e4, e5, e6, e7) = (
+            s(71.0 / 57600.0),
+            s(-71.0 / 16695.0),
+            s(71.0 / 1920.0),
+            s(-17253.0 / 339200.0),
+            s(22.0 / 525.0),
+            s(-1.0 / 40.0),
+        );
+        let (d1, d3, d4, d5, d6, d7) = (
+            s(-12715105075.0 / 11282082432.0),
+            s(87487479700.0 / 32700410799.0),
+            s(-10690763975.0 / 1880347072.0),
+            s(701980252875.0 / 199316789632.0),
+            s(-1453857185.0 / 822651844.0),
+            s(69997945.0 / 29380423.0),
+        );
+        let (c2, c3, c4, c5) = (s(0.2), s(0.3), s(0.8), s(8.0 / 9.0));
+        let (atx, atv) = (s(cfg.tol.atol[0]), s(cfg.tol.atol[1]));
+        let (rtx, rtv) = (s(cfg.tol.rtol[0]), s(cfg.tol.rtol[1]));
+        let o = &cfg.opts;
+        let expo = 1.0 / 5.0 - 0.75 * o.beta;
+        let (expo_v, beta_v) = (s(expo), s(o.beta));
+        let (safety, inv_fac_max, inv_fac_min) =
+            (s(o.safety), s(1.0 / o.fac_max), s(1.0 / o.fac_min));
+        let h_max = s(o.h_max);
+        let ln_floor = s(1e-4f64.ln());
+        let min_step_rel = s(16.0 * f64::EPSILON);
+        let h_min = s(o.h_min);
+        let math = cfg.math;
+        let one = s(1.0);
+        let zero = s(0.0);
+        let mut buf = [[0.0f64; 16]; 20];
+        while self.active.bits() != 0 {
+            let p = self.packed;
+            let (t, x, v, k1x, k1v, h) = (self.t, self.x, self.v, self.fx, self.fv, self.h);
+            // The trial step, cut to land on the lane's limit (clamp_to_limit).
+            let rest = self.limit - t;
+            let lands = h.ge(rest * s(0.99));
+            let hs = lands.select(rest, h);
+            let too_small = (hs.lt((min_step_rel * t.abs()).max(h_min)) | !(t + hs).gt(t))
+                & !lands
+                & self.active;
+            if too_small.bits() != 0 {
+                for i in 0..V::LANES {
+                    if too_small.bits() & (1 << i) != 0 {
+                        let e = IntegrateError::StepSizeTooSmall {
+                            t: t.lane(i),
+                            h: hs.lane(i),
+                        };
+                        self.finish(i, Err(e.into()), observers, out);
+                    }
+                }
+                continue;
+            }
+            let (k2x, k2v) = p.rhs(
+                math,
+                t + c2 * hs,
+                x + k1x * (a21 * hs),
+                v + k1v * (a21 * hs),
+            );
+            let (k3x, k3v) = p.rhs(
+                math,
+                t + c3 * hs,
+                x + (k1x * a31 + k2x * a32) * hs,
+                v + (k1v * a31 + k2v * a32) * hs,
+            );
+            let (k4x, k4v) = p.rhs(
+                math,
+                t + c4 * hs,
+                x + (k1x * a41 + k2x * a42 + k3x * a43) * hs,
+                v + (k1v * a41 + k2v * a42 + k3v * a43) * hs,
+            );
+            let (k5x, k5v) = p.rhs(
+                math,
+                t + c5 * hs,
+                x + (k1x * a51 + k2x * a52 + k3x * a53 + k4x * a54) * hs,
+                v + (k1v * a51 + k2v * a52 + k3v * a53 + k4v * a54) * hs,
+            );
+            let t_new = lands.select(self.limit, t + hs);
+            let (k6x, k6v) = p.rhs(
+                math,
+                t_new,
+                x + (k1x * a61 + k2x * a62 + k3x * a63 + k4x * a64 + k5x * a65) * hs,
+                v + (k1v * a61 + k2v * a62 + k3v * a63 + k4v * a64 + k5v * a65) * hs,
+            );
+            let xn = x + (k1x * a71 + k3x * a73 + k4x * a74 + k5x * a75 + k6x * a76) * hs;
+            let vn = v + (k1v * a71 + k3v * a73 + k4v * a74 + k5v * a75 + k6v * a76) * hs;
+            let (k7x, k7v) = p.rhs(math, t_new, xn, vn);
+            let ex = (k1x * e1 + k3x * e3 + k4x * e4 + k5x * e5 + k6x * e6 + k7x * e7) * hs;
+            let ev = (k1v * e1 + k3v * e3 + k4v * e4 + k5v * e5 + k6v * e6 + k7v * e7) * hs;
+            let qx = ex / (atx + rtx * x.abs().max(xn.abs()));
+            let qv = ev / (atv + rtv * v.abs().max(vn.abs()));
+            let err = (((zero + qx * qx) + qv * qv) / s(2.0)).sqrt();
+            let finite = xn.finite() & vn.finite() & k7x.finite() & k7v.finite();
+            let err = finite.select(err, s(f64::NAN));
+            // The PI controller (Controller::propose), lane-wise.
+            let err_ok = err.finite();
+            let pos = err.gt(zero) & err_ok;
+            let ln_err = pos.select(ln(math, pos.select(err, one)), s(-700.0));
+            let acc = err_ok & err.le(one);
+            // One exp per lane: err^α/err_old^β where accepted, err^α where rejected.
+            let arg = acc.select(expo_v * ln_err - beta_v * self.ln_err_old, expo_v * ln_err);
+            let fac_any = exp(math, arg);
+            let fac = (fac_any / safety).max(inv_fac_max).min(inv_fac_min);
+            let h_acc = hs / fac;
+            let h_acc = self.rej_last.select(h_acc.min(hs), h_acc).min(h_max);
+            let h_rej = hs / (fac_any / safety).min(inv_fac_min);
+            let h_next = acc.select(h_acc, err_ok.select(h_rej, hs * s(0.1)));
+            let acc = acc & self.active;
+            let rejected = !acc & self.active;
+            let non_finite = !finite & self.active;
+            // Rejected lanes retry with the smaller step.
+            self.h = rejected.select(h_next, self.h);
+            self.rej_last = rejected.select(s(ALL), acc.select(zero, self.rej_last));
+            self.ln_err_old = acc.select(ln_err.max(ln_floor), self.ln_err_old);
+            let (rb, ab, nb) = (rejected.bits(), acc.bits(), non_finite.bits());
+            let act = self.active.bits();
+            for i in 0..V::LANES {
+                if act & (1 << i) != 0 {
+                    self.slots[i].stats.rhs_evals += 6;
+                }
+                if rb & (1 << i) != 0 {
+                    self.slots[i].stats.rejected += 1;
+                }
+                if nb & (1 << i) != 0 {
+                    self.slots[i].nonfinite += 1;
+                    if self.slots[i].nonfinite > 20 {
+                        let e = IntegrateError::NonFiniteRhs { t: t.lane(i) };
+                        self.finish(i, Err(e.into()), observers, out);
+                    }
+                }
+            }
+            if ab == 0 {
+                continue;
+            }
+            // Accepted lanes: the new state, the next step, the dense output.
+            self.t = acc.select(t_new, self.t);
+            self.x = acc.select(xn, self.x);
+            self.v = acc.select(vn, self.v);
+            self.fx = acc.select(k7x, self.fx);
+            self.fv = acc.select(k7v, self.fv);
+            self.h = acc.select(lands.select(h_next.max(h), h_next), self.h);
+            let dxd = xn - x;
+            let dvd = vn - v;
+            let bx = k1x * hs - dxd;
+            let bv = k1v * hs - dvd;
+            let r4x = dxd - k7x * hs - bx;
+            let r4v = dvd - k7v * hs - bv;
+            let r5x = (k1x * d1 + k3x * d3 + k4x * d4 + k5x * d5 + k6x * d6 + k7x * d7) * hs;
+            let r5v = (k1v * d1 + k3v * d3 + k4v * d4 + k5v * d5 + k6v * d6 + k7v * d7) * hs;
+            for (b, w) in buf.iter_mut().zip([
+                t, t_new, hs, x, v, xn, vn, k1x, k1v, k7x, k7v, dxd, dvd, bx, bv, r4x, r4v, r5x,
+                r5v,
+            ]) {
+                w.store(b);
+            }
+            // Lane `i` of each stored vector is `buf[k][i]`.
+            #[allow(clippy::needless_range_loop)]
+            for i in 0..V::LANES {
+                if ab & (1 << i) == 0 {
+                    continue;
+                }
+                let g = |k: usize| buf[k][i];
+                let sv = |a: usize, b: usize| SVector::<f64, 2>::new(g(a), g(b));
+                let dense = LaneDense {
+                    t0: g(0),
+                    t1: g(1),
+                    h: g(2),
+                    y0: sv(3, 4),
+                    y1: sv(5, 6),
+                    f0: sv(7, 8),
+                    f1: sv(9, 10),
+                    r2: sv(11, 12),
+                    r3: sv(13, 14),
+                    r4: sv(15, 16),
+                    r5: sv(17, 18),
+                };
+                self.after_step(i, &dense, observers, out);
+            }
+        }
+    }
+
+    /// A lane's accepted step: events and observers, then the end or the next limit.
+    fn after_step<O: Observer<f64, 2>>(
+        &mut self,
+        i: usize,
+        dense: &LaneDense,
+        observers: &mut [O],
+        out: &mut [Option<Result<Outcome<f64, 2>>>],
+    ) {
+        let Some(j) = self.slots[i].job else { return };
+        let slot = &mut self.slots[i];
+        slot.stats.accepted += 1;
+        slot.steps += 1;
+        slot.nonfinite = 0;
+        let obs = &mut observers[j];
+        let res = scan(self.cfg, slot, dense, obs);
+        match res {
+            Err(e) => self.finish(i, Err(e), observers, out),
+            Ok(Some((t, y))) => {
+                self.finish(i, Ok((t, y, Termination::ObserverStopped)), observers, out)
+            }
+            Ok(None) => {
+                let slot = &self.slots[i];
+                let (t1, y1) = (dense.t1, dense.y1);
+                if t1 >= slot.t_end {
+                    self.finish(i, Ok((t1, y1, Termination::ReachedEnd)), observers, out);
+                } else if slot.steps >= self.cfg.max_steps {
+                    let e = IntegrateError::MaxSteps {
+                        t: t1,
+                        max_steps: self.cfg.max_steps,
+                    };
+                    self.finish(i, Err(e.into()), observers, out);
+                } else {
+                    let l = next_limit(t1, slot.t_end, slot.grid);
+                    self.limit = self.limit.with_lane(i, l);
+                }
+            }
+        }
+    }
+}
+
+fn non_finite(t: f64, g: f64) -> crate::Error {
+    EventError::NonFinite {
+        index: 0,
+        t,
+        value: g,
+    }
+    .into()
+}
+
+/// A crossing found on a step.
+#[derive(Debug, Clone, Copy)]
+struct Crossing {
+    t: f64,
+    rising: bool,
+    resume: Option<(f64, f64)>,
+}
+
+/// The driver's event scan and observer calls for one lane's step (one detection event,
+/// no reset). Returns the state to stop at if an observer stopped the run.
+fn scan<G: EventFunction<f64, 2>, O: Observer<f64, 2>>(
+    cfg: &Ensemble<G>,
+    slot: &mut Slot,
+    dense: &LaneDense,
+    obs: &mut O,
+) -> Result<Option<(f64, SVector<f64, 2>)>> {
+    let (ts0, ts1) = (dense.t0, dense.t1);
+    let (y_start, y_end) = (dense.y0, dense.y1);
+    let mut t_lo = ts0;
+    let mut y_lo = y_start;
+    let mut g_end = None;
+    if let (Some(ev), Some(m)) = (&cfg.event, &slot.member) {
+        let fun = &ev.function;
+        let g0 = fun.value(ts0, &y_start);
+        let ge = fun.value(ts1, &y_end);
+        if !(g0.is_finite() && ge.is_finite()) {
+            let (t, g) = if g0.is_finite() { (ts1, ge) } else { (ts0, g0) };
+            return Err(non_finite(t, g));
+        }
+        g_end = Some(ge);
+        if slot.side == 0 {
+            slot.side = if ge != 0.0 { sign_of(ge) } else { 1 };
+        }
+        let st_g = if g0 == 0.0 {
+            let tiny = f64::EPSILON * f64::EPSILON;
+            if slot.side < 0 { -tiny } else { tiny }
+        } else {
+            g0
+        };
+        let st_r = fun.rate(ts0, &y_start, &dense.f0);
+        let r_end = fun.rate(ts1, &y_end, &dense.f1);
+        let tol = cfg.event_tol.max(4.0 * f64::EPSILON * ts1.abs());
+        let mut found = find_crossing(fun, m, dense, tol, ts0, st_g, st_r, ts1, ge, r_end);
+        while let Some(c) = found {
+            found = match c.resume {
+                Some((tr, gr)) => find_crossing(fun, m, dense, tol, tr, gr, None, ts1, ge, r_end),
+                None => None,
+            };
+            slot.side = if c.rising { 1 } else { -1 };
+            if !ev.direction.accepts(c.rising) {
+                continue;
+            }
+            let tc = c.t;
+            let mut yc = SVector::zeros();
+            dense.interpolate_unchecked(tc, &mut yc);
+            let view = StepView {
+                t0: t_lo,
+                t1: tc,
+                y0: y_lo,
+                y1: yc,
+                dense,
+            };
+            let stop_obs = obs.on_step(&view) == Control::Stop;
+            slot.stats.events += 1;
+            if let Some((count, last)) = slot.history.push(tc, &cfg.zeno) {
+                return Err(EventError::Zeno {
+                    t: tc,
+                    count,
+                    last_interval: last,
+                    state: yc.iter().copied().collect(),
+                }
+                .into());
+            }
+            let rec = EventRecord {
+                index: 0,
+                t: tc,
+                y: yc,
+                y_after: None,
+                direction: if c.rising {
+                    Direction::Rising
+                } else {
+                    Direction::Falling
+                },
+            };
+            let stop_ev = obs.on_event(&rec) == Control::Stop;
+            if stop_obs || stop_ev {
+                return Ok(Some((tc, yc)));
+            }
+            t_lo = tc;
+            y_lo = yc;
+        }
+    }
+    let view = StepView {
+        t0: t_lo,
+        t1: ts1,
+        y0: y_lo,
+        y1: y_end,
+        dense,
+    };
+    let stop = obs.on_step(&view) == Control::Stop;
+    if let Some(ge) = g_end {
+        if ge != 0.0 {
+            slot.side = sign_of(ge);
+        }
+    }
+    Ok(stop.then_some((ts1, y_end)))
+}
+
+/// The earliest crossing of the event in `(t_lo, t1]` ([`Simulation`]'s search without
+/// interior samples).
+///
+/// [`Simulation`]: crate::drive::Simulation
+#[allow(clippy::too_many_arguments)]
+fn find_crossing<G: EventFunction<f64, 2>>(
+    ev: &G,
+    m: &Member,
+    dense: &LaneDense,
+    tol: f64,
+    t_lo: f64,
+    g_lo: f64,
+    r_lo: Option<f64>,
+    t1: f64,
+    g1: f64,
+    r1: Option<f64>,
+) -> Option<Crossing> {
+    let g_at = |t: f64| {
+        let mut y = SVector::<f64, 2>::zeros();
+        dense.interpolate_unchecked(t, &mut y);
+        ev.value(t, &y)
+    };
+    let s = sign_of(g_lo);
+    if g1 != 0.0 && sign_of(g1) != s {
+        let (tc, _) = locate(g_at, t_lo, t1, g_lo, g1, tol);
+        return Some(Crossing {
+            t: tc,
+            rising: g1 > 0.0,
+            resume: None,
+        });
+    }
+    let r_lo = match r_lo {
+        Some(r) => Some(r),
+        None => {
+            let mut y = SVector::zeros();
+            dense.interpolate_unchecked(t_lo, &mut y);
+            let f = scalar_rhs(m, t_lo, &y);
+            ev.rate(t_lo, &y, &f)
+        }
+    };
+    let (Some(r_lo), Some(r1)) = (r_lo, r1) else {
+        return None;
+    };
+    let towards = if s > 0 { r_lo < 0.0 } else { r_lo > 0.0 };
+    let away = if s > 0 { r1 > 0.0 } else { r1 < 0.0 };
+    if !(towards && (away || g1 == 0.0)) {
+        return None;
+    }
+    let sg = if s > 0 { 1.0 } else { -1.0 };
+    let (te, neg) = crate::roots::golden_max(|t| -sg * g_at(t), t_lo, t1, tol);
+    let ge = -neg * sg;
+    if ge == 0.0 || sign_of(ge) == s {
+        return None;
+    }
+    let (tc, _) = locate(g_at, t_lo, te, g_lo, ge, tol);
+    Some(Crossing {
+        t: tc,
+        rising: ge > 0.0,
+        resume: Some((te, ge)),
+    })
+}

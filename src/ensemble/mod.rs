@@ -1,0 +1,92 @@
+//! Ensembles: many trajectories in the lanes of SIMD vectors, each with its own adaptive
+//! step, error control, events and observers.
+//!
+//! A bifurcation sweep, a TLE diagram or a parameter plane integrates thousands of
+//! independent trajectories of the same model. [`Ensemble::run`] puts `L` of them in the
+//! lanes of a [`Lanes`] vector (`wide`'s `f64x2`, `f64x4`, `f64x8`) and steps them
+//! together with DOPRI5.
+//!
+//! # The lane method
+//! Every lane carries its own `t`, state `(x, ẋ)`, cached derivative (first same as last),
+//! proposed step `h`, step limit (the next landing point or its end) and controller memory
+//! (`ln` of the last accepted error, whether the last trial was rejected). One pass of the
+//! loop is one *trial* step in every lane: with `h_s = h` cut to the lane's limit
+//! (`h_s = t_limit − t` when `h ≥ 0.99·(t_limit − t)`), the six stages
+//! $$k_i = f\Bigl(t + c_i h_s,\; y + h_s\sum_{j<i} a_{ij}k_j\Bigr)$$
+//! of Dormand and Prince are evaluated in all lanes at once, then the error norm
+//! $$\|e\| = \sqrt{\tfrac12\sum_i \bigl(e_i/(a_i + r_i\max(|y_{0,i}|,|y_{1,i}|))\bigr)^2}$$
+//! and the PI controller `h_new = h_s / min(max(‖e‖^{α}‖e_old‖^{−β}/0.9, 1/10), 5)` on
+//! acceptance, `h_s / min(‖e‖^{α}/0.9, 5)` on rejection (the scalar
+//! [`Dopri5`](crate::integrate::Dopri5)'s constants, `α = 1/5 − 0.75β`, `β = 0.04`).
+//! Nothing of the scalar method changes: the tableau, the norm, the controller, Hairer's
+//! first-step guess and the landing rule are the scalar ones, operation for operation.
+//!
+//! # Masking
+//! The accept test `‖e‖ ≤ 1` gives a mask `A`. The new state, derivative and step are
+//! blended in by `A` (`y ← A ? y₁ : y`); rejected lanes keep their state and take the
+//! smaller step on the next pass. A rejected lane therefore costs the others nothing but
+//! the slot it occupies for one pass: no lane waits for another. Accepted lanes are then
+//! visited one by one (a scalar loop over the set bits of `A`): their dense output is
+//! taken out of the lanes, events are located on it with the scalar driver's search (sign
+//! changes and grazing pairs, the same bracketing solver, tolerance `max(10⁻¹², 4ε|t|)`),
+//! and the observer of the lane's trajectory receives the step and its events exactly as
+//! from [`Simulation`](crate::drive::Simulation). A lane whose trajectory ends takes the
+//! next one of the batch (a work queue), so the vectors stay full until the queue runs
+//! dry. Events and observers are scalar work per accepted step and per event, a small
+//! part of a step's six vector evaluations.
+//!
+//! # Same answers
+//! With [`LaneMath::Exact`] (the default) every lane evaluates the same arithmetic as the
+//! scalar path in the same order — `sin` by the lane form of the crate's `fastmath`
+//! kernels, `exp`/`ln` by the platform's functions lane by lane — so a lane reproduces the
+//! scalar [`Simulation`](crate::drive::Simulation) with
+//! [`Dopri5`](crate::integrate::Dopri5) **to the bit**: the same steps, the same events,
+//! the same section points (tested on the paper's model). With [`LaneMath::Vector`] the
+//! exponentials are evaluated in the lanes (`math` gives their accuracy in ulps); results
+//! then agree with the scalar path within the integration tolerance. Either way a
+//! trajectory's result depends only on its own inputs: not on the lane count, on its
+//! position in the batch, on the other lanes or on the number of threads
+//! ([`Ensemble::run_parallel`]).
+//!
+//! # Continuation sweeps
+//! A continuation sweep starts each value from the end state of the previous one: one
+//! branch is a sequential chain, and its values cannot share lanes. Ensembles serve the
+//! independent runs — independent-start sweeps, the two trajectories of a Lyapunov pair
+//! at many parameter values, entropy scans, parameter planes and basins; a continuation
+//! sweep can put its branches (or its up and down directions) in lanes, and otherwise
+//! stays on the scalar path.
+//!
+//! # Examples
+//! ```
+//! use nalgebra::Vector2;
+//! use nonsmooth::drive::Simulation;
+//! use nonsmooth::ensemble::{Ensemble, F64x4, Member, Trajectory};
+//! use nonsmooth::integrate::{Dopri5, Tolerances};
+//! use nonsmooth::model::paper::PAPER;
+//!
+//! let tol = Tolerances::per_component(1e-8, [1e-12, 1e-10])?;
+//! let y0 = Vector2::new(PAPER.static_equilibrium()?, 0.0);
+//! // Eight forcing frequencies, 5 periods each, in lanes of four.
+//! let jobs: Vec<Trajectory> = (0..8)
+//!     .map(|i| Trajectory::periods(Member::paper(17.5 + i as f64)?, y0, 5.0))
+//!     .collect::<nonsmooth::Result<_>>()?;
+//! let mut observers = vec![(); jobs.len()];
+//! let out = Ensemble::new(tol)?.run::<F64x4, _>(&jobs, &mut observers)?;
+//! // The same as the scalar path, to the bit.
+//! let j = &jobs[3];
+//! let scalar = Simulation::new(*j.member.scalar(), Dopri5::new(tol))
+//!     .landing_grid(j.grid)?
+//!     .run(0.0, y0, j.t_end, &mut ())?;
+//! assert_eq!(out[3].as_ref().unwrap().y, scalar.y);
+//! # Ok::<(), nonsmooth::Error>(())
+//! ```
+
+mod engine;
+mod lanes;
+pub mod math;
+mod model;
+
+pub use engine::{Ensemble, LaneDense, Trajectory};
+pub use lanes::{F64x2, F64x4, F64x8, Lanes};
+pub use math::LaneMath;
+pub use model::Member;

@@ -1,0 +1,535 @@
+//! Ensembles in SIMD lanes against the scalar path: the paper's model (to the bit with the
+//! exact math, within the tolerance with the vector math), a linear forced oscillator with
+//! a closed form, event times, determinism over lane counts, batch order and threads, and
+//! the lane math functions against libm.
+
+use nalgebra::Vector2;
+use nonsmooth::drive::{Control, EventRecord, Observer, Simulation};
+use nonsmooth::ensemble::{
+    Ensemble, F64x2, F64x4, F64x8, LaneMath, Lanes, Member, Trajectory, math,
+};
+use nonsmooth::event::{Direction, Event, Level, Stop};
+use nonsmooth::integrate::{Dopri5, Stats, Tolerances};
+use nonsmooth::model::paper::{PAPER, PaperParameters};
+use nonsmooth::sample::Stroboscopic;
+
+/// Section points and event times of one run.
+#[derive(Debug, Clone)]
+struct Record {
+    strobe: Stroboscopic<f64, 2>,
+    events: Vec<(f64, f64, f64)>,
+}
+
+impl Record {
+    fn new(period: f64) -> Self {
+        Self {
+            strobe: Stroboscopic::periodic(0.0, period, 0.5 * period, 1 << 16).unwrap(),
+            events: Vec::new(),
+        }
+    }
+    fn sections(&self) -> Vec<(f64, Vector2<f64>)> {
+        self.strobe.points().iter().map(|p| (p.t, p.y)).collect()
+    }
+}
+
+impl Observer<f64, 2> for Record {
+    fn check_span(&self, t0: f64, t_end: f64) -> nonsmooth::Result<()> {
+        self.strobe.check_span(t0, t_end)
+    }
+    fn on_start(&mut self, t0: f64, y0: &Vector2<f64>) {
+        self.strobe.on_start(t0, y0);
+    }
+    fn on_step<D: nonsmooth::integrate::DenseOutput<f64, 2>>(
+        &mut self,
+        s: &nonsmooth::drive::StepView<'_, f64, 2, D>,
+    ) -> Control {
+        self.strobe.on_step(s)
+    }
+    fn on_event(&mut self, e: &EventRecord<f64, 2>) -> Control {
+        self.events.push((e.t, e.y[0], e.y[1]));
+        Control::Continue
+    }
+}
+
+fn tol(rtol: f64) -> Tolerances<f64, 2> {
+    Tolerances::per_component(rtol, [rtol * 1e-4, rtol * 1e-2]).unwrap()
+}
+
+fn impact() -> Event<Stop<f64>> {
+    Event::new(
+        Stop {
+            position: 0,
+            velocity: 1,
+            level: PAPER.x_i,
+        },
+        Direction::Rising,
+    )
+}
+
+fn rest() -> Vector2<f64> {
+    Vector2::new(PAPER.static_equilibrium().unwrap(), 0.0)
+}
+
+/// The scalar path: `Simulation` + `Dopri5`, steps landing on the sections.
+fn scalar(job: &Trajectory, tol: Tolerances<f64, 2>, event: bool) -> (Record, Stats, Vector2<f64>) {
+    let mut rec = Record::new(job.member.period());
+    let sim = Simulation::new(*job.member.scalar(), Dopri5::new(tol))
+        .landing_grid(job.grid)
+        .unwrap();
+    let out = if event {
+        sim.with_events(impact())
+            .run(job.t0, job.y0, job.t_end, &mut rec)
+            .unwrap()
+    } else {
+        let mut sim = sim;
+        sim.run(job.t0, job.y0, job.t_end, &mut rec).unwrap()
+    };
+    (rec, out.stats, out.y)
+}
+
+/// The ensemble path in lanes of `V`.
+fn lanes<V: Lanes>(
+    jobs: &[Trajectory],
+    tol: Tolerances<f64, 2>,
+    math: LaneMath,
+) -> Vec<(Record, Stats, Vector2<f64>)> {
+    let mut recs: Vec<Record> = jobs
+        .iter()
+        .map(|j| Record::new(j.member.period()))
+        .collect();
+    let ens = Ensemble::new(tol)
+        .unwrap()
+        .with_event(impact())
+        .unwrap()
+        .with_math(math);
+    let out = ens.run::<V, _>(jobs, &mut recs).unwrap();
+    recs.into_iter()
+        .zip(out)
+        .map(|(r, o)| {
+            let o = o.unwrap();
+            (r, o.stats, o.y)
+        })
+        .collect()
+}
+
+fn paper_jobs(omegas: &[f64], periods: f64) -> Vec<Trajectory> {
+    omegas
+        .iter()
+        .map(|&w| Trajectory::periods(Member::paper(w).unwrap(), rest(), periods).unwrap())
+        .collect()
+}
+
+#[test]
+fn lanes_reproduce_the_scalar_paper_model_to_the_bit() {
+    // Impact-free, one to five impacts per period, period 2, chaotic: all regimes.
+    let omegas = [13.0, 14.5, 17.0, 18.0, 19.0, 20.465, 22.0, 25.0, 15.7];
+    let jobs = paper_jobs(&omegas, 40.0);
+    let tol = tol(1e-8);
+    let ens = lanes::<F64x4>(&jobs, tol, LaneMath::Exact);
+    let mut impacts = 0;
+    for (job, (rec, stats, y)) in jobs.iter().zip(&ens) {
+        let (srec, sstats, sy) = scalar(job, tol, true);
+        assert_eq!(*stats, sstats, "ω = {}", job.member.omega());
+        assert_eq!(*y, sy);
+        assert_eq!(rec.sections(), srec.sections());
+        assert_eq!(rec.sections().len(), 40);
+        assert_eq!(rec.events, srec.events);
+        impacts += rec.events.len();
+    }
+    assert!(impacts > 200, "{impacts}");
+}
+
+/// The largest distance between the section points of two runs relative to the points'
+/// scale per component, over the last `n` sections.
+fn section_distance(a: &Record, b: &Record, n: usize) -> f64 {
+    let (pa, pb) = (a.sections(), b.sections());
+    assert_eq!(pa.len(), pb.len());
+    let mut scale = [0.0f64; 2];
+    for (_, y) in &pa {
+        for c in 0..2 {
+            scale[c] = scale[c].max(y[c].abs());
+        }
+    }
+    pa.iter()
+        .zip(&pb)
+        .rev()
+        .take(n)
+        .map(|((ta, ya), (tb, yb))| {
+            assert_eq!(ta, tb);
+            (0..2)
+                .map(|c| (ya[c] - yb[c]).abs() / scale[c])
+                .fold(0.0, f64::max)
+        })
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn vector_math_lanes_agree_with_scalar_within_the_tolerance() {
+    // Periodic attractors (on a chaotic one any two computations separate): the section
+    // points of the vector-math lanes against the scalar path, and the scatter of the
+    // scalar path itself between rtol 1e-8 and 1e-9 as the yardstick.
+    let omegas = [14.5, 16.0, 17.0, 19.0, 20.2, 24.0];
+    let jobs = paper_jobs(&omegas, 150.0);
+    let ens = lanes::<F64x4>(&jobs, tol(1e-8), LaneMath::Vector);
+    for (job, (rec, stats, _)) in jobs.iter().zip(&ens) {
+        let (srec, sstats, _) = scalar(job, tol(1e-8), true);
+        let (frec, _, _) = scalar(job, tol(1e-9), true);
+        let d = section_distance(rec, &srec, 20);
+        let yard = section_distance(&frec, &srec, 20);
+        println!(
+            "ω = {}: lanes {d:e}, scalar 1e-8 vs 1e-9 {yard:e}",
+            job.member.omega()
+        );
+        assert!(
+            // Two runs at the same tolerance differ by up to about twice the error of
+            // either (the 1e-8 vs 1e-9 spread); factor 3 for the variation along the orbit.
+            d <= 3.0 * yard.max(1e-9),
+            "ω = {}: lanes {d:e} vs scalar tolerance spread {yard:e}",
+            job.member.omega()
+        );
+        // The same number of impacts in the recorded window, and close work.
+        let count = |r: &Record| {
+            r.events
+                .iter()
+                .filter(|e| e.0 > 50.0 * job.member.period())
+                .count()
+        };
+        assert_eq!(count(rec), count(&srec), "ω = {}", job.member.omega());
+        let ratio = stats.rhs_evals as f64 / sstats.rhs_evals as f64;
+        assert!((0.9..1.1).contains(&ratio), "work ratio {ratio}");
+    }
+}
+
+/// A linear forced oscillator `m ẍ + c ẋ + k x = A sin ωt` (the paper's member without
+/// friction and with the stop out of reach) and its closed form.
+struct Linear {
+    m: f64,
+    c: f64,
+    k: f64,
+    a: f64,
+    w: f64,
+}
+
+impl Linear {
+    fn params() -> PaperParameters {
+        PaperParameters {
+            t: 0.0,
+            x_i: 1.0,
+            ..PAPER
+        }
+    }
+    fn new(w: f64) -> Self {
+        let p = Self::params();
+        Self {
+            m: p.m,
+            c: p.c,
+            k: p.k,
+            a: p.m0e * w * w,
+            w,
+        }
+    }
+    /// `x(t)` from `(x0, v0)` at `t = 0`.
+    fn x(&self, t: f64, x0: f64, v0: f64) -> f64 {
+        let (m, c, k, a, w) = (self.m, self.c, self.k, self.a, self.w);
+        let d = (k - m * w * w).powi(2) + (c * w).powi(2);
+        let (p, q) = (a * (k - m * w * w) / d, -a * c * w / d);
+        let s = c / (2.0 * m);
+        let wd = (k / m - s * s).sqrt();
+        let c1 = x0 - q;
+        let c2 = (v0 + s * c1 - p * w) / wd;
+        (-s * t).exp() * (c1 * (wd * t).cos() + c2 * (wd * t).sin())
+            + p * (w * t).sin()
+            + q * (w * t).cos()
+    }
+}
+
+#[test]
+fn smooth_reference_closed_form() {
+    let omegas = [6.0, 9.0, 12.7, 15.0, 20.0, 31.0];
+    let y0 = Vector2::new(1e-3, -2e-2);
+    let jobs: Vec<Trajectory> = omegas
+        .iter()
+        .map(|&w| Trajectory::periods(Member::new(Linear::params(), w).unwrap(), y0, 30.0).unwrap())
+        .collect();
+    let tol = Tolerances::per_component(1e-9, [1e-13, 1e-11]).unwrap();
+    for math in [LaneMath::Exact, LaneMath::Vector] {
+        let ens = lanes::<F64x4>(&jobs, tol, math);
+        for (job, (rec, _, _)) in jobs.iter().zip(&ens) {
+            let lin = Linear::new(job.member.omega());
+            let (srec, _, _) = scalar(job, tol, true);
+            let err = |r: &Record| {
+                r.sections()
+                    .iter()
+                    .map(|(t, y)| (y[0] - lin.x(*t, y0[0], y0[1])).abs())
+                    .fold(0.0, f64::max)
+            };
+            let (el, es) = (err(rec), err(&srec));
+            let amplitude = rec
+                .sections()
+                .iter()
+                .map(|(_, y)| y[0].abs())
+                .fold(0.0, f64::max);
+            // Both paths meet the closed form to the tolerance's order (rtol 1e-9).
+            assert!(
+                es < 1e-8 * amplitude && el < 1e-8 * amplitude,
+                "ω = {}: {el:e} {es:e} of {amplitude:e}",
+                lin.w
+            );
+            if math == LaneMath::Exact {
+                assert_eq!(rec.sections(), srec.sections());
+            } else {
+                // Within the scalar path's own error of the closed form.
+                assert!(section_distance(rec, &srec, 30) * amplitude <= 2.0 * es.max(1e-15));
+            }
+        }
+    }
+}
+
+#[test]
+fn events_in_lanes_are_located_like_the_scalar_ones() {
+    // Crossings of x = 3e-4 (both directions) on the linear oscillator against the roots of
+    // the closed form, in lanes and on the scalar path.
+    let level = 3e-4;
+    let y0 = Vector2::new(1e-3, 0.0);
+    let omegas = [7.0, 11.0, 13.0, 17.0];
+    let tol = Tolerances::per_component(1e-9, [1e-13, 1e-11]).unwrap();
+    let ev = Event::new(Level::new(0, level).unwrap(), Direction::Either);
+    for math in [LaneMath::Exact, LaneMath::Vector] {
+        let jobs: Vec<Trajectory> = omegas
+            .iter()
+            .map(|&w| {
+                Trajectory::periods(Member::new(Linear::params(), w).unwrap(), y0, 20.0).unwrap()
+            })
+            .collect();
+        let mut recs: Vec<Record> = jobs
+            .iter()
+            .map(|j| Record::new(j.member.period()))
+            .collect();
+        let ens = Ensemble::new(tol)
+            .unwrap()
+            .with_event(ev)
+            .unwrap()
+            .with_math(math);
+        ens.run::<F64x4, _>(&jobs, &mut recs).unwrap();
+        let mut n = 0;
+        for (job, rec) in jobs.iter().zip(&recs) {
+            let lin = Linear::new(job.member.omega());
+            let mut srec = Record::new(job.member.period());
+            Simulation::new(*job.member.scalar(), Dopri5::new(tol))
+                .with_events(ev)
+                .landing_grid(job.grid)
+                .unwrap()
+                .run(0.0, y0, job.t_end, &mut srec)
+                .unwrap();
+            assert_eq!(rec.events.len(), srec.events.len());
+            for (a, b) in rec.events.iter().zip(&srec.events) {
+                // The exact crossing near the located one (bisection on the closed form).
+                let g = |t: f64| lin.x(t, y0[0], y0[1]) - level;
+                let (mut lo, mut hi) = (a.0 - 1e-6, a.0 + 1e-6);
+                assert!(g(lo) * g(hi) < 0.0);
+                for _ in 0..100 {
+                    let mid = 0.5 * (lo + hi);
+                    if g(lo) * g(mid) <= 0.0 {
+                        hi = mid;
+                    } else {
+                        lo = mid;
+                    }
+                }
+                let exact = 0.5 * (lo + hi);
+                assert!((a.0 - exact).abs() < 1e-9, "lane {} vs {exact}", a.0);
+                assert!((b.0 - exact).abs() < 1e-9, "scalar {} vs {exact}", b.0);
+                if math == LaneMath::Exact {
+                    assert_eq!(a, b);
+                }
+                n += 1;
+            }
+        }
+        assert!(n > 100, "{n}");
+    }
+}
+
+/// What a run produced: section points, events, work and end state.
+type Summary = (
+    Vec<(f64, Vector2<f64>)>,
+    Vec<(f64, f64, f64)>,
+    Stats,
+    Vector2<f64>,
+);
+
+fn summary(r: &[(Record, Stats, Vector2<f64>)]) -> Vec<Summary> {
+    r.iter()
+        .map(|(a, s, y)| (a.sections(), a.events.clone(), *s, *y))
+        .collect()
+}
+
+#[test]
+fn results_do_not_depend_on_lanes_order_or_threads() {
+    let omegas: Vec<f64> = (0..11).map(|i| 17.5 + 0.7 * i as f64).collect();
+    let jobs = paper_jobs(&omegas, 12.0);
+    let tol = tol(1e-8);
+    for math in [LaneMath::Exact, LaneMath::Vector] {
+        let base = summary(&lanes::<F64x4>(&jobs, tol, math));
+        assert_eq!(summary(&lanes::<F64x2>(&jobs, tol, math)), base);
+        assert_eq!(summary(&lanes::<F64x8>(&jobs, tol, math)), base);
+        // Reversed batch: the same per trajectory.
+        let rev: Vec<Trajectory> = jobs.iter().rev().copied().collect();
+        let mut r = summary(&lanes::<F64x4>(&rev, tol, math));
+        r.reverse();
+        assert_eq!(r, base);
+        // Threads and chunks.
+        let ens = Ensemble::new(tol)
+            .unwrap()
+            .with_event(impact())
+            .unwrap()
+            .with_math(math);
+        for (threads, chunk) in [(1, 3), (2, 4), (2, 1)] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let mut recs: Vec<Record> = jobs
+                .iter()
+                .map(|j| Record::new(j.member.period()))
+                .collect();
+            let out = pool
+                .install(|| ens.run_parallel::<F64x4, _>(&jobs, &mut recs, chunk))
+                .unwrap();
+            let got: Vec<_> = recs
+                .into_iter()
+                .zip(out)
+                .map(|(r, o)| {
+                    let o = o.unwrap();
+                    (r, o.stats, o.y)
+                })
+                .collect();
+            assert_eq!(summary(&got), base, "{threads} threads, chunk {chunk}");
+        }
+    }
+}
+
+/// Distance in units in the last place of the reference.
+fn ulps(a: f64, b: f64) -> f64 {
+    if a == b {
+        return 0.0;
+    }
+    let ulp = f64::from_bits(b.abs().to_bits() + 1) - b.abs();
+    ((a - b) / ulp).abs()
+}
+
+fn lcg(n: usize) -> impl Iterator<Item = f64> {
+    let mut s: u64 = 0x2545_f491_4f6c_dd1d;
+    (0..n).map(move |_| {
+        s = s
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (s >> 11) as f64 / (1u64 << 53) as f64
+    })
+}
+
+#[test]
+fn lane_sin_is_the_scalar_kernel_to_the_bit() {
+    let mut xs: Vec<f64> = lcg(40_000)
+        .flat_map(|u| [u * 8.0 - 4.0, (u - 0.5) * 1.1e6, u * 2e4, (u - 0.5) * 1e-8])
+        .collect();
+    xs.extend([
+        0.0,
+        -0.0,
+        1e-300,
+        1e7,
+        -3e9,
+        f64::INFINITY,
+        f64::NAN,
+        524_288.0,
+        524_288.5,
+    ]);
+    for c in xs.chunks(4) {
+        let v = F64x4::load(c);
+        let s = math::sin(v);
+        for (i, &x) in c.iter().enumerate() {
+            let want = nonsmooth::fastmath::sin_f64(x);
+            let got = s.lane(i);
+            assert!(
+                got.to_bits() == want.to_bits() || (got.is_nan() && want.is_nan()),
+                "sin({x}): {got} vs {want}"
+            );
+        }
+    }
+}
+
+#[test]
+fn vector_exp_and_ln_against_libm() {
+    let mut worst_exp: f64 = 0.0;
+    let mut worst_ln: f64 = 0.0;
+    let mut worst_ln_abs: f64 = 0.0;
+    for u in lcg(200_000).collect::<Vec<_>>().chunks(4) {
+        // exp on [−40, 40] (the controller's and the contact law's exponents).
+        let x: Vec<f64> = u.iter().map(|u| (u - 0.5) * 80.0).collect();
+        let e = math::exp(LaneMath::Vector, F64x4::load(&x));
+        for (i, &xi) in x.iter().enumerate() {
+            worst_exp = worst_exp.max(ulps(e.lane(i), xi.exp()));
+        }
+        // ln over [1e-300, 1e300] and near 1.
+        let y: Vec<f64> = u
+            .iter()
+            .enumerate()
+            .map(|(i, u)| {
+                if i % 2 == 0 {
+                    10f64.powf((u - 0.5) * 600.0)
+                } else {
+                    0.5 + u
+                }
+            })
+            .collect();
+        let l = math::ln(LaneMath::Vector, F64x4::load(&y));
+        for (i, &yi) in y.iter().enumerate() {
+            let want = yi.ln();
+            if want.abs() > 0.5 {
+                worst_ln = worst_ln.max(ulps(l.lane(i), want));
+            } else {
+                worst_ln_abs = worst_ln_abs.max((l.lane(i) - want).abs() / f64::EPSILON);
+            }
+        }
+    }
+    println!("exp {worst_exp} ulp, ln {worst_ln} ulp (|ln| > 0.5), ln near 1 {worst_ln_abs} ε abs");
+    assert!(worst_exp <= 1.0, "exp: {worst_exp} ulp");
+    assert!(worst_ln <= 1.0, "ln: {worst_ln} ulp");
+    assert!(worst_ln_abs <= 1.0, "ln near 1: {worst_ln_abs} ε");
+    // Exact mode is libm itself.
+    let x = F64x4::load(&[0.3, -7.0, 25.0, 1e-3]);
+    for i in 0..4 {
+        assert_eq!(math::exp(LaneMath::Exact, x).lane(i), x.lane(i).exp());
+    }
+}
+
+#[test]
+fn invalid_input_is_an_error() {
+    let tol = tol(1e-8);
+    let ens = Ensemble::new(tol).unwrap();
+    let m = Member::paper(20.0).unwrap();
+    assert!(Member::paper(f64::NAN).is_err());
+    assert!(Member::paper(-1.0).is_err());
+    assert!(Trajectory::new(m, 0.0, rest(), 0.0).is_err());
+    assert!(Trajectory::new(m, 0.0, Vector2::new(f64::NAN, 0.0), 1.0).is_err());
+    assert!(Trajectory::periods(m, rest(), 0.0).is_err());
+    assert!(
+        Trajectory::new(m, 0.0, rest(), 1.0)
+            .unwrap()
+            .with_grid(0.0, -1.0)
+            .is_err()
+    );
+    let jobs = paper_jobs(&[20.0, 21.0], 2.0);
+    let mut one = vec![()];
+    assert!(ens.run::<F64x4, _>(&jobs, &mut one).is_err());
+    let mut terminal = impact();
+    terminal.terminal = true;
+    assert!(Ensemble::new(tol).unwrap().with_event(terminal).is_err());
+    assert!(ens.clone().max_steps(0).is_err());
+    // A step cap too small for a trajectory fails that trajectory only.
+    let capped = ens.max_steps(50).unwrap();
+    let short = [Trajectory::new(m, 0.0, rest(), 2e-5).unwrap(), jobs[0]];
+    let mut obs = vec![(); 2];
+    let out = capped.run::<F64x4, _>(&jobs, &mut obs).unwrap();
+    assert!(out.iter().all(|o| o.is_err()));
+    let out = capped.run::<F64x4, _>(&short, &mut obs).unwrap();
+    assert!(out[0].is_ok() && out[1].is_err(), "{out:?}");
+}
