@@ -66,6 +66,8 @@ pub mod sample;
 pub mod scalar;
 mod serde_check;
 pub mod signal;
+#[cfg(feature = "cli")]
+pub mod study;
 pub mod sweep;
 pub mod systems;
 #[cfg(feature = "testing")]

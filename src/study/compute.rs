@@ -1,0 +1,284 @@
+//! The computation at one grid point, and a shard's share of them.
+
+use nalgebra::{SVector, Vector2};
+
+use super::model::{ModelKind, ParameterSet};
+use super::shard::Shard;
+use super::spec::{Study, apply_axis};
+use crate::Dynamics;
+use crate::entropy::{Histogram, QRange, entropy_index};
+use crate::integrate::{Dopri5, Tolerances};
+use crate::lyapunov::{Norm, TwoTrajectory};
+use crate::sample::Regime;
+use crate::sweep::{Stop, SweepConfig, SweepSystem, run_point};
+
+/// What one grid point gave. Every field is a function of the spec and the point index
+/// only (no shared state between points), so a point computes to the same bits in any
+/// shard, on any thread.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PointRecord {
+    /// The point index `i = ix + nx·iy`.
+    pub index: usize,
+    /// `"ok"`, or what failed (the point's other fields hold what was computed before).
+    pub status: String,
+    /// The period in forcing periods (0: no period up to the maximum tested).
+    pub period: usize,
+    /// Impacts per forcing period (NaN if the run failed).
+    pub impacts_per_period: f64,
+    /// Top Lyapunov exponent (1/time unit; NaN if not recorded).
+    pub tle: f64,
+    /// Its standard error (NaN if not recorded).
+    pub tle_spread: f64,
+    /// Entropy index `q*` of the inter-impact intervals (NaN if not recorded or not
+    /// defined, e.g. one interval value on a periodic orbit).
+    pub q: f64,
+    /// The last stroboscopic points `(x, v)` (at most the spec's `record.poincare`, at
+    /// least the period).
+    pub sections: Vec<[f64; 2]>,
+    /// The attractor fingerprint: the cells of the section tessellation visited by the
+    /// recorded points, sorted (see the [module docs](super)); empty on a grid
+    /// without an initial-condition axis, where no two points share their parameters.
+    pub cells: Vec<(i64, i64)>,
+}
+
+impl PointRecord {
+    /// A point whose run failed.
+    pub fn failed(index: usize, message: String) -> Self {
+        Self {
+            index,
+            status: message,
+            period: 0,
+            impacts_per_period: f64::NAN,
+            tle: f64::NAN,
+            tle_spread: f64::NAN,
+            q: f64::NAN,
+            sections: Vec::new(),
+            cells: Vec::new(),
+        }
+    }
+
+    /// Whether the point computed without failure.
+    pub fn is_ok(&self) -> bool {
+        self.status == "ok"
+    }
+}
+
+/// Computes grid point `index` of `study` (a failure is recorded in the point's `status`,
+/// never lost).
+pub fn compute_point(study: &Study, index: usize) -> PointRecord {
+    match try_point(study, index) {
+        Ok(r) => r,
+        Err(m) => PointRecord::failed(index, m),
+    }
+}
+
+fn try_point(study: &Study, index: usize) -> Result<PointRecord, String> {
+    let spec = study.spec();
+    if index >= study.points() {
+        return Err(format!(
+            "point {index} outside the grid of {} points",
+            study.points()
+        ));
+    }
+    let mut set = ParameterSet::new(study.kind(), &spec.system.parameters);
+    let mut y0 = spec.initial.state;
+    let (xv, yv) = study.values(index);
+    apply_axis(&mut set, &mut y0, &spec.grid.x.parameter, xv);
+    if let Some(y) = &spec.grid.y {
+        apply_axis(&mut set, &mut y0, &y.parameter, yv);
+    }
+    let e = |e: crate::Error| e.to_string();
+    match study.kind() {
+        ModelKind::Paper => {
+            let (p, omega) = set.paper().ok_or("internal: not the paper's model")?;
+            let rest = [p.static_equilibrium().map_err(e)?, 0.0];
+            let stop = Stop {
+                position: 0,
+                velocity: 1,
+                level: p.x_i,
+            };
+            run_model(
+                study,
+                index,
+                || Ok(p.oscillator::<f64>(omega)?),
+                std::f64::consts::TAU / omega,
+                Some(stop),
+                fill(y0, rest),
+            )
+        }
+        ModelKind::DuffingUeda => {
+            let d = set.duffing().ok_or("internal: not Duffing–Ueda")?;
+            run_model(
+                study,
+                index,
+                || d.model::<f64>(),
+                d.period(),
+                None,
+                fill(y0, [0.0, 0.0]),
+            )
+        }
+    }
+}
+
+/// The initial state: given components, the rest state for the others.
+fn fill(y0: Option<[f64; 2]>, rest: [f64; 2]) -> Vector2<f64> {
+    let s = y0.unwrap_or(rest);
+    let pick = |k: usize| if s[k].is_nan() { rest[k] } else { s[k] };
+    Vector2::new(pick(0), pick(1))
+}
+
+fn run_model<S, F>(
+    study: &Study,
+    index: usize,
+    make: F,
+    period: f64,
+    stop: Option<Stop>,
+    y0: Vector2<f64>,
+) -> Result<PointRecord, String>
+where
+    S: Dynamics<f64, 2>,
+    F: Fn() -> crate::Result<S>,
+{
+    let spec = study.spec();
+    let kind = study.kind();
+    let s = |e: &dyn std::fmt::Display| e.to_string();
+    let rtol = spec.integration.rtol;
+    let atol = spec.integration.atol.unwrap_or({
+        let a = kind.atol_per_rtol();
+        [a[0] * rtol, a[1] * rtol]
+    });
+    let tol = Tolerances::per_component(rtol, atol).map_err(|e| s(&e))?;
+    let cfg = SweepConfig::new(vec![0.0])
+        .and_then(|c| c.record(spec.periods.record))
+        .and_then(|c| c.period_detection(spec.record.period_tol, spec.record.max_period))
+        .map_err(|e| s(&e))?
+        .max_steps(spec.integration.max_steps);
+    let system = make().map_err(|e| s(&e))?;
+    let pt = run_point(
+        &cfg,
+        0.0,
+        SweepSystem {
+            system,
+            period,
+            stop,
+        },
+        Dopri5::new(tol),
+        y0,
+        spec.periods.transient,
+    )
+    .map_err(|e| s(&e))?;
+    let period_n = match pt.regime {
+        Regime::Periodic(p) => p,
+        Regime::NotPeriodic => 0,
+    };
+    let keep = spec.record.poincare.max(period_n).min(pt.poincare.len());
+    let sections: Vec<[f64; 2]> = pt.poincare[pt.poincare.len() - keep..]
+        .iter()
+        .map(|p| [p[0], p[1]])
+        .collect();
+    let scales = spec.attractors.scales.unwrap_or(kind.scales());
+    // Fingerprints are compared only between points of the same system parameters, which
+    // exist only on a grid with an initial-condition axis.
+    let cells = if study.has_initial_condition_axis() {
+        fingerprint(&pt.poincare, scales, spec.attractors.cell)
+    } else {
+        Vec::new()
+    };
+    let mut rec = PointRecord {
+        index,
+        status: "ok".into(),
+        period: period_n,
+        impacts_per_period: pt.impacts_per_period,
+        tle: f64::NAN,
+        tle_spread: f64::NAN,
+        q: f64::NAN,
+        sections,
+        cells,
+    };
+    if let Some(q) = &spec.record.q {
+        rec.q = Histogram::new(q.lo, q.hi, q.step)
+            .ok()
+            .and_then(|h| h.estimate(&pt.intervals).ok())
+            .and_then(|est| entropy_index(&est.probabilities, &QRange::default()).ok())
+            .map_or(f64::NAN, |i| i.q);
+    }
+    if let Some(l) = &spec.record.lyapunov {
+        let tle = (|| -> crate::Result<(f64, f64)> {
+            let norm = Norm::weighted(scales)?;
+            let d0 = l.d0.unwrap_or(kind.d0());
+            let mut est = TwoTrajectory::<f64, 2, 4, _, _>::with_tolerances(
+                make()?,
+                Dopri5::new,
+                &tol,
+                d0,
+                norm,
+            )?;
+            // The run ended after a whole number of periods: t = 0 has the same phase.
+            est.start(0.0, pt.end_state)?;
+            let e = est.estimate(period, l.periods)?;
+            Ok((e.exponent, e.spread))
+        })();
+        match tle {
+            Ok((l, sp)) => {
+                rec.tle = l;
+                rec.tle_spread = sp;
+            }
+            Err(e) => rec.status = format!("lyapunov: {e}"),
+        }
+    }
+    Ok(rec)
+}
+
+/// The most cells kept in a fingerprint.
+pub const MAX_CELLS: usize = 256;
+
+/// The cells of side `cell·scale` visited by the section points, at most [`MAX_CELLS`] of
+/// them (the most visited; ties by cell), sorted.
+fn fingerprint(points: &[SVector<f64, 2>], scales: [f64; 2], cell: f64) -> Vec<(i64, i64)> {
+    let mut all: Vec<(i64, i64)> = points
+        .iter()
+        .map(|p| {
+            // `as` saturates: a far-out point lands in an edge cell instead of wrapping.
+            (
+                (p[0] / (scales[0] * cell)).floor() as i64,
+                (p[1] / (scales[1] * cell)).floor() as i64,
+            )
+        })
+        .collect();
+    all.sort_unstable();
+    let mut counted: Vec<((i64, i64), usize)> = Vec::new();
+    for c in all {
+        match counted.last_mut() {
+            Some((last, n)) if *last == c => *n += 1,
+            _ => counted.push((c, 1)),
+        }
+    }
+    if counted.len() > MAX_CELLS {
+        counted.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
+        counted.truncate(MAX_CELLS);
+    }
+    let mut cells: Vec<(i64, i64)> = counted.into_iter().map(|(c, _)| c).collect();
+    cells.sort_unstable();
+    cells
+}
+
+/// The indices of `shard`: `i ≡ shard.index() − 1 (mod shard.count())`, ascending
+/// (round-robin spreads the costly regions of a map over all shards).
+pub fn shard_indices(total: usize, shard: Shard) -> impl Iterator<Item = usize> {
+    (shard.index() - 1..total).step_by(shard.count())
+}
+
+/// Computes the points of `shard` in parallel (rayon, in the current pool), calling
+/// `progress` after each point; returned in index order. The result does not depend on the
+/// number of threads: each point depends only on the spec and its index.
+pub fn run_shard<F: Fn() + Sync>(study: &Study, shard: Shard, progress: F) -> Vec<PointRecord> {
+    use rayon::prelude::*;
+    let idx: Vec<usize> = shard_indices(study.points(), shard).collect();
+    idx.par_iter()
+        .map(|&i| {
+            let r = compute_point(study, i);
+            progress();
+            r
+        })
+        .collect()
+}

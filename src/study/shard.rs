@@ -1,0 +1,598 @@
+//! Shards: which points a task runs, the self-describing shard files, and the verified
+//! merge.
+//!
+//! See the [study module docs](super#the-shard-files) for the file formats.
+
+use std::collections::BTreeMap;
+use std::fs;
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use super::StudyError;
+use super::compute::{PointRecord, shard_indices};
+use super::spec::{Study, StudySpec, fnv1a};
+
+/// The manifest format written and accepted.
+pub const SHARD_FORMAT: &str = "nonsmooth-study-shard/1";
+
+/// Shard `index` of `count` (1-based: `1 ≤ index ≤ count`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Shard {
+    index: usize,
+    count: usize,
+}
+
+impl Shard {
+    /// The whole study as one shard (1/1).
+    pub const WHOLE: Shard = Shard { index: 1, count: 1 };
+
+    /// Shard `index` of `count`.
+    ///
+    /// # Errors
+    /// [`StudyError::Shard`] unless `1 ≤ index ≤ count`.
+    pub fn new(index: usize, count: usize) -> Result<Self, StudyError> {
+        if count == 0 || index == 0 || index > count {
+            return Err(StudyError::Shard(format!(
+                "shard {index}/{count} out of range: need 1 <= I <= N"
+            )));
+        }
+        Ok(Self { index, count })
+    }
+
+    /// Parses `"I/N"`.
+    ///
+    /// # Errors
+    /// [`StudyError::Shard`] for another form or an out-of-range shard.
+    pub fn parse(text: &str) -> Result<Self, StudyError> {
+        let bad = || {
+            StudyError::Shard(format!(
+                "--shard {text:?}: expected I/N with integers 1 <= I <= N, e.g. 2/7"
+            ))
+        };
+        let (i, n) = text.split_once('/').ok_or_else(bad)?;
+        let i: usize = i.trim().parse().map_err(|_| bad())?;
+        let n: usize = n.trim().parse().map_err(|_| bad())?;
+        Self::new(i, n)
+    }
+
+    /// The shard of a Slurm array task, from `SLURM_ARRAY_TASK_ID`, `SLURM_ARRAY_TASK_MIN`,
+    /// `SLURM_ARRAY_TASK_MAX` and `SLURM_ARRAY_TASK_COUNT` (read through `var`): the task
+    /// at offset `ID − MIN` is shard `ID − MIN + 1` of `COUNT`. `None` outside an array.
+    /// The array must be contiguous (`MAX − MIN + 1 = COUNT`); to re-run single tasks, pass
+    /// `--shard I/N` explicitly (the script of `study plan` does).
+    ///
+    /// # Errors
+    /// [`StudyError::Shard`] for unreadable values or an array with gaps or a step.
+    pub fn from_slurm(var: impl Fn(&str) -> Option<String>) -> Result<Option<Self>, StudyError> {
+        let Some(id) = var("SLURM_ARRAY_TASK_ID") else {
+            return Ok(None);
+        };
+        let num = |name: &str| -> Result<usize, StudyError> {
+            let v = var(name).ok_or_else(|| {
+                StudyError::Shard(format!("SLURM_ARRAY_TASK_ID is set but {name} is not"))
+            })?;
+            v.trim()
+                .parse()
+                .map_err(|_| StudyError::Shard(format!("{name}={v:?} is not a number")))
+        };
+        let id: usize = id.trim().parse().map_err(|_| {
+            StudyError::Shard(format!("SLURM_ARRAY_TASK_ID={id:?} is not a number"))
+        })?;
+        let (min, max, count) = (
+            num("SLURM_ARRAY_TASK_MIN")?,
+            num("SLURM_ARRAY_TASK_MAX")?,
+            num("SLURM_ARRAY_TASK_COUNT")?,
+        );
+        if max < min || max - min + 1 != count || id < min || id > max {
+            return Err(StudyError::Shard(format!(
+                "the Slurm array {min}-{max} ({count} tasks, this one {id}) is not contiguous: \
+                 pass --shard I/N explicitly"
+            )));
+        }
+        Self::new(id - min + 1, count).map(Some)
+    }
+
+    /// `I` (1-based).
+    pub fn index(&self) -> usize {
+        self.index
+    }
+
+    /// `N`.
+    pub fn count(&self) -> usize {
+        self.count
+    }
+
+    /// The file stem `shard-IIIII-of-NNNNN`.
+    pub fn stem(&self) -> String {
+        format!("shard-{:05}-of-{:05}", self.index, self.count)
+    }
+}
+
+impl std::fmt::Display for Shard {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}/{}", self.index, self.count)
+    }
+}
+
+/// A shard's manifest (`shard-…json`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShardManifest {
+    /// [`SHARD_FORMAT`].
+    pub format: String,
+    /// The crate version that computed the shard.
+    pub crate_version: String,
+    /// The spec hash ([`StudySpec::hash`]).
+    pub spec_hash: String,
+    /// The spec.
+    pub spec: StudySpec,
+    /// `I`.
+    pub shard: usize,
+    /// `N`.
+    pub shards: usize,
+    /// Points in the whole study.
+    pub total_points: usize,
+    /// Points in this shard.
+    pub points: usize,
+    /// Points whose status is not `ok`.
+    pub failed_points: usize,
+    /// The points file name.
+    pub points_file: String,
+    /// Its FNV-1a hash (hex).
+    pub points_fnv: String,
+    /// The sections file name.
+    pub sections_file: String,
+    /// Its FNV-1a hash (hex).
+    pub sections_fnv: String,
+}
+
+/// A float in the shortest form that reads back to the same bits.
+pub(crate) fn fmt_f64(v: f64) -> String {
+    let a = v.abs();
+    if v == 0.0 || !v.is_finite() || (1e-4..1e7).contains(&a) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
+}
+
+fn io(path: &Path, e: impl std::fmt::Display) -> StudyError {
+    StudyError::Io(format!("{}: {e}", path.display()))
+}
+
+/// Writes `bytes` to `path` through a temporary file and a rename.
+fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), StudyError> {
+    let name = path
+        .file_name()
+        .and_then(|n| n.to_str())
+        .ok_or_else(|| io(path, "not a file name"))?;
+    let tmp = path.with_file_name(format!(".{name}.tmp.{}", std::process::id()));
+    fs::write(&tmp, bytes).map_err(|e| io(&tmp, e))?;
+    fs::rename(&tmp, path).map_err(|e| io(path, e))
+}
+
+pub(crate) const POINT_HEADER: [&str; 10] = [
+    "index",
+    "status",
+    "period",
+    "impacts_per_period",
+    "tle",
+    "tle_spread",
+    "q",
+    "kept_sections",
+    "cells",
+    "spec_hash",
+];
+
+fn points_csv(records: &[PointRecord], hash: &str) -> Result<Vec<u8>, StudyError> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let e = |e: csv::Error| StudyError::Io(e.to_string());
+    w.write_record(POINT_HEADER).map_err(e)?;
+    for r in records {
+        let cells: Vec<String> = r.cells.iter().map(|(a, b)| format!("{a}:{b}")).collect();
+        w.write_record([
+            r.index.to_string(),
+            r.status.clone(),
+            r.period.to_string(),
+            fmt_f64(r.impacts_per_period),
+            fmt_f64(r.tle),
+            fmt_f64(r.tle_spread),
+            fmt_f64(r.q),
+            r.sections.len().to_string(),
+            cells.join(" "),
+            hash.to_string(),
+        ])
+        .map_err(e)?;
+    }
+    w.into_inner().map_err(|e| StudyError::Io(e.to_string()))
+}
+
+fn sections_csv(records: &[PointRecord]) -> Result<Vec<u8>, StudyError> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let e = |e: csv::Error| StudyError::Io(e.to_string());
+    w.write_record(["index", "k", "x", "v"]).map_err(e)?;
+    for r in records {
+        for (k, s) in r.sections.iter().enumerate() {
+            w.write_record([
+                r.index.to_string(),
+                k.to_string(),
+                fmt_f64(s[0]),
+                fmt_f64(s[1]),
+            ])
+            .map_err(e)?;
+        }
+    }
+    w.into_inner().map_err(|e| StudyError::Io(e.to_string()))
+}
+
+/// A manifest file and what reading it gave.
+type Found = (PathBuf, Result<ShardManifest, String>);
+
+/// Manifests already in `dir`, by file.
+fn manifests(dir: &Path) -> Result<Vec<Found>, StudyError> {
+    let mut out = Vec::new();
+    let rd = match fs::read_dir(dir) {
+        Ok(rd) => rd,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(out),
+        Err(e) => return Err(io(dir, e)),
+    };
+    for entry in rd {
+        let p = entry.map_err(|e| io(dir, e))?.path();
+        let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("");
+        if name.starts_with("shard-") && name.ends_with(".json") {
+            let m = fs::read_to_string(&p)
+                .map_err(|e| e.to_string())
+                .and_then(|t| serde_json::from_str::<ShardManifest>(&t).map_err(|e| e.to_string()));
+            out.push((p, m));
+        }
+    }
+    out.sort_by(|a, b| a.0.cmp(&b.0));
+    Ok(out)
+}
+
+/// Checks that `dir` holds no shards of another study (call before a long run).
+///
+/// # Errors
+/// [`StudyError::Mismatch`] naming a shard file of another spec or crate version.
+pub fn check_output_dir(dir: &Path, study: &Study) -> Result<(), StudyError> {
+    for (p, m) in manifests(dir)? {
+        if let Ok(m) = m {
+            if m.spec_hash != study.hash() {
+                return Err(StudyError::Mismatch(format!(
+                    "{} belongs to another study (spec hash {} here, {} in the file): \
+                     use another output directory",
+                    p.display(),
+                    study.hash(),
+                    m.spec_hash
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Writes the shard files of `records` (the points of `shard`, in index order) into `dir`,
+/// atomically; returns the manifest's path.
+///
+/// # Errors
+/// [`StudyError::Shard`] if `records` are not exactly the points of `shard`;
+/// [`StudyError::Io`] if a file cannot be written.
+pub fn write_shard(
+    dir: &Path,
+    study: &Study,
+    shard: Shard,
+    records: &[PointRecord],
+) -> Result<PathBuf, StudyError> {
+    let expected: Vec<usize> = shard_indices(study.points(), shard).collect();
+    if records.len() != expected.len() || records.iter().zip(&expected).any(|(r, &i)| r.index != i)
+    {
+        return Err(StudyError::Shard(format!(
+            "records are not the {} points of shard {shard}",
+            expected.len()
+        )));
+    }
+    fs::create_dir_all(dir).map_err(|e| io(dir, e))?;
+    let stem = shard.stem();
+    let points = points_csv(records, study.hash())?;
+    let sections = sections_csv(records)?;
+    let points_file = format!("{stem}.csv");
+    let sections_file = format!("{stem}.sections.csv");
+    let manifest = ShardManifest {
+        format: SHARD_FORMAT.into(),
+        crate_version: env!("CARGO_PKG_VERSION").into(),
+        spec_hash: study.hash().into(),
+        spec: study.spec().clone(),
+        shard: shard.index(),
+        shards: shard.count(),
+        total_points: study.points(),
+        points: records.len(),
+        failed_points: records.iter().filter(|r| !r.is_ok()).count(),
+        points_fnv: format!("{:016x}", fnv1a(&points)),
+        sections_fnv: format!("{:016x}", fnv1a(&sections)),
+        points_file,
+        sections_file,
+    };
+    write_atomic(&dir.join(&manifest.points_file), &points)?;
+    write_atomic(&dir.join(&manifest.sections_file), &sections)?;
+    let json =
+        serde_json::to_string_pretty(&manifest).map_err(|e| StudyError::Io(e.to_string()))?;
+    let path = dir.join(format!("{stem}.json"));
+    write_atomic(&path, json.as_bytes())?;
+    Ok(path)
+}
+
+fn corrupt(path: &Path, what: impl std::fmt::Display) -> StudyError {
+    StudyError::Corrupt(format!("{}: {what}", path.display()))
+}
+
+fn parse_f64(path: &Path, row: usize, col: &str, s: &str) -> Result<f64, StudyError> {
+    s.parse()
+        .map_err(|_| corrupt(path, format!("row {row}: {col} = {s:?} is not a number")))
+}
+
+fn parse_usize(path: &Path, row: usize, col: &str, s: &str) -> Result<usize, StudyError> {
+    s.parse()
+        .map_err(|_| corrupt(path, format!("row {row}: {col} = {s:?} is not an integer")))
+}
+
+/// Reads one shard's points after checking its hashes.
+fn read_shard(
+    dir: &Path,
+    m: &ShardManifest,
+    manifest_path: &Path,
+) -> Result<Vec<PointRecord>, StudyError> {
+    let pp = dir.join(&m.points_file);
+    let sp = dir.join(&m.sections_file);
+    let points = fs::read(&pp).map_err(|e| {
+        StudyError::MissingShards(format!(
+            "{} (listed in {}): {e}; re-run shard {}/{}",
+            pp.display(),
+            manifest_path.display(),
+            m.shard,
+            m.shards
+        ))
+    })?;
+    let sections = fs::read(&sp).map_err(|e| {
+        StudyError::MissingShards(format!(
+            "{} (listed in {}): {e}; re-run shard {}/{}",
+            sp.display(),
+            manifest_path.display(),
+            m.shard,
+            m.shards
+        ))
+    })?;
+    for (p, bytes, want) in [
+        (&pp, &points, &m.points_fnv),
+        (&sp, &sections, &m.sections_fnv),
+    ] {
+        let got = format!("{:016x}", fnv1a(bytes));
+        if &got != want {
+            return Err(corrupt(
+                p,
+                format!(
+                    "content hash {got} differs from {want} in its manifest (truncated or \
+                     modified): re-run shard {}/{}",
+                    m.shard, m.shards
+                ),
+            ));
+        }
+    }
+    let mut rd = csv::Reader::from_reader(points.as_slice());
+    let header = rd.headers().map_err(|e| corrupt(&pp, e))?.clone();
+    if header.iter().ne(POINT_HEADER.iter().copied()) {
+        return Err(corrupt(&pp, "unexpected header"));
+    }
+    let mut records = Vec::new();
+    for (row, rec) in rd.records().enumerate() {
+        let rec = rec.map_err(|e| corrupt(&pp, e))?;
+        let f = |k: usize| rec.get(k).unwrap_or("");
+        if f(9) != m.spec_hash {
+            return Err(corrupt(
+                &pp,
+                format!("row {row}: spec hash {} differs", f(9)),
+            ));
+        }
+        let mut cells = Vec::new();
+        for c in f(8).split_whitespace() {
+            let (a, b) = c
+                .split_once(':')
+                .ok_or_else(|| corrupt(&pp, format!("row {row}: cell {c:?}")))?;
+            let a: i64 = a
+                .parse()
+                .map_err(|_| corrupt(&pp, format!("row {row}: cell {c:?}")))?;
+            let b: i64 = b
+                .parse()
+                .map_err(|_| corrupt(&pp, format!("row {row}: cell {c:?}")))?;
+            cells.push((a, b));
+        }
+        let kept = parse_usize(&pp, row, "kept_sections", f(7))?;
+        records.push((
+            PointRecord {
+                index: parse_usize(&pp, row, "index", f(0))?,
+                status: f(1).to_string(),
+                period: parse_usize(&pp, row, "period", f(2))?,
+                impacts_per_period: parse_f64(&pp, row, "impacts_per_period", f(3))?,
+                tle: parse_f64(&pp, row, "tle", f(4))?,
+                tle_spread: parse_f64(&pp, row, "tle_spread", f(5))?,
+                q: parse_f64(&pp, row, "q", f(6))?,
+                sections: Vec::with_capacity(kept),
+                cells,
+            },
+            kept,
+        ));
+    }
+    let mut pos: BTreeMap<usize, usize> = BTreeMap::new();
+    for (k, (r, _)) in records.iter().enumerate() {
+        pos.insert(r.index, k);
+    }
+    let mut rd = csv::Reader::from_reader(sections.as_slice());
+    for (row, rec) in rd.records().enumerate() {
+        let rec = rec.map_err(|e| corrupt(&sp, e))?;
+        let f = |k: usize| rec.get(k).unwrap_or("");
+        let index = parse_usize(&sp, row, "index", f(0))?;
+        let k = *pos
+            .get(&index)
+            .ok_or_else(|| corrupt(&sp, format!("row {row}: point {index} is not in the shard")))?;
+        let x = parse_f64(&sp, row, "x", f(2))?;
+        let v = parse_f64(&sp, row, "v", f(3))?;
+        records[k].0.sections.push([x, v]);
+    }
+    let mut out = Vec::with_capacity(records.len());
+    for (r, kept) in records {
+        if r.sections.len() != kept {
+            return Err(corrupt(
+                &sp,
+                format!(
+                    "point {}: {} sections, {kept} expected",
+                    r.index,
+                    r.sections.len()
+                ),
+            ));
+        }
+        out.push(r);
+    }
+    Ok(out)
+}
+
+/// Reads every shard of the study in `dir`, checks that they are complete and consistent,
+/// and returns the study and its points in index order.
+///
+/// # Errors
+/// [`StudyError::MissingShards`] if no shard, or not every shard `1..=N`, is present
+/// (naming the missing ones); [`StudyError::Mismatch`] for shards of different specs, crate
+/// versions or shard counts; [`StudyError::Corrupt`] for an unreadable manifest, a file
+/// whose content hash differs from its manifest, or a shard whose points are not exactly
+/// its share (every index must appear exactly once).
+pub fn read_shards(dir: &Path) -> Result<(Study, Vec<PointRecord>), StudyError> {
+    let all = manifests(dir)?;
+    if all.is_empty() {
+        return Err(StudyError::MissingShards(format!(
+            "no shard manifests (shard-*.json) in {}",
+            dir.display()
+        )));
+    }
+    let mut ms: Vec<(PathBuf, ShardManifest)> = Vec::new();
+    for (p, m) in all {
+        let m = m.map_err(|e| corrupt(&p, format!("unreadable manifest: {e}")))?;
+        if m.format != SHARD_FORMAT {
+            return Err(corrupt(
+                &p,
+                format!("format {:?}, expected {SHARD_FORMAT:?}", m.format),
+            ));
+        }
+        ms.push((p, m));
+    }
+    let (p0, m0) = &ms[0];
+    for (p, m) in &ms[1..] {
+        if m.crate_version != m0.crate_version {
+            return Err(StudyError::Mismatch(format!(
+                "{} was computed by nonsmooth {}, {} by {}",
+                p.display(),
+                m.crate_version,
+                p0.display(),
+                m0.crate_version
+            )));
+        }
+        if m.spec_hash != m0.spec_hash {
+            return Err(StudyError::Mismatch(format!(
+                "{} has spec hash {}, {} has {}: shards of different studies",
+                p.display(),
+                m.spec_hash,
+                p0.display(),
+                m0.spec_hash
+            )));
+        }
+        if m.shards != m0.shards {
+            return Err(StudyError::Mismatch(format!(
+                "{} is a shard of {}, {} of {}: remove the shards of the other run",
+                p.display(),
+                m.shards,
+                p0.display(),
+                m0.shards
+            )));
+        }
+    }
+    if m0.crate_version != env!("CARGO_PKG_VERSION") {
+        return Err(StudyError::Mismatch(format!(
+            "the shards were computed by nonsmooth {}, this is {}",
+            m0.crate_version,
+            env!("CARGO_PKG_VERSION")
+        )));
+    }
+    let study = Study::new(m0.spec.clone())?;
+    if study.hash() != m0.spec_hash {
+        return Err(corrupt(
+            p0,
+            format!(
+                "the embedded spec hashes to {}, the manifest says {}",
+                study.hash(),
+                m0.spec_hash
+            ),
+        ));
+    }
+    let n = m0.shards;
+    let mut by_index: BTreeMap<usize, (PathBuf, ShardManifest)> = BTreeMap::new();
+    for (p, m) in ms {
+        let shard = Shard::new(m.shard, m.shards).map_err(|e| corrupt(&p, e))?;
+        let expected_name = format!("{}.json", shard.stem());
+        if p.file_name().and_then(|f| f.to_str()) != Some(expected_name.as_str()) {
+            return Err(corrupt(
+                &p,
+                format!("describes shard {shard}, file name differs"),
+            ));
+        }
+        by_index.insert(m.shard, (p, m));
+    }
+    let missing: Vec<String> = (1..=n)
+        .filter(|i| !by_index.contains_key(i))
+        .map(|i| i.to_string())
+        .collect();
+    if !missing.is_empty() {
+        return Err(StudyError::MissingShards(format!(
+            "{} of {n} shards missing in {}: {} (run them with --shard I/{n})",
+            missing.len(),
+            dir.display(),
+            missing.join(", ")
+        )));
+    }
+    let total = study.points();
+    let mut slots: Vec<Option<PointRecord>> = vec![None; total];
+    for (i, (p, m)) in &by_index {
+        let shard = Shard::new(*i, n)?;
+        let recs = read_shard(dir, m, p)?;
+        let expected: Vec<usize> = shard_indices(total, shard).collect();
+        if recs.len() != expected.len() || recs.len() != m.points {
+            return Err(corrupt(
+                p,
+                format!(
+                    "{} points, shard {shard} of {total} points has {}",
+                    recs.len(),
+                    expected.len()
+                ),
+            ));
+        }
+        for (r, &e) in recs.into_iter().zip(&expected) {
+            if r.index != e {
+                return Err(corrupt(
+                    p,
+                    format!("point {} where point {e} was expected", r.index),
+                ));
+            }
+            let slot = slots
+                .get_mut(e)
+                .ok_or_else(|| corrupt(p, format!("point {e} outside the grid")))?;
+            if slot.is_some() {
+                return Err(corrupt(p, format!("point {e} appears twice")));
+            }
+            *slot = Some(r);
+        }
+    }
+    let mut out = Vec::with_capacity(total);
+    for (i, s) in slots.into_iter().enumerate() {
+        out.push(s.ok_or_else(|| {
+            StudyError::MissingShards(format!("point {i} is in no shard of {}", dir.display()))
+        })?);
+    }
+    Ok((study, out))
+}

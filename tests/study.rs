@@ -1,0 +1,496 @@
+//! Studies (feature `cli`): determinism over shard and thread counts, the verified merge,
+//! attractor labels, bad inputs, the command-line tool.
+
+use std::fs;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use nonsmooth::study::{
+    Merged, PlanSettings, Shard, Study, StudyError, read_shards, run_shard, run_to_dir,
+    sbatch_script, write_shard,
+};
+
+/// A fresh scratch directory for one test, removed when dropped.
+struct Scratch(PathBuf);
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        let _ = fs::remove_dir_all(&self.0);
+    }
+}
+
+impl std::ops::Deref for Scratch {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl AsRef<Path> for Scratch {
+    fn as_ref(&self) -> &Path {
+        &self.0
+    }
+}
+
+fn scratch(name: &str) -> Scratch {
+    let d = std::env::temp_dir().join(format!("nonsmooth-study-{}-{name}", std::process::id()));
+    let _ = fs::remove_dir_all(&d);
+    fs::create_dir_all(&d).unwrap();
+    Scratch(d)
+}
+
+/// A small regime map with every recorded quantity.
+const MAP: &str = r#"
+name = "map"
+[system]
+model = "paper"
+[grid]
+x = { parameter = "omega", start = 18.0, end = 24.0, points = 5 }
+y = { parameter = "amplitude_factor", start = 0.8, end = 1.2, points = 3 }
+[periods]
+transient = 40
+record = 20
+[record]
+poincare = 4
+lyapunov = { periods = 10 }
+q = { lo = 0.05, hi = 0.3, step = 0.001 }
+"#;
+
+/// A small basin picture where two attractors coexist (period 3 and the 3-impacts-per-2-
+/// periods family, see `examples/studies/paper_basin_22_73.toml`).
+const BASIN: &str = r#"
+name = "basin"
+[system]
+model = "paper"
+parameters = { omega = 22.73 }
+[grid]
+x = { parameter = "x0", start = -0.01, end = -0.0021, points = 5 }
+y = { parameter = "v0", start = -0.1, end = 0.1, points = 5 }
+[periods]
+transient = 300
+record = 40
+"#;
+
+fn run_in_shards(study: &Study, dir: &Path, n: usize) {
+    for i in 1..=n {
+        run_to_dir(study, Shard::new(i, n).unwrap(), dir, || {}).unwrap();
+    }
+}
+
+/// The merged files' bytes, in a fixed order.
+fn merged_bytes(dir: &Path) -> Vec<Vec<u8>> {
+    let out = dir.join("merged.csv");
+    let m = Merged::from_dir(dir).unwrap();
+    let files = m.write(&out).unwrap();
+    files
+        .iter()
+        .filter(|f| f.extension().is_some_and(|e| e == "csv"))
+        .map(|f| fs::read(f).unwrap())
+        .collect()
+}
+
+#[test]
+fn merged_result_is_identical_for_1_3_and_7_shards_and_any_thread_count() {
+    for (name, text) in [("map", MAP), ("basin", BASIN)] {
+        let study = Study::from_toml(text).unwrap();
+        let mut results = Vec::new();
+        for n in [1, 3, 7] {
+            let d = scratch(&format!("det-{name}-{n}"));
+            run_in_shards(&study, &d, n);
+            results.push(merged_bytes(&d));
+        }
+        assert_eq!(results[0].len(), 3);
+        assert_eq!(results[0], results[1], "{name}: 1 vs 3 shards");
+        assert_eq!(results[0], results[2], "{name}: 1 vs 7 shards");
+        // Thread counts: the whole study in pools of 1 and 2 threads.
+        let one = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap();
+        let two = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap();
+        let r1 = one.install(|| run_shard(&study, Shard::WHOLE, || {}));
+        let r2 = two.install(|| run_shard(&study, Shard::WHOLE, || {}));
+        let d1 = scratch(&format!("thr1-{name}"));
+        let d2 = scratch(&format!("thr2-{name}"));
+        write_shard(&d1, &study, Shard::WHOLE, &r1).unwrap();
+        write_shard(&d2, &study, Shard::WHOLE, &r2).unwrap();
+        assert_eq!(
+            fs::read(d1.join("shard-00001-of-00001.csv")).unwrap(),
+            fs::read(d2.join("shard-00001-of-00001.csv")).unwrap(),
+            "{name}: 1 vs 2 threads"
+        );
+        assert_eq!(merged_bytes(&d1), results[0], "{name}: threads vs shards");
+    }
+}
+
+#[test]
+fn regime_map_records_what_the_spec_asks_for() {
+    let study = Study::from_toml(MAP).unwrap();
+    let d = scratch("records");
+    run_to_dir(&study, Shard::WHOLE, &d, || {}).unwrap();
+    let (_, recs) = read_shards(&d).unwrap();
+    assert_eq!(recs.len(), 15);
+    for r in &recs {
+        assert!(r.is_ok(), "point {}: {}", r.index, r.status);
+        assert!(
+            r.tle.is_finite() && r.tle_spread.is_finite(),
+            "point {}",
+            r.index
+        );
+        assert_eq!(r.sections.len(), r.period.clamp(4, 20), "point {}", r.index);
+        // A parameter map needs no fingerprints (no two points share their parameters).
+        assert!(r.cells.is_empty());
+        assert!(r.impacts_per_period >= 0.0);
+    }
+    // Above the first grazing (ω ≈ 14) every point of this map hits the stop.
+    assert!(recs.iter().all(|r| r.impacts_per_period > 0.0));
+    // Periodic points have a negative top exponent.
+    for r in recs.iter().filter(|r| r.period > 0) {
+        assert!(
+            r.tle < 0.0,
+            "point {} period {}: λ = {}",
+            r.index,
+            r.period,
+            r.tle
+        );
+    }
+}
+
+#[test]
+fn coexisting_attractors_get_different_labels() {
+    let study = Study::from_toml(BASIN).unwrap();
+    let recs = run_shard(&study, Shard::WHOLE, || {});
+    let m = Merged::new(study, recs).unwrap();
+    assert!(
+        m.attractors.len() >= 2,
+        "attractors: {:?}",
+        m.attractors
+            .iter()
+            .map(|a| (a.period, a.impacts_per_period, a.points))
+            .collect::<Vec<_>>()
+    );
+    for r in &m.records {
+        assert!(!r.cells.is_empty() && r.cells.len() <= nonsmooth::study::MAX_CELLS);
+        assert!(r.cells.windows(2).all(|w| w[0] < w[1]), "sorted, unique");
+    }
+    // Every point is labelled; the fractions add up to one.
+    assert!(m.labels.iter().all(Option::is_some));
+    let total: f64 = m.attractors.iter().map(|a| a.fraction).sum();
+    assert!((total - 1.0).abs() < 1e-12);
+    // Points with the same label have the same impacts per period (same attractor), and
+    // the period-3 orbit with 4 impacts is among them.
+    for (r, l) in m.records.iter().zip(&m.labels) {
+        let a = &m.attractors[l.unwrap()];
+        if r.period > 0 && a.period == r.period {
+            assert!((r.impacts_per_period - a.impacts_per_period).abs() < 1e-9);
+        }
+    }
+    assert!(
+        m.attractors
+            .iter()
+            .any(|a| a.period == 3 && (a.impacts_per_period * 3.0 - 4.0).abs() < 1e-9)
+    );
+}
+
+fn expect_spec_error(text: &str, field: &str) {
+    match Study::from_toml(text) {
+        Err(StudyError::InvalidSpec { field: f, .. }) => assert_eq!(f, field, "{text}"),
+        Err(StudyError::Toml(m)) => assert!(m.contains(field), "{m} does not name {field}"),
+        other => panic!("expected an error naming {field}, got {other:?}"),
+    }
+}
+
+#[test]
+fn bad_specs_name_the_field() {
+    expect_spec_error(
+        &MAP.replace("parameter = \"omega\"", "parameter = \"omegaa\""),
+        "grid.x.parameter",
+    );
+    expect_spec_error(
+        &BASIN.replace("omega = 22.73", "omega = 22.73, stiffness = 3.0"),
+        "system.parameters.stiffness",
+    );
+    expect_spec_error(&MAP.replace("points = 5", "points = 0"), "grid.x.points");
+    expect_spec_error(&MAP.replace("record = 20", "record = 0"), "periods.record");
+    expect_spec_error(&MAP.replace("record = 20", "recrd = 20"), "recrd");
+    expect_spec_error(
+        &MAP.replace("model = \"paper\"", "model = \"cart\""),
+        "system.model",
+    );
+    expect_spec_error(&MAP.replace("end = 24.0", "end = 17.0"), "grid.x.end");
+    expect_spec_error(
+        &MAP.replace("parameter = \"amplitude_factor\"", "parameter = \"omega\""),
+        "grid.y.parameter",
+    );
+    expect_spec_error(&MAP.replace("start = 0.8", "start = -2.0"), "grid.y");
+    expect_spec_error(
+        &MAP.replace("lyapunov = { periods = 10 }", "lyapunov = { periods = 3 }"),
+        "record.lyapunov.periods",
+    );
+    expect_spec_error(
+        &BASIN.replace("parameters = { omega = 22.73 }", ""),
+        "system.parameters.omega",
+    );
+    expect_spec_error("name = \"x\"", "system");
+}
+
+#[test]
+fn bad_shards_are_rejected() {
+    for bad in ["0/3", "4/3", "1/0", "x/3", "3", "1/2/3", "-1/3"] {
+        assert!(
+            matches!(Shard::parse(bad), Err(StudyError::Shard(_))),
+            "{bad}"
+        );
+    }
+    assert_eq!(Shard::parse("2/7").unwrap(), Shard::new(2, 7).unwrap());
+    // More shards than points.
+    let study = Study::from_toml(MAP).unwrap();
+    let d = scratch("too-many");
+    assert!(matches!(
+        run_to_dir(&study, Shard::new(1, 16).unwrap(), &d, || {}),
+        Err(StudyError::Shard(_))
+    ));
+    // Slurm array variables.
+    let env = |id: &'static str, min: &'static str, max: &'static str, count: &'static str| {
+        move |k: &str| -> Option<String> {
+            match k {
+                "SLURM_ARRAY_TASK_ID" => Some(id.into()),
+                "SLURM_ARRAY_TASK_MIN" => Some(min.into()),
+                "SLURM_ARRAY_TASK_MAX" => Some(max.into()),
+                "SLURM_ARRAY_TASK_COUNT" => Some(count.into()),
+                _ => None,
+            }
+        }
+    };
+    assert_eq!(
+        Shard::from_slurm(env("0", "0", "2", "3")).unwrap(),
+        Some(Shard::new(1, 3).unwrap())
+    );
+    assert_eq!(
+        Shard::from_slurm(env("7", "5", "7", "3")).unwrap(),
+        Some(Shard::new(3, 3).unwrap())
+    );
+    assert!(Shard::from_slurm(env("4", "0", "8", "3")).is_err()); // a stepped array
+    assert!(Shard::from_slurm(env("a", "0", "2", "3")).is_err());
+    assert_eq!(Shard::from_slurm(|_| None).unwrap(), None);
+}
+
+#[test]
+fn merge_refuses_missing_mismatched_and_corrupt_shards() {
+    let study = Study::from_toml(MAP).unwrap();
+    let d = scratch("merge-errors");
+    // Nothing there.
+    assert!(matches!(
+        Merged::from_dir(&d),
+        Err(StudyError::MissingShards(_))
+    ));
+    run_to_dir(&study, Shard::new(1, 3).unwrap(), &d, || {}).unwrap();
+    run_to_dir(&study, Shard::new(3, 3).unwrap(), &d, || {}).unwrap();
+    match Merged::from_dir(&d) {
+        Err(StudyError::MissingShards(m)) => assert!(m.contains(": 2 "), "{m}"),
+        other => panic!("{other:?}"),
+    }
+    run_to_dir(&study, Shard::new(2, 3).unwrap(), &d, || {}).unwrap();
+    let good = merged_bytes(&d);
+    // A re-run replaces its shard: nothing lost or counted twice.
+    run_to_dir(&study, Shard::new(2, 3).unwrap(), &d, || {}).unwrap();
+    assert_eq!(merged_bytes(&d), good);
+
+    // A corrupt points file (one byte changed) and a truncated sections file.
+    let p = d.join("shard-00002-of-00003.csv");
+    let orig = fs::read(&p).unwrap();
+    let mut bad = orig.clone();
+    let k = bad.iter().rposition(|&b| b == b'.').unwrap();
+    bad[k + 1] = if bad[k + 1] == b'1' { b'2' } else { b'1' };
+    fs::write(&p, &bad).unwrap();
+    assert!(matches!(Merged::from_dir(&d), Err(StudyError::Corrupt(_))));
+    fs::write(&p, &orig).unwrap();
+    let s = d.join("shard-00001-of-00003.sections.csv");
+    let orig_s = fs::read(&s).unwrap();
+    fs::write(&s, &orig_s[..orig_s.len() / 2]).unwrap();
+    assert!(matches!(Merged::from_dir(&d), Err(StudyError::Corrupt(_))));
+    fs::write(&s, &orig_s).unwrap();
+    // A corrupt manifest.
+    let j = d.join("shard-00003-of-00003.json");
+    let orig_j = fs::read(&j).unwrap();
+    fs::write(&j, b"{ not json").unwrap();
+    assert!(matches!(Merged::from_dir(&d), Err(StudyError::Corrupt(_))));
+    fs::write(&j, &orig_j).unwrap();
+    // A missing data file.
+    fs::remove_file(&s).unwrap();
+    assert!(matches!(
+        Merged::from_dir(&d),
+        Err(StudyError::MissingShards(_))
+    ));
+    fs::write(&s, &orig_s).unwrap();
+    assert_eq!(merged_bytes(&d), good);
+
+    // A shard of another run (other shard count) in the same directory.
+    run_to_dir(&study, Shard::new(1, 2).unwrap(), &d, || {}).unwrap();
+    assert!(matches!(Merged::from_dir(&d), Err(StudyError::Mismatch(_))));
+    fs::remove_file(d.join("shard-00001-of-00002.json")).unwrap();
+    assert_eq!(merged_bytes(&d), good);
+
+    // A shard of another study: refused when running into the directory, and at merge.
+    let other = Study::from_toml(&MAP.replace("record = 20", "record = 21")).unwrap();
+    assert_ne!(other.hash(), study.hash());
+    assert!(matches!(
+        run_to_dir(&other, Shard::new(1, 3).unwrap(), &d, || {}),
+        Err(StudyError::Mismatch(_))
+    ));
+    let e = scratch("merge-other");
+    run_to_dir(&other, Shard::new(1, 3).unwrap(), &e, || {}).unwrap();
+    fs::copy(
+        e.join("shard-00001-of-00003.json"),
+        d.join("shard-00001-of-00003.json"),
+    )
+    .unwrap();
+    assert!(matches!(Merged::from_dir(&d), Err(StudyError::Mismatch(_))));
+}
+
+#[test]
+fn spec_hash_is_stable_and_layout_independent() {
+    let a = Study::from_toml(MAP).unwrap();
+    // Same study, other layout and explicit defaults.
+    let b = Study::from_toml(&MAP.replace(
+        "[periods]",
+        "[integration]\nrtol = 1e-8\nmax_steps = 10000000\n[periods]",
+    ))
+    .unwrap();
+    assert_eq!(a.hash(), b.hash());
+    assert_eq!(a.hash().len(), 16);
+    // Any change of substance changes it.
+    let c = Study::from_toml(&MAP.replace("end = 24.0", "end = 24.5")).unwrap();
+    assert_ne!(a.hash(), c.hash());
+}
+
+#[test]
+fn plan_prints_an_array_script() {
+    let study = Study::from_toml(MAP).unwrap();
+    let s = sbatch_script(
+        &study,
+        Path::new("/data/map.toml"),
+        &PlanSettings::new(5, "/data/out", "/opt/nonsmooth").cpus(4),
+    )
+    .unwrap();
+    assert!(s.starts_with("#!/bin/bash\n"));
+    assert!(s.contains("#SBATCH --array=1-5\n"));
+    assert!(s.contains("#SBATCH --cpus-per-task=4\n"));
+    assert!(s.contains("--shard \"${SLURM_ARRAY_TASK_ID}/5\""));
+    assert!(s.contains("'/data/map.toml'"));
+    assert!(
+        sbatch_script(
+            &study,
+            Path::new("m.toml"),
+            &PlanSettings::new(16, "o", "p")
+        )
+        .is_err()
+    );
+    assert!(sbatch_script(&study, Path::new("m.toml"), &PlanSettings::new(0, "o", "p")).is_err());
+}
+
+#[test]
+fn command_line_runs_merges_and_reports_errors() {
+    let exe = env!("CARGO_BIN_EXE_nonsmooth");
+    let d = scratch("cli");
+    let spec = d.join("map.toml");
+    fs::write(&spec, MAP.replace("lyapunov = { periods = 10 }", "")).unwrap();
+    let out = d.join("shards");
+    for i in 1..=2 {
+        let st = Command::new(exe)
+            .args(["study", "run"])
+            .arg(&spec)
+            .arg("--out")
+            .arg(&out)
+            .args(["--shard", &format!("{i}/2"), "--threads", "1", "--quiet"])
+            .env_remove("SLURM_ARRAY_TASK_ID")
+            .status()
+            .unwrap();
+        assert!(st.success());
+    }
+    let table = d.join("merged/map.csv");
+    let st = Command::new(exe)
+        .args(["study", "merge"])
+        .arg(&out)
+        .arg("--out")
+        .arg(&table)
+        .status()
+        .unwrap();
+    assert!(st.success());
+    let text = fs::read_to_string(&table).unwrap();
+    assert_eq!(text.lines().count(), 16);
+    assert!(text.starts_with("index,ix,iy,omega,amplitude_factor,"));
+    assert!(d.join("merged/map.png").exists());
+    assert!(d.join("merged/map.attractors.csv").exists());
+    // Errors: a shard out of range, a missing shard, an unknown command.
+    let o = Command::new(exe)
+        .args(["study", "run"])
+        .arg(&spec)
+        .arg("--out")
+        .arg(&out)
+        .args(["--shard", "3/2"])
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("out of range"));
+    fs::remove_file(out.join("shard-00002-of-00002.json")).unwrap();
+    let o = Command::new(exe)
+        .args(["study", "merge"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("missing"));
+    let o = Command::new(exe)
+        .args(["study", "frobnicate"])
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    // plan prints a script.
+    let o = Command::new(exe)
+        .args(["study", "plan"])
+        .arg(&spec)
+        .args(["--shards", "3", "--out"])
+        .arg(d.join("planned"))
+        .output()
+        .unwrap();
+    assert!(o.status.success());
+    assert!(String::from_utf8_lossy(&o.stdout).contains("#SBATCH --array=1-3"));
+}
+
+#[test]
+fn duffing_ueda_study_runs_without_a_stop() {
+    let text = r#"
+name = "ueda"
+[system]
+model = "duffing_ueda"
+[grid]
+x = { parameter = "x0", start = -2.0, end = 2.0, points = 3 }
+[periods]
+transient = 20
+record = 20
+[record]
+lyapunov = { periods = 10 }
+q = { lo = 0.1, hi = 1.0, step = 0.01 }
+"#;
+    let study = Study::from_toml(text).unwrap();
+    let recs = run_shard(&study, Shard::WHOLE, || {});
+    assert_eq!(recs.len(), 3);
+    for r in &recs {
+        assert!(r.is_ok(), "{}", r.status);
+        // No stop: no impacts, no intervals, no entropy index.
+        assert_eq!(r.impacts_per_period, 0.0);
+        assert!(r.q.is_nan());
+        assert!(r.tle.is_finite());
+    }
+    // The initial condition axis changes the start: the first sections differ.
+    assert_ne!(recs[0].sections, recs[2].sections);
+    // A parameter of the paper's model is unknown here.
+    expect_spec_error(
+        &text.replace("[periods]", "[system.parameters]\nx_i = 0.1\n[periods]"),
+        "system.parameters.x_i",
+    );
+}
