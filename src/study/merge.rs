@@ -7,7 +7,7 @@ use plotters::prelude::*;
 use super::StudyError;
 use super::attractor::{AttractorSummary, identify, regime_class};
 use super::compute::PointRecord;
-use super::shard::{fmt_f64, read_shards};
+use super::shard::{fmt_f64, read_shards, sections_csv};
 use super::spec::Study;
 
 /// A merged study.
@@ -127,28 +127,11 @@ impl Merged {
         std::fs::write(out, self.table()?).map_err(|e| io(out, &e))?;
         written.push(out.to_path_buf());
 
-        let mut w = csv::Writer::from_writer(Vec::new());
-        let ce = |e: csv::Error| StudyError::Io(e.to_string());
-        w.write_record(["index", "k", "x", "v"]).map_err(ce)?;
-        for r in &self.records {
-            for (k, s) in r.sections.iter().enumerate() {
-                w.write_record([
-                    r.index.to_string(),
-                    k.to_string(),
-                    fmt_f64(s[0]),
-                    fmt_f64(s[1]),
-                ])
-                .map_err(ce)?;
-            }
-        }
         let p = side(".sections.csv");
-        std::fs::write(
-            &p,
-            w.into_inner().map_err(|e| StudyError::Io(e.to_string()))?,
-        )
-        .map_err(|e| io(&p, &e))?;
+        std::fs::write(&p, sections_csv(&self.records)?).map_err(|e| io(&p, &e))?;
         written.push(p);
 
+        let ce = |e: csv::Error| StudyError::Io(e.to_string());
         let mut w = csv::Writer::from_writer(Vec::new());
         w.write_record([
             "group_ix",

@@ -208,7 +208,7 @@ fn points_csv(records: &[PointRecord], hash: &str) -> Result<Vec<u8>, StudyError
     w.into_inner().map_err(|e| StudyError::Io(e.to_string()))
 }
 
-fn sections_csv(records: &[PointRecord]) -> Result<Vec<u8>, StudyError> {
+pub(super) fn sections_csv(records: &[PointRecord]) -> Result<Vec<u8>, StudyError> {
     let mut w = csv::Writer::from_writer(Vec::new());
     let e = |e: csv::Error| StudyError::Io(e.to_string());
     w.write_record(["index", "k", "x", "v"]).map_err(e)?;
