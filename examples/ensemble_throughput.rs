@@ -13,14 +13,20 @@
 //! ```sh
 //! cargo run --release --example ensemble_throughput            # 64 × 200 periods
 //! cargo run --release --example ensemble_throughput -- --quick # 16 × 100 periods
-//! RUSTFLAGS="-C target-cpu=native" cargo run --release --example ensemble_throughput
+//! cargo run --release --example ensemble_throughput -- --simd avx2  # cap the dispatch
 //! ```
+//!
+//! The lane loop is compiled for the baseline, AVX2+FMA and AVX-512F and picked at run time
+//! (`ensemble::Simd`), so the default build runs at the machine's width; `--simd baseline`
+//! shows the build's own target alone.
 
 use std::time::Instant;
 
 use nalgebra::Vector2;
 use nonsmooth::drive::{Control, EventRecord, Observer, Simulation, StepView};
-use nonsmooth::ensemble::{Ensemble, F64x2, F64x4, F64x8, LaneMath, Lanes, Member, Trajectory};
+use nonsmooth::ensemble::{
+    Ensemble, F64x2, F64x4, F64x8, LaneMath, Lanes, Member, Simd, Trajectory,
+};
 use nonsmooth::event::{Direction, Event, Stop};
 use nonsmooth::integrate::{DenseOutput, Dopri5, Tolerances};
 use nonsmooth::model::paper::PAPER;
@@ -49,7 +55,20 @@ impl Observer<f64, 2> for Collect {
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let quick = std::env::args().any(|a| a == "--quick");
+    let args: Vec<String> = std::env::args().collect();
+    let quick = args.iter().any(|a| a == "--quick");
+    // `--simd baseline|avx2|avx512` caps the run-time dispatch (default: the widest).
+    let simd = match args
+        .iter()
+        .position(|a| a == "--simd")
+        .and_then(|i| args.get(i + 1))
+        .map(String::as_str)
+    {
+        Some("baseline") => Simd::Baseline,
+        Some("avx2") => Simd::Avx2,
+        Some("avx512") => Simd::Avx512,
+        _ => Simd::Auto,
+    };
     let (n, periods) = if quick { (16, 100.0) } else { (64, 200.0) };
     let rtol = 1e-8;
     let tol = Tolerances::per_component(rtol, [rtol * 1e-4, rtol * 1e-2])?;
@@ -86,6 +105,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         cfg!(target_feature = "fma"),
         cfg!(target_feature = "avx512f")
     );
+    println!("lane loop dispatched at run time to: {:?}", simd.resolve());
 
     // The scalar path.
     let mut scalar_obs = observers();
@@ -104,7 +124,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         scalar_s * 1e9 / evals as f64
     );
 
-    let ensemble = Ensemble::new(tol)?.with_event(impact)?;
+    let ensemble = Ensemble::new(tol)?.with_event(impact)?.with_simd(simd);
     let mut best = (0.0f64, String::new());
     let mut run = |name: &str,
                    f: &dyn Fn(&mut [Collect]) -> nonsmooth::Result<()>|

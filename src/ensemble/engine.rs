@@ -2,9 +2,9 @@
 
 use nalgebra::SVector;
 
-use super::Lanes;
 use super::math::{LaneMath, exp, ln};
 use super::model::{Member, Packed, scalar_rhs};
+use super::{Lanes, Simd};
 use crate::drive::{Control, EventRecord, Observer, Outcome, StepView, Termination};
 use crate::error::{ParameterError, Result};
 use crate::event::{Direction, Event, EventError, EventFunction, EventHistory, ZenoGuard, locate};
@@ -78,6 +78,7 @@ pub struct Ensemble<G = crate::event::Level<f64>> {
     tol: Tolerances<f64, 2>,
     opts: StepOptions<f64>,
     math: LaneMath,
+    simd: Simd,
     max_steps: usize,
     event_tol: f64,
     zeno: ZenoGuard<f64>,
@@ -97,6 +98,7 @@ impl Ensemble {
             tol,
             opts: StepOptions::default(),
             math: LaneMath::Exact,
+            simd: Simd::Auto,
             max_steps: 100_000_000,
             event_tol: 1e-12,
             zeno: ZenoGuard::default(),
@@ -134,6 +136,7 @@ impl<G: EventFunction<f64, 2>> Ensemble<G> {
             tol: self.tol,
             opts: self.opts,
             math: self.math,
+            simd: self.simd,
             max_steps: self.max_steps,
             event_tol: self.event_tol,
             zeno: self.zeno,
@@ -145,6 +148,18 @@ impl<G: EventFunction<f64, 2>> Ensemble<G> {
     pub fn with_math(mut self, math: LaneMath) -> Self {
         self.math = math;
         self
+    }
+
+    /// Sets the instruction set of the lane loop (default [`Simd::Auto`]; the results do
+    /// not depend on it, bit for bit).
+    pub fn with_simd(mut self, simd: Simd) -> Self {
+        self.simd = simd;
+        self
+    }
+
+    /// The requested instruction set ([`Simd::resolve`] gives the one that runs).
+    pub fn simd(&self) -> Simd {
+        self.simd
     }
 
     /// Sets the step options.
@@ -316,6 +331,26 @@ impl Slot {
             history: EventHistory::new(),
             stats: Stats::default(),
         }
+    }
+}
+
+/// One run of the lane loop, handed to `pulp` to be compiled per instruction set.
+#[cfg(target_arch = "x86_64")]
+struct LaneLoop<'e, 'a, 'o, V: Lanes, G, O> {
+    engine: &'e mut Engine<'a, V, G>,
+    observers: &'o mut [O],
+    out: &'o mut [Option<Result<Outcome<f64, 2>>>],
+}
+
+#[cfg(target_arch = "x86_64")]
+impl<V: Lanes, G: EventFunction<f64, 2>, O: Observer<f64, 2>> pulp::WithSimd
+    for LaneLoop<'_, '_, '_, V, G, O>
+{
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) {
+        self.engine.run_lanes(self.observers, self.out)
     }
 }
 
@@ -527,7 +562,45 @@ impl<'a, V: Lanes, G: EventFunction<f64, 2>> Engine<'a, V, G> {
         self.fill(i, observers, out);
     }
 
+    /// The lane loop, compiled for the instruction set chosen at run time (see
+    /// [`Simd`]): the same operations in the same order on every path. The AVX2 and
+    /// AVX-512 variants are `pulp`'s `V3`/`V4` tokens (created only where the CPU has the
+    /// features), which run the inlined loop compiled with those target features, in safe code.
     fn run<O: Observer<f64, 2>>(
+        &mut self,
+        observers: &mut [O],
+        out: &mut [Option<Result<Outcome<f64, 2>>>],
+    ) {
+        #[cfg(target_arch = "x86_64")]
+        match self.cfg.simd.resolve() {
+            Simd::Avx512 => {
+                if let Some(v4) = pulp::x86::V4::try_new() {
+                    let job = LaneLoop {
+                        engine: self,
+                        observers,
+                        out,
+                    };
+                    return pulp::Simd::vectorize(v4, job);
+                }
+            }
+            Simd::Avx2 => {
+                if let Some(v3) = pulp::x86::V3::try_new() {
+                    let job = LaneLoop {
+                        engine: self,
+                        observers,
+                        out,
+                    };
+                    return pulp::Simd::vectorize(v3, job);
+                }
+            }
+            _ => {}
+        }
+        self.run_lanes(observers, out)
+    }
+
+    /// The lane loop (inlined into each instruction-set variant of [`run`](Self::run)).
+    #[inline(always)]
+    fn run_lanes<O: Observer<f64, 2>>(
         &mut self,
         observers: &mut [O],
         out: &mut [Option<Result<Outcome<f64, 2>>>],

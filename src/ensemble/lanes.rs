@@ -1,5 +1,4 @@
-//! The lane vector: `L` values of `f64` in one SIMD register (or a few), from the `wide`
-//! crate.
+//! The lane vector: `L` values of `f64` in one SIMD register (or a few).
 
 use core::fmt::Debug;
 use core::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
@@ -8,15 +7,14 @@ mod sealed {
     pub trait Sealed {}
 }
 
-/// `L` lanes of `f64`: [`wide::f64x2`], [`wide::f64x4`] (the default, [`F64x4`]) and
-/// [`wide::f64x8`].
+/// `L` lanes of `f64`: [`F64x2`], [`F64x4`] (the default) and [`F64x8`].
 ///
 /// Every operation acts lane by lane; comparisons return a *mask* of the same type (all
-/// bits set where true, zero where false), which [`Lanes::select`] consumes. The `wide`
-/// types compile to one register per vector where the target has one (`f64x4` on AVX,
-/// `f64x8` on AVX-512F), and to pairs of narrower registers (SSE2 on any x86-64)
-/// otherwise: `RUSTFLAGS="-C target-cpu=native"` picks the widest the machine has. The
-/// trait is sealed: the engine relies on each operation being lane-wise and IEEE-exact.
+/// bits set where true, zero where false), which [`Lanes::select`] consumes. The types
+/// compile to one register per vector where the instruction set in use has one (`F64x4`
+/// on AVX2, `F64x8` on AVX-512F), and to pairs of narrower registers otherwise; the
+/// ensemble picks the instruction set at run time ([`Simd`](super::Simd)). The trait is
+/// sealed: the engine relies on each operation being lane-wise and IEEE-exact.
 pub trait Lanes:
     Copy
     + Send
@@ -74,14 +72,117 @@ pub trait Lanes:
     fn ln_poly(self) -> Self;
 }
 
-macro_rules! lanes_impl {
-    ($t:ty, $n:expr) => {
-        impl sealed::Sealed for $t {}
-        impl Lanes for $t {
+macro_rules! lanes_type {
+    ($name:ident, $n:expr, $align:literal, $wide:ty, $doc:literal) => {
+        #[doc = $doc]
+        ///
+        /// A plain array of `f64` whose operations are lane-wise loops: the compiler turns
+        /// them into the vector instructions of the code they are inlined into, so the
+        /// ensemble's lane loop, compiled once per instruction set
+        /// ([`Simd`](super::Simd)), runs on SSE2, AVX2 or AVX-512 registers from the
+        /// same source. Every operation is the IEEE operation of each lane.
+        #[derive(Clone, Copy, Debug, PartialEq, Default)]
+        #[repr(C, align($align))]
+        pub struct $name([f64; $n]);
+
+        impl $name {
+            #[inline(always)]
+            fn zip(self, o: Self, f: impl Fn(f64, f64) -> f64) -> Self {
+                let mut r = [0.0; $n];
+                for i in 0..$n {
+                    r[i] = f(self.0[i], o.0[i]);
+                }
+                Self(r)
+            }
+            #[inline(always)]
+            fn map(self, f: impl Fn(f64) -> f64) -> Self {
+                let mut r = [0.0; $n];
+                for i in 0..$n {
+                    r[i] = f(self.0[i]);
+                }
+                Self(r)
+            }
+            #[inline(always)]
+            fn bitwise(self, o: Self, f: impl Fn(u64, u64) -> u64) -> Self {
+                self.zip(o, |a, b| f64::from_bits(f(a.to_bits(), b.to_bits())))
+            }
+            #[inline(always)]
+            fn cmp(self, o: Self, f: impl Fn(f64, f64) -> bool) -> Self {
+                self.zip(o, |a, b| f64::from_bits((f(a, b) as u64).wrapping_neg()))
+            }
+            #[inline(always)]
+            fn wide(self) -> $wide {
+                <$wide>::new(self.0)
+            }
+            #[inline(always)]
+            fn from_wide(w: $wide) -> Self {
+                Self(w.to_array())
+            }
+        }
+
+        impl Add for $name {
+            type Output = Self;
+            #[inline(always)]
+            fn add(self, o: Self) -> Self {
+                self.zip(o, |a, b| a + b)
+            }
+        }
+        impl Sub for $name {
+            type Output = Self;
+            #[inline(always)]
+            fn sub(self, o: Self) -> Self {
+                self.zip(o, |a, b| a - b)
+            }
+        }
+        impl Mul for $name {
+            type Output = Self;
+            #[inline(always)]
+            fn mul(self, o: Self) -> Self {
+                self.zip(o, |a, b| a * b)
+            }
+        }
+        impl Div for $name {
+            type Output = Self;
+            #[inline(always)]
+            fn div(self, o: Self) -> Self {
+                self.zip(o, |a, b| a / b)
+            }
+        }
+        impl Neg for $name {
+            type Output = Self;
+            #[inline(always)]
+            fn neg(self) -> Self {
+                self.map(|a| -a)
+            }
+        }
+        impl BitAnd for $name {
+            type Output = Self;
+            #[inline(always)]
+            fn bitand(self, o: Self) -> Self {
+                self.bitwise(o, |a, b| a & b)
+            }
+        }
+        impl BitOr for $name {
+            type Output = Self;
+            #[inline(always)]
+            fn bitor(self, o: Self) -> Self {
+                self.bitwise(o, |a, b| a | b)
+            }
+        }
+        impl Not for $name {
+            type Output = Self;
+            #[inline(always)]
+            fn not(self) -> Self {
+                self.map(|a| f64::from_bits(!a.to_bits()))
+            }
+        }
+
+        impl sealed::Sealed for $name {}
+        impl Lanes for $name {
             const LANES: usize = $n;
             #[inline(always)]
             fn splat(x: f64) -> Self {
-                <$t>::splat(x)
+                Self([x; $n])
             }
             #[inline(always)]
             fn load(src: &[f64]) -> Self {
@@ -89,93 +190,102 @@ macro_rules! lanes_impl {
                 for (d, s) in a.iter_mut().zip(src) {
                     *d = *s;
                 }
-                <$t>::new(a)
+                Self(a)
             }
             #[inline(always)]
             fn store(self, dst: &mut [f64]) {
-                for (d, s) in dst.iter_mut().zip(self.to_array()) {
+                for (d, s) in dst.iter_mut().zip(self.0) {
                     *d = s;
                 }
             }
             #[inline(always)]
             fn lane(self, i: usize) -> f64 {
-                self.to_array().get(i).copied().unwrap_or(0.0)
+                self.0.get(i).copied().unwrap_or(0.0)
             }
             #[inline(always)]
-            fn with_lane(self, i: usize, x: f64) -> Self {
-                let mut a = self.to_array();
-                if let Some(v) = a.get_mut(i) {
+            fn with_lane(mut self, i: usize, x: f64) -> Self {
+                if let Some(v) = self.0.get_mut(i) {
                     *v = x;
                 }
-                <$t>::new(a)
+                self
             }
             #[inline(always)]
             fn sqrt(self) -> Self {
-                <$t>::sqrt(self)
+                self.map(f64::sqrt)
             }
             #[inline(always)]
             fn abs(self) -> Self {
-                <$t>::abs(self)
+                self.map(f64::abs)
             }
             #[inline(always)]
             fn max(self, o: Self) -> Self {
-                <$t>::max(self, o)
+                // x86's `maxpd`: `a > b ? a : b`, and `a` where `b` is NaN (`wide`'s rule).
+                self.zip(o, |a, b| if b.is_nan() || a > b { a } else { b })
             }
             #[inline(always)]
             fn min(self, o: Self) -> Self {
-                <$t>::min(self, o)
+                self.zip(o, |a, b| if b.is_nan() || a < b { a } else { b })
             }
             #[inline(always)]
             fn gt(self, o: Self) -> Self {
-                self.simd_gt(o)
+                self.cmp(o, |a, b| a > b)
             }
             #[inline(always)]
             fn ge(self, o: Self) -> Self {
-                self.simd_ge(o)
+                self.cmp(o, |a, b| a >= b)
             }
             #[inline(always)]
             fn lt(self, o: Self) -> Self {
-                self.simd_lt(o)
+                self.cmp(o, |a, b| a < b)
             }
             #[inline(always)]
             fn le(self, o: Self) -> Self {
-                self.simd_le(o)
+                self.cmp(o, |a, b| a <= b)
             }
             #[inline(always)]
             fn eq(self, o: Self) -> Self {
-                self.simd_eq(o)
+                self.cmp(o, |a, b| a == b)
             }
             #[inline(always)]
             fn finite(self) -> Self {
-                self.is_finite()
+                self.cmp(self, |a, _| a.is_finite())
             }
             #[inline(always)]
             fn select(self, a: Self, b: Self) -> Self {
-                <$t>::select(self, a, b)
+                (self & a) | (!self & b)
             }
             #[inline(always)]
             fn bits(self) -> u32 {
-                self.to_bitmask()
+                let mut r = 0u32;
+                for i in 0..$n {
+                    r |= ((self.0[i].to_bits() >> 63) as u32) << i;
+                }
+                r
             }
             #[inline(always)]
             fn exp_poly(self) -> Self {
-                <$t>::exp(self)
+                Self::from_wide(self.wide().exp())
             }
             #[inline(always)]
             fn ln_poly(self) -> Self {
-                <$t>::ln(self)
+                Self::from_wide(self.wide().ln())
             }
         }
     };
 }
 
-lanes_impl!(wide::f64x2, 2);
-lanes_impl!(wide::f64x4, 4);
-lanes_impl!(wide::f64x8, 8);
-
-/// Four lanes: the default width (one AVX register, two SSE2 registers).
-pub type F64x4 = wide::f64x4;
-/// Two lanes (one SSE2 register).
-pub type F64x2 = wide::f64x2;
-/// Eight lanes (one AVX-512 register with `target-cpu` support, else two or four).
-pub type F64x8 = wide::f64x8;
+lanes_type!(F64x2, 2, 16, wide::f64x2, "Two lanes (one SSE2 register).");
+lanes_type!(
+    F64x4,
+    4,
+    32,
+    wide::f64x4,
+    "Four lanes: the default width (one AVX register, two SSE2 registers)."
+);
+lanes_type!(
+    F64x8,
+    8,
+    64,
+    wide::f64x8,
+    "Eight lanes (one AVX-512 register, two AVX or four SSE2 registers)."
+);

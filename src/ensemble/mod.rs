@@ -48,13 +48,32 @@
 //! position in the batch, on the other lanes or on the number of threads
 //! ([`Ensemble::run_parallel`]).
 //!
-//! # Continuation sweeps
-//! A continuation sweep starts each value from the end state of the previous one: one
-//! branch is a sequential chain, and its values cannot share lanes. Ensembles serve the
-//! independent runs — independent-start sweeps, the two trajectories of a Lyapunov pair
-//! at many parameter values, entropy scans, parameter planes and basins; a continuation
-//! sweep can put its branches (or its up and down directions) in lanes, and otherwise
-//! stays on the scalar path.
+//! # Instruction sets
+//! The lane types ([`F64x2`], [`F64x4`], [`F64x8`]) are arrays whose operations are
+//! lane-wise loops; the lane loop is compiled for the build's target, for AVX2+FMA and for
+//! AVX-512F, and [`Simd`] picks the widest the CPU has when a run starts, so a default
+//! build (x86-64 baseline) runs on AVX2 or AVX-512 registers without `-C target-cpu`. The
+//! variants execute the same IEEE operations in the same order (no fused multiply-add is
+//! introduced): results are bit-identical across them (tested).
+//!
+//! # Where ensembles are used
+//! * [`sweep_independent`] (and [`sweep_independent_parallel`]): a bifurcation sweep with
+//!   independent starts, one parameter value per lane, returning the records of
+//!   [`sweep`](crate::sweep::sweep) — to the bit with [`LaneMath::Exact`].
+//! * [`tle_independent`] (and [`tle_independent_parallel`]): the two-trajectory top
+//!   exponent of many parameter values from the same start, both copies of every pair in
+//!   lanes, renormalized every interval as
+//!   [`TwoTrajectory`](crate::lyapunov::TwoTrajectory) does; each copy has its own step,
+//!   so the estimates agree with the scalar pair's within the estimator's scatter, not to
+//!   the bit (see its docs).
+//! * The entropy index of the inter-impact intervals is computed from the records of a
+//!   sweep ([`SweepPoint::intervals`](crate::sweep::SweepPoint::intervals)): an entropy
+//!   scan over ω is [`sweep_independent`] followed by the histogram and index of
+//!   [`entropy`](crate::entropy) per value.
+//!
+//! A continuation sweep (and the continuation TLE diagram) starts each value from the end
+//! state of the previous one: one branch is a sequential chain, and its values cannot
+//! share lanes; those stay on the scalar path.
 //!
 //! # Examples
 //! ```
@@ -83,10 +102,20 @@
 
 mod engine;
 mod lanes;
+mod lyapunov;
 pub mod math;
 mod model;
+mod simd;
+mod sweep;
 
 pub use engine::{Ensemble, LaneDense, Trajectory};
 pub use lanes::{F64x2, F64x4, F64x8, Lanes};
+pub use lyapunov::tle_independent;
+#[cfg(feature = "parallel")]
+pub use lyapunov::tle_independent_parallel;
 pub use math::LaneMath;
 pub use model::Member;
+pub use simd::Simd;
+#[cfg(feature = "parallel")]
+pub use sweep::sweep_independent_parallel;
+pub use sweep::{IndependentSweep, sweep_independent};

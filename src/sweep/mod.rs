@@ -506,7 +506,7 @@ where
 /// of orbit periods in the window (a 50-period window holds no whole number of period-3
 /// orbits, and the plain average would flicker between neighbouring values); otherwise the
 /// average over the window.
-fn impacts_per_period(
+pub(crate) fn impacts_per_period(
     periods: &[crate::sample::PeriodRecord<f64>],
     regime: Regime,
     total: u64,
