@@ -63,8 +63,10 @@ impl<S: Dynamics<f64, 2>> Dynamics<f64, 2> for Reparam<S> {
     fn rhs(&self, s: f64, z: &SVector<f64, 2>, dz: &mut SVector<f64, 2>) {
         let u = self.sigma * s;
         let au = u.abs();
-        let v = u.signum() * au.powf(self.p);
-        let dv = self.p * au.powf(self.p - 1.0);
+        let mag = au.powf(self.p);
+        let v = u.signum() * mag;
+        // v'(u) = p·|u|^{p−1} = p·|v|/|u| (one power per evaluation; 0 at u = 0, p > 1).
+        let dv = if au > 0.0 { self.p * mag / au } else { 0.0 };
         let mut f = Vector2::zeros();
         self.sys.rhs(self.t0 + z[0], &Vector2::new(z[1], v), &mut f);
         self.evals.set(self.evals.get() + 1);

@@ -266,14 +266,7 @@ where
     /// [`OrbitError::Singular`], [`OrbitError::NotConverged`], and the errors of
     /// [`flow`](Self::flow).
     pub fn find(&self, t0: T, period: T, guess: SVector<T, N>) -> Result<PeriodicOrbit<T, N>> {
-        if !(period.is_finite() && period > T::zero()) {
-            return Err(OrbitError::InvalidSetting {
-                what: "the period",
-                requirement: "finite and > 0",
-                value: to_f64(period),
-            }
-            .into());
-        }
+        check_period(period)?;
         let mut y = guess;
         let (p, mut phi) = self.flow(t0, y, period)?;
         let mut residual = p - y;
@@ -361,14 +354,7 @@ where
             }
             .into());
         }
-        if !(period.is_finite() && period > T::zero()) {
-            return Err(OrbitError::InvalidSetting {
-                what: "the period",
-                requirement: "finite and > 0",
-                value: to_f64(period),
-            }
-            .into());
-        }
+        check_period(period)?;
         let h = period / lit(m as f64);
         let start = |i: usize| t0 + h * lit(i as f64);
         // Every segment's end state and Jacobian, and the mismatches φᵢ(yᵢ) − yᵢ₊₁.
@@ -453,6 +439,20 @@ where
             iterations: self.max_iterations,
             step,
             residual: to_f64(largest(&residuals)),
+        }
+        .into())
+    }
+}
+
+/// A shooting period must be finite and `> 0`.
+fn check_period<T: Real>(period: T) -> Result<()> {
+    if period.is_finite() && period > T::zero() {
+        Ok(())
+    } else {
+        Err(OrbitError::InvalidSetting {
+            what: "the period",
+            requirement: "finite and > 0",
+            value: to_f64(period),
         }
         .into())
     }
