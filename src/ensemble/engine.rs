@@ -2,7 +2,8 @@
 
 use nalgebra::SVector;
 
-use super::math::{LaneMath, exp, ln};
+use super::kernel::{ALL, LaneState, StepConsts, StepOut, row};
+use super::math::LaneMath;
 use super::model::{Member, Packed, scalar_rhs};
 use super::{Lanes, Simd};
 use crate::drive::{Control, EventRecord, Observer, Outcome, StepView, Termination};
@@ -334,46 +335,15 @@ impl Slot {
     }
 }
 
-/// One run of the lane loop, handed to `pulp` to be compiled per instruction set.
-#[cfg(target_arch = "x86_64")]
-struct LaneLoop<'e, 'a, 'o, V: Lanes, G, O> {
-    engine: &'e mut Engine<'a, V, G>,
-    observers: &'o mut [O],
-    out: &'o mut [Option<Result<Outcome<f64, 2>>>],
-}
-
-#[cfg(target_arch = "x86_64")]
-impl<V: Lanes, G: EventFunction<f64, 2>, O: Observer<f64, 2>> pulp::WithSimd
-    for LaneLoop<'_, '_, '_, V, G, O>
-{
-    type Output = ();
-
-    #[inline(always)]
-    fn with_simd<S: pulp::Simd>(self, _simd: S) {
-        self.engine.run_lanes(self.observers, self.out)
-    }
-}
-
-/// The vector state of all lanes.
+/// The lanes and their scalar bookkeeping.
 struct Engine<'a, V: Lanes, G> {
     cfg: &'a Ensemble<G>,
     jobs: &'a [Trajectory],
     next: usize,
     slots: Vec<Slot>,
-    packed: Packed<V>,
-    t: V,
-    x: V,
-    v: V,
-    fx: V,
-    fv: V,
-    h: V,
-    limit: V,
-    ln_err_old: V,
-    rej_last: V,
-    active: V,
+    st: LaneState<V>,
+    consts: StepConsts,
 }
-
-const ALL: f64 = f64::from_bits(u64::MAX);
 
 #[inline(always)]
 fn sign_of(x: f64) -> i8 {
@@ -413,17 +383,20 @@ impl<'a, V: Lanes, G: EventFunction<f64, 2>> Engine<'a, V, G> {
             jobs,
             next: 0,
             slots: (0..V::LANES).map(|_| Slot::idle()).collect(),
-            packed,
-            t: V::splat(t),
-            x: V::splat(x),
-            v: V::splat(v),
-            fx: z,
-            fv: z,
-            h: V::splat(1e-6),
-            limit: V::splat(t + 1.0),
-            ln_err_old: V::splat(1e-4f64.ln()),
-            rej_last: z,
-            active: z,
+            st: LaneState {
+                packed,
+                t: V::splat(t),
+                x: V::splat(x),
+                v: V::splat(v),
+                fx: z,
+                fv: z,
+                h: V::splat(1e-6),
+                limit: V::splat(t + 1.0),
+                ln_err_old: V::splat(1e-4f64.ln()),
+                rej_last: z,
+                active: z,
+            },
+            consts: StepConsts::new(&cfg.tol, &cfg.opts, cfg.math, cfg.simd),
         }
     }
 
@@ -435,14 +408,14 @@ impl<'a, V: Lanes, G: EventFunction<f64, 2>> Engine<'a, V, G> {
         observers: &mut [O],
         out: &mut [Option<Result<Outcome<f64, 2>>>],
     ) {
-        self.active = self.active.with_lane(i, 0.0);
+        self.st.active = self.st.active.with_lane(i, 0.0);
         self.slots[i].job = None;
         while self.next < self.jobs.len() {
             let j = self.next;
             self.next += 1;
             match self.start(i, j, &mut observers[j]) {
                 Ok(()) => {
-                    self.active = self.active.with_lane(i, ALL);
+                    self.st.active = self.st.active.with_lane(i, ALL);
                     return;
                 }
                 Err(e) => out[j] = Some(Err(e)),
@@ -519,16 +492,16 @@ impl<'a, V: Lanes, G: EventFunction<f64, 2>> Engine<'a, V, G> {
                 &mut stats.rhs_evals,
             ),
         };
-        self.packed.set(i, &m);
-        self.t = self.t.with_lane(i, t0);
-        self.x = self.x.with_lane(i, y0[0]);
-        self.v = self.v.with_lane(i, y0[1]);
-        self.fx = self.fx.with_lane(i, f0[0]);
-        self.fv = self.fv.with_lane(i, f0[1]);
-        self.h = self.h.with_lane(i, h);
-        self.limit = self.limit.with_lane(i, limit);
-        self.ln_err_old = self.ln_err_old.with_lane(i, 1e-4f64.ln());
-        self.rej_last = self.rej_last.with_lane(i, 0.0);
+        self.st.packed.set(i, &m);
+        self.st.t = self.st.t.with_lane(i, t0);
+        self.st.x = self.st.x.with_lane(i, y0[0]);
+        self.st.v = self.st.v.with_lane(i, y0[1]);
+        self.st.fx = self.st.fx.with_lane(i, f0[0]);
+        self.st.fv = self.st.fv.with_lane(i, f0[1]);
+        self.st.h = self.st.h.with_lane(i, h);
+        self.st.limit = self.st.limit.with_lane(i, limit);
+        self.st.ln_err_old = self.st.ln_err_old.with_lane(i, 1e-4f64.ln());
+        self.st.rej_last = self.st.rej_last.with_lane(i, 0.0);
         let s = &mut self.slots[i];
         *s = Slot::idle();
         s.job = Some(j);
@@ -562,45 +535,11 @@ impl<'a, V: Lanes, G: EventFunction<f64, 2>> Engine<'a, V, G> {
         self.fill(i, observers, out);
     }
 
-    /// The lane loop, compiled for the instruction set chosen at run time (see
-    /// [`Simd`]): the same operations in the same order on every path. The AVX2 and
-    /// AVX-512 variants are `pulp`'s `V3`/`V4` tokens (created only where the CPU has the
-    /// features), which run the inlined loop compiled with those target features, in safe code.
+    /// The lane loop: a vector step in every lane ([`kernel`](super::kernel), compiled in
+    /// this crate for the instruction set chosen at run time), then the scalar work of each
+    /// lane: a failed start or step ends its trajectory, an accepted step goes to the
+    /// lane's event search and observer.
     fn run<O: Observer<f64, 2>>(
-        &mut self,
-        observers: &mut [O],
-        out: &mut [Option<Result<Outcome<f64, 2>>>],
-    ) {
-        #[cfg(target_arch = "x86_64")]
-        match self.cfg.simd.resolve() {
-            Simd::Avx512 => {
-                if let Some(v4) = pulp::x86::V4::try_new() {
-                    let job = LaneLoop {
-                        engine: self,
-                        observers,
-                        out,
-                    };
-                    return pulp::Simd::vectorize(v4, job);
-                }
-            }
-            Simd::Avx2 => {
-                if let Some(v3) = pulp::x86::V3::try_new() {
-                    let job = LaneLoop {
-                        engine: self,
-                        observers,
-                        out,
-                    };
-                    return pulp::Simd::vectorize(v3, job);
-                }
-            }
-            _ => {}
-        }
-        self.run_lanes(observers, out)
-    }
-
-    /// The lane loop (inlined into each instruction-set variant of [`run`](Self::run)).
-    #[inline(always)]
-    fn run_lanes<O: Observer<f64, 2>>(
         &mut self,
         observers: &mut [O],
         out: &mut [Option<Result<Outcome<f64, 2>>>],
@@ -608,206 +547,61 @@ impl<'a, V: Lanes, G: EventFunction<f64, 2>> Engine<'a, V, G> {
         for i in 0..V::LANES {
             self.fill(i, observers, out);
         }
-        let cfg = self.cfg;
-        let s = V::splat;
-        let (a21, a31, a32) = (s(1.0 / 5.0), s(3.0 / 40.0), s(9.0 / 40.0));
-        let (a41, a42, a43) = (s(44.0 / 45.0), s(-56.0 / 15.0), s(32.0 / 9.0));
-        let (a51, a52, a53, a54) = (
-            s(19372.0 / 6561.0),
-            s(-25360.0 / 2187.0),
-            s(64448.0 / 6561.0),
-            s(-212.0 / 729.0),
-        );
-        let (a61, a62, a63, a64, a65) = (
-            s(9017.0 / 3168.0),
-            s(-355.0 / 33.0),
-            s(46732.0 / 5247.0),
-            s(49.0 / 176.0),
-            s(-5103.0 / 18656.0),
-        );
-        let (a71, a73, a74, a75, a76) = (
-            s(35.0 / 384.0),
-            s(500.0 / 1113.0),
-            s(125.0 / 192.0),
-            s(-2187.0 / 6784.0),
-            s(11.0 / 84.0),
-        );
-        let (e1, e3, e4, e5, e6, e7) = (
-            s(71.0 / 57600.0),
-            s(-71.0 / 16695.0),
-            s(71.0 / 1920.0),
-            s(-17253.0 / 339200.0),
-            s(22.0 / 525.0),
-            s(-1.0 / 40.0),
-        );
-        let (d1, d3, d4, d5, d6, d7) = (
-            s(-12715105075.0 / 11282082432.0),
-            s(87487479700.0 / 32700410799.0),
-            s(-10690763975.0 / 1880347072.0),
-            s(701980252875.0 / 199316789632.0),
-            s(-1453857185.0 / 822651844.0),
-            s(69997945.0 / 29380423.0),
-        );
-        let (c2, c3, c4, c5) = (s(0.2), s(0.3), s(0.8), s(8.0 / 9.0));
-        let (atx, atv) = (s(cfg.tol.atol[0]), s(cfg.tol.atol[1]));
-        let (rtx, rtv) = (s(cfg.tol.rtol[0]), s(cfg.tol.rtol[1]));
-        let o = &cfg.opts;
-        let expo = 1.0 / 5.0 - 0.75 * o.beta;
-        let (expo_v, beta_v) = (s(expo), s(o.beta));
-        let (safety, inv_fac_max, inv_fac_min) =
-            (s(o.safety), s(1.0 / o.fac_max), s(1.0 / o.fac_min));
-        let h_max = s(o.h_max);
-        let ln_floor = s(1e-4f64.ln());
-        let min_step_rel = s(16.0 * f64::EPSILON);
-        let h_min = s(o.h_min);
-        let math = cfg.math;
-        let one = s(1.0);
-        let zero = s(0.0);
-        let mut buf = [[0.0f64; 16]; 20];
-        while self.active.bits() != 0 {
-            let p = self.packed;
-            let (t, x, v, k1x, k1v, h) = (self.t, self.x, self.v, self.fx, self.fv, self.h);
-            // The trial step, cut to land on the lane's limit (clamp_to_limit).
-            let rest = self.limit - t;
-            let lands = h.ge(rest * s(0.99));
-            let hs = lands.select(rest, h);
-            let too_small = (hs.lt((min_step_rel * t.abs()).max(h_min)) | !(t + hs).gt(t))
-                & !lands
-                & self.active;
-            if too_small.bits() != 0 {
+        let mut step = StepOut::new();
+        while self.st.active.bits() != 0 {
+            let act = self.st.active.bits();
+            V::step_lanes(&mut self.st, &self.consts, &mut step);
+            if step.too_small != 0 {
                 for i in 0..V::LANES {
-                    if too_small.bits() & (1 << i) != 0 {
+                    if step.too_small & (1 << i) != 0 {
                         let e = IntegrateError::StepSizeTooSmall {
-                            t: t.lane(i),
-                            h: hs.lane(i),
+                            t: step.buf[row::T0][i],
+                            h: step.buf[row::H][i],
                         };
                         self.finish(i, Err(e.into()), observers, out);
                     }
                 }
                 continue;
             }
-            let (k2x, k2v) = p.rhs(
-                math,
-                t + c2 * hs,
-                x + k1x * (a21 * hs),
-                v + k1v * (a21 * hs),
-            );
-            let (k3x, k3v) = p.rhs(
-                math,
-                t + c3 * hs,
-                x + (k1x * a31 + k2x * a32) * hs,
-                v + (k1v * a31 + k2v * a32) * hs,
-            );
-            let (k4x, k4v) = p.rhs(
-                math,
-                t + c4 * hs,
-                x + (k1x * a41 + k2x * a42 + k3x * a43) * hs,
-                v + (k1v * a41 + k2v * a42 + k3v * a43) * hs,
-            );
-            let (k5x, k5v) = p.rhs(
-                math,
-                t + c5 * hs,
-                x + (k1x * a51 + k2x * a52 + k3x * a53 + k4x * a54) * hs,
-                v + (k1v * a51 + k2v * a52 + k3v * a53 + k4v * a54) * hs,
-            );
-            let t_new = lands.select(self.limit, t + hs);
-            let (k6x, k6v) = p.rhs(
-                math,
-                t_new,
-                x + (k1x * a61 + k2x * a62 + k3x * a63 + k4x * a64 + k5x * a65) * hs,
-                v + (k1v * a61 + k2v * a62 + k3v * a63 + k4v * a64 + k5v * a65) * hs,
-            );
-            let xn = x + (k1x * a71 + k3x * a73 + k4x * a74 + k5x * a75 + k6x * a76) * hs;
-            let vn = v + (k1v * a71 + k3v * a73 + k4v * a74 + k5v * a75 + k6v * a76) * hs;
-            let (k7x, k7v) = p.rhs(math, t_new, xn, vn);
-            let ex = (k1x * e1 + k3x * e3 + k4x * e4 + k5x * e5 + k6x * e6 + k7x * e7) * hs;
-            let ev = (k1v * e1 + k3v * e3 + k4v * e4 + k5v * e5 + k6v * e6 + k7v * e7) * hs;
-            let qx = ex / (atx + rtx * x.abs().max(xn.abs()));
-            let qv = ev / (atv + rtv * v.abs().max(vn.abs()));
-            let err = (((zero + qx * qx) + qv * qv) / s(2.0)).sqrt();
-            let finite = xn.finite() & vn.finite() & k7x.finite() & k7v.finite();
-            let err = finite.select(err, s(f64::NAN));
-            // The PI controller (Controller::propose), lane-wise.
-            let err_ok = err.finite();
-            let pos = err.gt(zero) & err_ok;
-            let ln_err = pos.select(ln(math, pos.select(err, one)), s(-700.0));
-            let acc = err_ok & err.le(one);
-            // One exp per lane: err^α/err_old^β where accepted, err^α where rejected.
-            let arg = acc.select(expo_v * ln_err - beta_v * self.ln_err_old, expo_v * ln_err);
-            let fac_any = exp(math, arg);
-            let fac = (fac_any / safety).max(inv_fac_max).min(inv_fac_min);
-            let h_acc = hs / fac;
-            let h_acc = self.rej_last.select(h_acc.min(hs), h_acc).min(h_max);
-            let h_rej = hs / (fac_any / safety).min(inv_fac_min);
-            let h_next = acc.select(h_acc, err_ok.select(h_rej, hs * s(0.1)));
-            let acc = acc & self.active;
-            let rejected = !acc & self.active;
-            let non_finite = !finite & self.active;
-            // Rejected lanes retry with the smaller step.
-            self.h = rejected.select(h_next, self.h);
-            self.rej_last = rejected.select(s(ALL), acc.select(zero, self.rej_last));
-            self.ln_err_old = acc.select(ln_err.max(ln_floor), self.ln_err_old);
-            let (rb, ab, nb) = (rejected.bits(), acc.bits(), non_finite.bits());
-            let act = self.active.bits();
             for i in 0..V::LANES {
                 if act & (1 << i) != 0 {
                     self.slots[i].stats.rhs_evals += 6;
                 }
-                if rb & (1 << i) != 0 {
+                if step.rejected & (1 << i) != 0 {
                     self.slots[i].stats.rejected += 1;
                 }
-                if nb & (1 << i) != 0 {
+                if step.non_finite & (1 << i) != 0 {
                     self.slots[i].nonfinite += 1;
                     if self.slots[i].nonfinite > 20 {
-                        let e = IntegrateError::NonFiniteRhs { t: t.lane(i) };
+                        let e = IntegrateError::NonFiniteRhs {
+                            t: step.buf[row::T0][i],
+                        };
                         self.finish(i, Err(e.into()), observers, out);
                     }
                 }
             }
-            if ab == 0 {
+            if step.accepted == 0 {
                 continue;
             }
-            // Accepted lanes: the new state, the next step, the dense output.
-            self.t = acc.select(t_new, self.t);
-            self.x = acc.select(xn, self.x);
-            self.v = acc.select(vn, self.v);
-            self.fx = acc.select(k7x, self.fx);
-            self.fv = acc.select(k7v, self.fv);
-            self.h = acc.select(lands.select(h_next.max(h), h_next), self.h);
-            let dxd = xn - x;
-            let dvd = vn - v;
-            let bx = k1x * hs - dxd;
-            let bv = k1v * hs - dvd;
-            let r4x = dxd - k7x * hs - bx;
-            let r4v = dvd - k7v * hs - bv;
-            let r5x = (k1x * d1 + k3x * d3 + k4x * d4 + k5x * d5 + k6x * d6 + k7x * d7) * hs;
-            let r5v = (k1v * d1 + k3v * d3 + k4v * d4 + k5v * d5 + k6v * d6 + k7v * d7) * hs;
-            for (b, w) in buf.iter_mut().zip([
-                t, t_new, hs, x, v, xn, vn, k1x, k1v, k7x, k7v, dxd, dvd, bx, bv, r4x, r4v, r5x,
-                r5v,
-            ]) {
-                w.store(b);
-            }
-            // Lane `i` of each stored vector is `buf[k][i]`.
             #[allow(clippy::needless_range_loop)]
             for i in 0..V::LANES {
-                if ab & (1 << i) == 0 {
+                if step.accepted & (1 << i) == 0 {
                     continue;
                 }
-                let g = |k: usize| buf[k][i];
-                let sv = |a: usize, b: usize| SVector::<f64, 2>::new(g(a), g(b));
+                let g = |k: usize| step.buf[k][i];
+                let sv = |k: usize| SVector::<f64, 2>::new(g(k), g(k + 1));
                 let dense = LaneDense {
-                    t0: g(0),
-                    t1: g(1),
-                    h: g(2),
-                    y0: sv(3, 4),
-                    y1: sv(5, 6),
-                    f0: sv(7, 8),
-                    f1: sv(9, 10),
-                    r2: sv(11, 12),
-                    r3: sv(13, 14),
-                    r4: sv(15, 16),
-                    r5: sv(17, 18),
+                    t0: g(row::T0),
+                    t1: g(row::T1),
+                    h: g(row::H),
+                    y0: sv(row::X0),
+                    y1: sv(row::X1),
+                    f0: sv(row::F0),
+                    f1: sv(row::F1),
+                    r2: sv(row::R2),
+                    r3: sv(row::R3),
+                    r4: sv(row::R4),
+                    r5: sv(row::R5),
                 };
                 self.after_step(i, &dense, observers, out);
             }
@@ -847,7 +641,7 @@ impl<'a, V: Lanes, G: EventFunction<f64, 2>> Engine<'a, V, G> {
                     self.finish(i, Err(e.into()), observers, out);
                 } else {
                     let l = next_limit(t1, slot.t_end, slot.grid);
-                    self.limit = self.limit.with_lane(i, l);
+                    self.st.limit = self.st.limit.with_lane(i, l);
                 }
             }
         }

@@ -3,8 +3,15 @@
 use core::fmt::Debug;
 use core::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
 
-mod sealed {
-    pub trait Sealed {}
+pub(crate) mod sealed {
+    use super::super::kernel::{LaneState, StepConsts, StepOut};
+
+    /// What only the crate's lane types provide: the vector step of the ensemble, compiled
+    /// once in this crate per lane type (see [`kernel`](super::super::kernel)).
+    pub trait Sealed: Sized {
+        /// One trial step in every lane ([`kernel::step`](super::super::kernel::step)).
+        fn step_lanes(st: &mut LaneState<Self>, k: &StepConsts, out: &mut StepOut);
+    }
 }
 
 /// `L` lanes of `f64`: [`F64x2`], [`F64x4`] (the default) and [`F64x8`].
@@ -177,7 +184,18 @@ macro_rules! lanes_type {
             }
         }
 
-        impl sealed::Sealed for $name {}
+        impl sealed::Sealed for $name {
+            // Not inlined: the step is compiled here, once per lane type, and not again in
+            // every crate or for every observer that runs an ensemble.
+            #[inline(never)]
+            fn step_lanes(
+                st: &mut super::kernel::LaneState<Self>,
+                k: &super::kernel::StepConsts,
+                out: &mut super::kernel::StepOut,
+            ) {
+                super::kernel::step(st, k, out)
+            }
+        }
         impl Lanes for $name {
             const LANES: usize = $n;
             #[inline(always)]

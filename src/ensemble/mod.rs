@@ -101,6 +101,7 @@
 //! ```
 
 mod engine;
+mod kernel;
 mod lanes;
 mod lyapunov;
 pub mod math;

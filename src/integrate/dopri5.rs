@@ -10,6 +10,58 @@ use super::{
 use crate::scalar::{lit, to_f64};
 use crate::{Dynamics, Real};
 
+/// The Dormand–Prince 5(4) tableau and Hairer's dense-output coefficients (shared with the
+/// ensemble's lane step, which must evaluate the same numbers).
+pub(crate) mod tableau {
+    /// Nodes `c₂…c₅` (`c₆ = c₇ = 1`).
+    pub const C: [f64; 4] = [0.2, 0.3, 0.8, 8.0 / 9.0];
+    /// Row 3 of `A`.
+    pub const A3: [f64; 2] = [3.0 / 40.0, 9.0 / 40.0];
+    /// Row 4 of `A`.
+    pub const A4: [f64; 3] = [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0];
+    /// Row 5 of `A`.
+    pub const A5: [f64; 4] = [
+        19372.0 / 6561.0,
+        -25360.0 / 2187.0,
+        64448.0 / 6561.0,
+        -212.0 / 729.0,
+    ];
+    /// Row 6 of `A`.
+    pub const A6: [f64; 5] = [
+        9017.0 / 3168.0,
+        -355.0 / 33.0,
+        46732.0 / 5247.0,
+        49.0 / 176.0,
+        -5103.0 / 18656.0,
+    ];
+    /// The weights `b₁, b₃…b₆` (`b₂ = b₇ = 0`; row 7 of `A`).
+    pub const B: [f64; 5] = [
+        35.0 / 384.0,
+        500.0 / 1113.0,
+        125.0 / 192.0,
+        -2187.0 / 6784.0,
+        11.0 / 84.0,
+    ];
+    /// The error weights `b − b̂` for stages 1, 3…7.
+    pub const E: [f64; 6] = [
+        71.0 / 57600.0,
+        -71.0 / 16695.0,
+        71.0 / 1920.0,
+        -17253.0 / 339200.0,
+        22.0 / 525.0,
+        -1.0 / 40.0,
+    ];
+    /// Hairer's dense-output coefficients for stages 1, 3…7.
+    pub const D: [f64; 6] = [
+        -12715105075.0 / 11282082432.0,
+        87487479700.0 / 32700410799.0,
+        -10690763975.0 / 1880347072.0,
+        701980252875.0 / 199316789632.0,
+        -1453857185.0 / 822651844.0,
+        69997945.0 / 29380423.0,
+    ];
+}
+
 /// The explicit Runge–Kutta method of Dormand and Prince, order 5 with an embedded order-4
 /// error estimate, first-same-as-last (6 evaluations per accepted step), and Hairer's
 /// 4th-order dense output.
@@ -80,37 +132,14 @@ impl<T: Real, const N: usize> Stepper<T, N> for Dopri5<T, N> {
             .core
             .proposed(sys, 5, &self.tol, self.ctrl.opts.h_max, t_limit);
         let c = |x: f64| lit::<T>(x);
-        let (a21, a31, a32) = (c(1.0 / 5.0), c(3.0 / 40.0), c(9.0 / 40.0));
-        let (a41, a42, a43) = (c(44.0 / 45.0), c(-56.0 / 15.0), c(32.0 / 9.0));
-        let (a51, a52, a53, a54) = (
-            c(19372.0 / 6561.0),
-            c(-25360.0 / 2187.0),
-            c(64448.0 / 6561.0),
-            c(-212.0 / 729.0),
-        );
-        let (a61, a62, a63, a64, a65) = (
-            c(9017.0 / 3168.0),
-            c(-355.0 / 33.0),
-            c(46732.0 / 5247.0),
-            c(49.0 / 176.0),
-            c(-5103.0 / 18656.0),
-        );
-        let (a71, a73, a74, a75, a76) = (
-            c(35.0 / 384.0),
-            c(500.0 / 1113.0),
-            c(125.0 / 192.0),
-            c(-2187.0 / 6784.0),
-            c(11.0 / 84.0),
-        );
-        let (e1, e3, e4, e5, e6, e7) = (
-            c(71.0 / 57600.0),
-            c(-71.0 / 16695.0),
-            c(71.0 / 1920.0),
-            c(-17253.0 / 339200.0),
-            c(22.0 / 525.0),
-            c(-1.0 / 40.0),
-        );
-        let (c2, c3, c4, c5) = (c(0.2), c(0.3), c(0.8), c(8.0 / 9.0));
+        let a21 = c(1.0 / 5.0);
+        let [a31, a32] = tableau::A3.map(c);
+        let [a41, a42, a43] = tableau::A4.map(c);
+        let [a51, a52, a53, a54] = tableau::A5.map(c);
+        let [a61, a62, a63, a64, a65] = tableau::A6.map(c);
+        let [a71, a73, a74, a75, a76] = tableau::B.map(c);
+        let [e1, e3, e4, e5, e6, e7] = tableau::E.map(c);
+        let [c2, c3, c4, c5] = tableau::C.map(c);
         let mut k2 = SVector::zeros();
         let mut k3 = SVector::zeros();
         let mut k4 = SVector::zeros();
@@ -154,14 +183,7 @@ impl<T: Real, const N: usize> Stepper<T, N> for Dopri5<T, N> {
             if accept {
                 let ydiff = y_new - y;
                 let bspl = k1 * hs - ydiff;
-                let (d1, d3, d4, d5, d6, d7) = (
-                    c(-12715105075.0 / 11282082432.0),
-                    c(87487479700.0 / 32700410799.0),
-                    c(-10690763975.0 / 1880347072.0),
-                    c(701980252875.0 / 199316789632.0),
-                    c(-1453857185.0 / 822651844.0),
-                    c(69997945.0 / 29380423.0),
-                );
+                let [d1, d3, d4, d5, d6, d7] = tableau::D.map(c);
                 self.dense = Dopri5Dense {
                     ends: HermiteDense::new(t, t_new, y, y_new, k1, k7),
                     h: hs,

@@ -23,7 +23,7 @@
 //! accumulated over a long run.
 
 mod dop853;
-mod dopri5;
+pub(crate) mod dopri5;
 mod rk4;
 mod rosenbrock;
 
