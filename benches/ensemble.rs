@@ -1,7 +1,7 @@
 //! Ensemble throughput on the paper's model at rtol 1e-8, one thread: 16 forcing
 //! frequencies in [17.5, 25] rad/s, 20 periods each from rest, every impact located, steps
 //! landing on the sections — the scalar path (`Simulation` + `Dopri5`, one trajectory
-//! after the other) against the ensemble in lanes of 4 and 8 (exact and vector math).
+//! after the other) against the ensemble in lanes of 4, 8 and 16 (exact and vector math).
 //! After the group, the throughput ratio ensemble/scalar of the fastest configuration,
 //! measured in this run, is printed as `throughput ratio ensemble/scalar: R`.
 
@@ -11,7 +11,7 @@ use std::time::Instant;
 use criterion::{Criterion, criterion_group, criterion_main};
 use nalgebra::Vector2;
 use nonsmooth::drive::Simulation;
-use nonsmooth::ensemble::{Ensemble, F64x4, F64x8, LaneMath, Lanes, Member, Trajectory};
+use nonsmooth::ensemble::{Ensemble, F64x4, F64x8, F64x16, LaneMath, Lanes, Member, Trajectory};
 use nonsmooth::event::{Direction, Event, Stop};
 use nonsmooth::integrate::{Dopri5, Tolerances};
 use nonsmooth::model::paper::PAPER;
@@ -75,12 +75,14 @@ fn lanes<V: Lanes>(s: &Setup, math: LaneMath) -> u64 {
 
 type Path = (&'static str, fn(&Setup) -> u64);
 
-const PATHS: [Path; 5] = [
+const PATHS: [Path; 7] = [
     ("scalar", scalar),
     ("lanes4_exact", |s| lanes::<F64x4>(s, LaneMath::Exact)),
     ("lanes8_exact", |s| lanes::<F64x8>(s, LaneMath::Exact)),
     ("lanes4_vector", |s| lanes::<F64x4>(s, LaneMath::Vector)),
     ("lanes8_vector", |s| lanes::<F64x8>(s, LaneMath::Vector)),
+    ("lanes16_exact", |s| lanes::<F64x16>(s, LaneMath::Exact)),
+    ("lanes16_vector", |s| lanes::<F64x16>(s, LaneMath::Vector)),
 ];
 
 fn bench(c: &mut Criterion) {

@@ -25,7 +25,7 @@ use std::time::Instant;
 use nalgebra::Vector2;
 use nonsmooth::drive::{Control, EventRecord, Observer, Simulation, StepView};
 use nonsmooth::ensemble::{
-    Ensemble, F64x2, F64x4, F64x8, LaneMath, Lanes, Member, Simd, Trajectory,
+    Ensemble, F64x2, F64x4, F64x8, F64x16, LaneMath, Lanes, Member, Simd, Trajectory,
 };
 use nonsmooth::event::{Direction, Event, Stop};
 use nonsmooth::integrate::{DenseOutput, Dopri5, Tolerances};
@@ -164,9 +164,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     run("ensemble 2, exact", &|o| lanes::<F64x2>(&exact, &jobs, o))?;
     run("ensemble 4, exact", &|o| lanes::<F64x4>(&exact, &jobs, o))?;
     run("ensemble 8, exact", &|o| lanes::<F64x8>(&exact, &jobs, o))?;
+    run("ensemble 16, exact", &|o| lanes::<F64x16>(&exact, &jobs, o))?;
     run("ensemble 2, vector", &|o| lanes::<F64x2>(&vector, &jobs, o))?;
     run("ensemble 4, vector", &|o| lanes::<F64x4>(&vector, &jobs, o))?;
     run("ensemble 8, vector", &|o| lanes::<F64x8>(&vector, &jobs, o))?;
+    run("ensemble 16, vector", &|o| {
+        lanes::<F64x16>(&vector, &jobs, o)
+    })?;
     println!("fastest ensemble configuration: {}", best.1);
     println!("throughput ratio ensemble/scalar: {:.2}", best.0);
     Ok(())

@@ -6,7 +6,7 @@
 use nalgebra::Vector2;
 use nonsmooth::drive::{Control, EventRecord, Observer, Simulation};
 use nonsmooth::ensemble::{
-    Ensemble, F64x2, F64x4, F64x8, LaneMath, Lanes, Member, Trajectory, math,
+    Ensemble, F64x2, F64x4, F64x8, F64x16, LaneMath, Lanes, Member, Trajectory, math,
 };
 use nonsmooth::event::{Direction, Event, Level, Stop};
 use nonsmooth::integrate::{Dopri5, Stats, Tolerances};
@@ -371,6 +371,7 @@ fn results_do_not_depend_on_lanes_order_or_threads() {
         let base = summary(&lanes::<F64x4>(&jobs, tol, math));
         assert_eq!(summary(&lanes::<F64x2>(&jobs, tol, math)), base);
         assert_eq!(summary(&lanes::<F64x8>(&jobs, tol, math)), base);
+        assert_eq!(summary(&lanes::<F64x16>(&jobs, tol, math)), base);
         // Reversed batch: the same per trajectory.
         let rev: Vec<Trajectory> = jobs.iter().rev().copied().collect();
         let mut r = summary(&lanes::<F64x4>(&rev, tol, math));
@@ -488,6 +489,64 @@ fn vector_exp_and_ln_against_libm() {
             } else {
                 worst_ln_abs = worst_ln_abs.max((l.lane(i) - want).abs() / f64::EPSILON);
             }
+        }
+    }
+    // The whole range of exp, past the fast path's |x| ≤ 708 (those lanes take libm).
+    for u in lcg(100_000).collect::<Vec<_>>().chunks(8) {
+        let x: Vec<f64> = u.iter().map(|u| -745.0 + 1455.0 * u).collect();
+        let e = math::exp(LaneMath::Vector, F64x8::load(&x));
+        for (i, &xi) in x.iter().enumerate() {
+            let want = xi.exp();
+            if want >= f64::MIN_POSITIVE {
+                worst_exp = worst_exp.max(ulps(e.lane(i), want));
+            } else {
+                assert_eq!(e.lane(i).to_bits(), want.to_bits(), "exp({xi}) (subnormal)");
+            }
+        }
+    }
+    // Special values go to libm in both functions.
+    let special = [
+        f64::NAN,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        0.0,
+        -0.0,
+        -1.0,
+        5e-324,
+        1e-310,
+        f64::MIN_POSITIVE,
+        f64::MAX,
+        708.0,
+        -708.0,
+        709.7,
+        -744.0,
+        1e-300,
+        1.0,
+    ];
+    for c in special.chunks(8) {
+        let v = F64x8::load(c);
+        let (e, l) = (
+            math::exp(LaneMath::Vector, v),
+            math::ln(LaneMath::Vector, v),
+        );
+        for (i, &x) in c.iter().enumerate() {
+            let same = |got: f64, want: f64| {
+                got.to_bits() == want.to_bits()
+                    || (got.is_nan() && want.is_nan())
+                    || ulps(got, want) <= 1.0
+            };
+            assert!(
+                same(e.lane(i), x.exp()),
+                "exp({x}) = {} vs {}",
+                e.lane(i),
+                x.exp()
+            );
+            assert!(
+                same(l.lane(i), x.ln()),
+                "ln({x}) = {} vs {}",
+                l.lane(i),
+                x.ln()
+            );
         }
     }
     println!("exp {worst_exp} ulp, ln {worst_ln} ulp (|ln| > 0.5), ln near 1 {worst_ln_abs} ε abs");

@@ -640,8 +640,15 @@ impl<'a, V: Lanes, G: EventFunction<f64, 2>> Engine<'a, V, G> {
                     };
                     self.finish(i, Err(e.into()), observers, out);
                 } else {
-                    let l = next_limit(t1, slot.t_end, slot.grid);
-                    self.st.limit = self.st.limit.with_lane(i, l);
+                    // The driver computes the next landing point after every step. Short of
+                    // the current one (by more than the rounding of that computation) it
+                    // is the current one again, so it is only recomputed near or on it.
+                    let limit = self.st.limit.lane(i);
+                    let scale = t1.abs() + slot.grid.map_or(0.0, |(o, dt)| o.abs() + dt);
+                    if limit - t1 <= 64.0 * f64::EPSILON * scale {
+                        let l = next_limit(t1, slot.t_end, slot.grid);
+                        self.st.limit = self.st.limit.with_lane(i, l);
+                    }
                 }
             }
         }

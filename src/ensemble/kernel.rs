@@ -1,7 +1,7 @@
 //! One trial step of DOPRI5 in every lane: the vector part of the ensemble's loop.
 //!
 //! The step is compiled inside this crate, once per lane type ([`F64x2`], [`F64x4`],
-//! [`F64x8`]) and instruction set ([`Simd`]), and reached through the sealed
+//! [`F64x8`], [`F64x16`]) and instruction set ([`Simd`]), and reached through the sealed
 //! [`Lanes`] trait by a non-generic function per lane type. Code that runs an ensemble with
 //! its own observer or event type therefore instantiates only the scalar bookkeeping
 //! (events, observers, the work queue), not the inlined vector step: the step is compiled
@@ -10,6 +10,7 @@
 //! [`F64x2`]: super::F64x2
 //! [`F64x4`]: super::F64x4
 //! [`F64x8`]: super::F64x8
+//! [`F64x16`]: super::F64x16
 
 use super::math::{LaneMath, exp, ln};
 use super::model::Packed;
@@ -205,40 +206,55 @@ fn body<V: Lanes>(st: &mut LaneState<V>, k: &StepConsts, out: &mut StepOut) {
         hs.store(&mut out.buf[row::H]);
         return;
     }
-    let (k2x, k2v) = p.rhs(
-        math,
-        t + c2 * hs,
-        x + k1x * (a21 * hs),
-        v + k1v * (a21 * hs),
-    );
-    let (k3x, k3v) = p.rhs(
-        math,
-        t + c3 * hs,
-        x + (k1x * a31 + k2x * a32) * hs,
-        v + (k1v * a31 + k2v * a32) * hs,
-    );
-    let (k4x, k4v) = p.rhs(
-        math,
-        t + c4 * hs,
-        x + (k1x * a41 + k2x * a42 + k3x * a43) * hs,
-        v + (k1v * a41 + k2v * a42 + k3v * a43) * hs,
-    );
-    let (k5x, k5v) = p.rhs(
-        math,
-        t + c5 * hs,
-        x + (k1x * a51 + k2x * a52 + k3x * a53 + k4x * a54) * hs,
-        v + (k1v * a51 + k2v * a52 + k3v * a53 + k4v * a54) * hs,
-    );
     let t_new = lands.select(st.limit, t + hs);
-    let (k6x, k6v) = p.rhs(
-        math,
-        t_new,
-        x + (k1x * a61 + k2x * a62 + k3x * a63 + k4x * a64 + k5x * a65) * hs,
-        v + (k1v * a61 + k2v * a62 + k3v * a63 + k4v * a64 + k5v * a65) * hs,
-    );
-    let xn = x + (k1x * a71 + k3x * a73 + k4x * a74 + k5x * a75 + k6x * a76) * hs;
-    let vn = v + (k1v * a71 + k3v * a73 + k4v * a74 + k5v * a75 + k6v * a76) * hs;
-    let (k7x, k7v) = p.rhs(math, t_new, xn, vn);
+    // The six new stages in one loop, so that the right-hand side (sin, the contact law's
+    // powers) is inlined once instead of six times: the stage inputs are the scalar
+    // stepper's expressions, term for term.
+    let mut kx = [zero; 7];
+    let mut kv = [zero; 7];
+    kx[0] = k1x;
+    kv[0] = k1v;
+    let (mut xn, mut vn) = (x, v);
+    let mut forcing = zero;
+    for stage in 1..7 {
+        let (ts, xs, vs) = match stage {
+            1 => (t + c2 * hs, x + k1x * (a21 * hs), v + k1v * (a21 * hs)),
+            2 => (
+                t + c3 * hs,
+                x + (k1x * a31 + kx[1] * a32) * hs,
+                v + (k1v * a31 + kv[1] * a32) * hs,
+            ),
+            3 => (
+                t + c4 * hs,
+                x + (k1x * a41 + kx[1] * a42 + kx[2] * a43) * hs,
+                v + (k1v * a41 + kv[1] * a42 + kv[2] * a43) * hs,
+            ),
+            4 => (
+                t + c5 * hs,
+                x + (k1x * a51 + kx[1] * a52 + kx[2] * a53 + kx[3] * a54) * hs,
+                v + (k1v * a51 + kv[1] * a52 + kv[2] * a53 + kv[3] * a54) * hs,
+            ),
+            5 => (
+                t_new,
+                x + (k1x * a61 + kx[1] * a62 + kx[2] * a63 + kx[3] * a64 + kx[4] * a65) * hs,
+                v + (k1v * a61 + kv[1] * a62 + kv[2] * a63 + kv[3] * a64 + kv[4] * a65) * hs,
+            ),
+            _ => {
+                xn = x + (k1x * a71 + kx[2] * a73 + kx[3] * a74 + kx[4] * a75 + kx[5] * a76) * hs;
+                vn = v + (k1v * a71 + kv[2] * a73 + kv[3] * a74 + kv[4] * a75 + kv[5] * a76) * hs;
+                (t_new, xn, vn)
+            }
+        };
+        // Stages 6 and 7 are both at t_new: one sin for the two.
+        if stage != 6 {
+            forcing = p.excitation(ts);
+        }
+        let (fx, fv) = p.rhs_forced(math, forcing, xs, vs);
+        kx[stage] = fx;
+        kv[stage] = fv;
+    }
+    let [_, _, k3x, k4x, k5x, k6x, k7x] = kx;
+    let [_, _, k3v, k4v, k5v, k6v, k7v] = kv;
     let ex = (k1x * e1 + k3x * e3 + k4x * e4 + k5x * e5 + k6x * e6 + k7x * e7) * hs;
     let ev = (k1v * e1 + k3v * e3 + k4v * e4 + k5v * e5 + k6v * e6 + k7v * e7) * hs;
     let qx = ex / (atx + rtx * x.abs().max(xn.abs()));

@@ -11,6 +11,12 @@ pub(crate) mod sealed {
     pub trait Sealed: Sized {
         /// One trial step in every lane ([`kernel::step`](super::super::kernel::step)).
         fn step_lanes(st: &mut LaneState<Self>, k: &StepConsts, out: &mut StepOut);
+        /// `2^k` from `y = k + 1.5·2⁵²` (`k` an integer in `[−1022, 1023]`, held in the low
+        /// bits of `y`): the bits `(bits(y) + 1023) << 52`, lane-wise.
+        fn pow2_from_rounded(self) -> Self;
+        /// The biased exponent field `bits(x) >> 52` as an `f64` (exact; the sign bit must
+        /// be clear), lane-wise.
+        fn exponent_field(self) -> Self;
     }
 }
 
@@ -73,14 +79,10 @@ pub trait Lanes:
     fn select(self, a: Self, b: Self) -> Self;
     /// Bit `i` set where lane `i` of the mask is set.
     fn bits(self) -> u32;
-    /// `e^x` by `wide`'s polynomial (see [`math`](super::math) for its accuracy).
-    fn exp_poly(self) -> Self;
-    /// `ln x` by `wide`'s rational approximation (see [`math`](super::math)).
-    fn ln_poly(self) -> Self;
 }
 
 macro_rules! lanes_type {
-    ($name:ident, $n:expr, $align:literal, $wide:ty, $doc:literal) => {
+    ($name:ident, $n:expr, $align:literal, $doc:literal) => {
         #[doc = $doc]
         ///
         /// A plain array of `f64` whose operations are lane-wise loops: the compiler turns
@@ -116,14 +118,6 @@ macro_rules! lanes_type {
             #[inline(always)]
             fn cmp(self, o: Self, f: impl Fn(f64, f64) -> bool) -> Self {
                 self.zip(o, |a, b| f64::from_bits((f(a, b) as u64).wrapping_neg()))
-            }
-            #[inline(always)]
-            fn wide(self) -> $wide {
-                <$wide>::new(self.0)
-            }
-            #[inline(always)]
-            fn from_wide(w: $wide) -> Self {
-                Self(w.to_array())
             }
         }
 
@@ -194,6 +188,19 @@ macro_rules! lanes_type {
                 out: &mut super::kernel::StepOut,
             ) {
                 super::kernel::step(st, k, out)
+            }
+            #[inline(always)]
+            fn pow2_from_rounded(self) -> Self {
+                self.map(|y| f64::from_bits(y.to_bits().wrapping_add(1023) << 52))
+            }
+            #[inline(always)]
+            fn exponent_field(self) -> Self {
+                // (e | bits of 2⁵²) − 2⁵² = e exactly, for e < 2¹²: no integer conversion,
+                // which AVX2 lacks for 64-bit lanes.
+                self.map(|x| {
+                    f64::from_bits((x.to_bits() >> 52) | 0x4330_0000_0000_0000)
+                        - 4_503_599_627_370_496.0
+                })
             }
         }
         impl Lanes for $name {
@@ -280,30 +287,28 @@ macro_rules! lanes_type {
                 }
                 r
             }
-            #[inline(always)]
-            fn exp_poly(self) -> Self {
-                Self::from_wide(self.wide().exp())
-            }
-            #[inline(always)]
-            fn ln_poly(self) -> Self {
-                Self::from_wide(self.wide().ln())
-            }
         }
     };
 }
 
-lanes_type!(F64x2, 2, 16, wide::f64x2, "Two lanes (one SSE2 register).");
+lanes_type!(F64x2, 2, 16, "Two lanes (one SSE2 register).");
 lanes_type!(
     F64x4,
     4,
     32,
-    wide::f64x4,
     "Four lanes: the default width (one AVX register, two SSE2 registers)."
 );
 lanes_type!(
     F64x8,
     8,
     64,
-    wide::f64x8,
     "Eight lanes (one AVX-512 register, two AVX or four SSE2 registers)."
+);
+lanes_type!(
+    F64x16,
+    16,
+    64,
+    "Sixteen lanes (two AVX-512, four AVX or eight SSE2 registers): more independent \
+     work per instruction stream, which hides the latency of the polynomial chains in \
+     `sin`, `exp` and `ln`."
 );

@@ -17,14 +17,18 @@
 //! * [`LaneMath::Exact`] calls the platform's `exp`/`ln` lane by lane, for the lanes that
 //!   need them (in contact): the values are those of the scalar path to the bit, so a lane
 //!   follows the scalar trajectory step for step.
-//! * [`LaneMath::Vector`] evaluates them in the lanes with `wide`'s polynomials (`exp`: a
-//!   Cody–Waite reduction by `ln 2` and a degree-13 Taylor polynomial; `ln`: a rational
-//!   approximation of degree 5/5 on `[√½, √2]` with `ln 2` split in two). Measured against
-//!   `libm` in `tests/ensemble.rs` over the arguments the model produces (`exp` on
-//!   `[−40, 40]`, `ln` on `[10⁻³⁰⁰, 10³⁰⁰]`): at most 1 ulp for `exp` and 1 ulp for `ln`
-//!   away from `x = 1`, where `ln x → 0` and the error is below `2⁻⁵³` absolute. Results
-//!   then differ from the scalar path by rounding, and a lane's trajectory agrees with the
-//!   scalar one within the integration tolerance instead of to the bit.
+//! * [`LaneMath::Vector`] evaluates them in the lanes, without leaving the vector
+//!   registers, by fdlibm's algorithms ([`exp_vector`]: reduction by `ln 2` in two parts,
+//!   the rational form `1 + 2r/(2 − c(r))` with a degree-5 polynomial in `r²`, the scale
+//!   `2^k` written into the exponent bits; [`ln_vector`]: exponent and mantissa from the
+//!   bits, `s = f/(2 + f)` and a degree-7 polynomial in `s²`). Lanes outside their fast
+//!   ranges (`|x| > 708` for `exp`; zero, subnormal, negative, infinite or NaN for `ln`)
+//!   are passed to the platform's functions one by one. Measured against `libm` in
+//!   `tests/ensemble.rs` (`exp` on `[−745, 710]`, `ln` on `[10⁻³⁰⁰, 10³⁰⁰]` and near 1,
+//!   special values): at most 1 ulp for `exp` and for `ln` away from `x = 1`, where
+//!   `ln x → 0` and the error is below `2⁻⁵⁴` absolute. Results then differ from the
+//!   scalar path by rounding, and a lane's trajectory agrees with the scalar one within
+//!   the integration tolerance instead of to the bit.
 
 // The fdlibm constants are printed with the digits of their source.
 #![allow(clippy::excessive_precision)]
@@ -37,8 +41,8 @@ pub enum LaneMath {
     /// The platform's `exp`/`ln`, lane by lane: bit-identical to the scalar path.
     #[default]
     Exact,
-    /// `wide`'s vector polynomials: faster in contact, equal to the scalar path within
-    /// rounding (≤ 1 ulp per call).
+    /// fdlibm's algorithms in the lanes ([`exp_vector`], [`ln_vector`]): equal to the
+    /// scalar path within rounding (≤ 1 ulp per call).
     Vector,
 }
 
@@ -96,15 +100,7 @@ pub fn sin<V: Lanes>(x: V) -> V {
     let a = x.abs();
     v = a.lt(s(TINY)).select(x, v);
     let slow = !a.le(s(TRIG_LIMIT));
-    let bits = slow.bits();
-    if bits != 0 {
-        for i in 0..V::LANES {
-            if bits & (1 << i) != 0 {
-                v = v.with_lane(i, x.lane(i).sin());
-            }
-        }
-    }
-    v
+    patch(v, slow, x, f64::sin)
 }
 
 /// `e^x` in every lane.
@@ -112,7 +108,7 @@ pub fn sin<V: Lanes>(x: V) -> V {
 pub fn exp<V: Lanes>(math: LaneMath, x: V) -> V {
     match math {
         LaneMath::Exact => map(x, f64::exp),
-        LaneMath::Vector => x.exp_poly(),
+        LaneMath::Vector => exp_vector(x),
     }
 }
 
@@ -121,7 +117,7 @@ pub fn exp<V: Lanes>(math: LaneMath, x: V) -> V {
 pub fn ln<V: Lanes>(math: LaneMath, x: V) -> V {
     match math {
         LaneMath::Exact => map(x, f64::ln),
-        LaneMath::Vector => x.ln_poly(),
+        LaneMath::Vector => ln_vector(x),
     }
 }
 
@@ -151,10 +147,87 @@ pub(crate) fn pow_masked<V: Lanes>(math: LaneMath, mask: V, x: V, c: V) -> V {
                 V::splat(0.0)
             } else {
                 let xs = mask.select(x, V::splat(1.0));
-                mask.select((c * xs.ln_poly()).exp_poly(), V::splat(0.0))
+                mask.select(exp_vector(c * ln_vector(xs)), V::splat(0.0))
             }
         }
     }
+}
+
+const LN2_HI: f64 = 6.931_471_803_691_238_164_90e-01;
+const LN2_LO: f64 = 1.908_214_929_270_587_700_02e-10;
+
+/// `e^x` in every lane for [`LaneMath::Vector`]: fdlibm's `exp` (Cody–Waite reduction `x = k·ln 2 + r`,
+/// `|r| ≤ ½ln 2`, with `ln 2` in two parts; the rational form
+/// `e^r = 1 + 2r/(2 − c(r))`, `c(r) = r − r²P(r²)`, `P` of degree 4; scaling by `2^k`
+/// built in the exponent bits). `k` is rounded with the `1.5·2⁵²` trick, so nothing
+/// leaves the vector registers. Lanes with `|x| > 708` or NaN (where `2^k` would not be a
+/// normal number) take the platform's `exp`, one by one.
+#[inline(always)]
+pub fn exp_vector<V: Lanes>(x: V) -> V {
+    let s = V::splat;
+    let y = x * s(core::f64::consts::LOG2_E) + s(ROUND_MAGIC);
+    let k = y - s(ROUND_MAGIC);
+    let hi = x - k * s(LN2_HI);
+    let lo = k * s(LN2_LO);
+    let r = hi - lo;
+    let t = r * r;
+    let c = r - t
+        * (s(1.666_666_666_666_660_190_37e-01)
+            + t * (s(-2.777_777_777_701_559_338_42e-03)
+                + t * (s(6.613_756_321_437_934_361_17e-05)
+                    + t * (s(-1.653_390_220_546_525_153_90e-06)
+                        + t * s(4.138_136_797_057_238_460_39e-08)))));
+    let e = s(1.0) - ((lo - (r * c) / (s(2.0) - c)) - hi);
+    let v = e * y.pow2_from_rounded();
+    let slow = !x.abs().le(s(708.0));
+    patch(v, slow, x, f64::exp)
+}
+
+/// `ln x` in every lane for [`LaneMath::Vector`]: fdlibm's `log` (`x = 2^k(1 + f)` with `1 + f ∈ [√½, √2)`,
+/// `s = f/(2 + f)`, `ln(1 + f) = f − ½f² + s(½f² + R(s²))`, `R` of degree 7, `k·ln 2`
+/// in two parts). The exponent and mantissa come from the bits by lane-wise masks and
+/// shifts. Lanes that are not positive normal numbers (0, subnormal, negative, infinite,
+/// NaN) take the platform's `ln`, one by one.
+#[inline(always)]
+pub fn ln_vector<V: Lanes>(x: V) -> V {
+    let s = V::splat;
+    let mantissa = s(f64::from_bits(0x000f_ffff_ffff_ffff));
+    // 1 + f in [1, 2), then halved (and k raised by one) above √2.
+    let m = (x & mantissa) | s(1.0);
+    let big = m.ge(s(core::f64::consts::SQRT_2));
+    let m = big.select(m * s(0.5), m);
+    let dk = x.exponent_field() - s(1023.0) + big.select(s(1.0), s(0.0));
+    let f = m - s(1.0);
+    let hfsq = s(0.5) * f * f;
+    let sf = f / (s(2.0) + f);
+    let z = sf * sf;
+    let w = z * z;
+    let t1 = w
+        * (s(3.999_999_999_940_941_908e-01)
+            + w * (s(2.222_219_843_214_978_396e-01) + w * s(1.531_383_769_920_937_332e-01)));
+    let t2 = z
+        * (s(6.666_666_666_666_735_130e-01)
+            + w * (s(2.857_142_874_366_239_149e-01)
+                + w * (s(1.818_357_216_161_805_012e-01) + w * s(1.479_819_860_511_658_591e-01))));
+    let rr = t2 + t1;
+    let v = sf * (hfsq + rr) + dk * s(LN2_LO) - hfsq + f + dk * s(LN2_HI);
+    let normal = x.ge(s(f64::MIN_POSITIVE)) & x.lt(s(f64::INFINITY));
+    patch(v, !normal, x, f64::ln)
+}
+
+/// `v` with the lanes of `mask` replaced by `f` of the same lanes of `x` (the slow lanes of
+/// the vector functions, computed one by one).
+#[inline(always)]
+fn patch<V: Lanes>(mut v: V, mask: V, x: V, f: fn(f64) -> f64) -> V {
+    let bits = mask.bits();
+    if bits != 0 {
+        for i in 0..V::LANES {
+            if bits & (1 << i) != 0 {
+                v = v.with_lane(i, f(x.lane(i)));
+            }
+        }
+    }
+    v
 }
 
 #[inline(always)]

@@ -215,11 +215,17 @@ impl<V: Lanes> Packed<V> {
         self.general = general(self.n1) || general(self.n2);
     }
 
-    /// `(ẋ, v̇)` of the oscillator in every lane.
+    /// The forcing `m₀eω²·sin ωt` in every lane.
     #[inline(always)]
-    pub(crate) fn rhs(&self, math: LaneMath, t: V, x: V, v: V) -> (V, V) {
+    pub(crate) fn excitation(&self, t: V) -> V {
+        self.amp * sin(self.omega * t)
+    }
+
+    /// `(ẋ, v̇)` of the oscillator in every lane, with the forcing's value given (the last
+    /// two stages of a step share their time, and so their forcing).
+    #[inline(always)]
+    pub(crate) fn rhs_forced(&self, math: LaneMath, excitation: V, x: V, v: V) -> (V, V) {
         let z = V::splat(0.0);
-        let excitation = self.amp * sin(self.omega * t);
         let spring = self.k * x;
         let damper = self.c * v;
         let friction = self.tf * v / (v * v + self.eps2).sqrt();

@@ -14,13 +14,12 @@
 /// `-C target-cpu`.
 ///
 /// # Same answers on every path
-/// The variants differ in instruction selection only. The `wide` lane types pick their
-/// implementation when the crate is compiled, not per variant, so every variant executes
-/// the same IEEE operations (add, multiply, divide, `sqrt`, compare, blend) in the same
-/// order; Rust never contracts `a·b + c` into a fused multiply-add unless `mul_add` is
-/// called, and the lane loop calls none (`wide`'s polynomials for [`LaneMath::Vector`]
-/// choose fused or unfused operations at compile time too). Results are bit-identical
-/// across the variants in both math modes (tested).
+/// The variants differ in instruction selection only: every variant executes the same
+/// IEEE operations (add, multiply, divide, `sqrt`, compare, blend, integer shifts of the
+/// bits) in the same order; Rust never contracts `a·b + c` into a fused multiply-add
+/// unless `mul_add` is called, and the lane step calls none (also not in the
+/// [`LaneMath::Vector`] functions). Results are bit-identical across the variants in both
+/// math modes (tested).
 ///
 /// [`LaneMath::Vector`]: super::LaneMath::Vector
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
