@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use nonsmooth::study::{
-    Merged, PlanSettings, Shard, Study, StudyError, read_shards, run_shard, run_to_dir,
-    sbatch_script, write_shard,
+    Merged, PlanSettings, Shard, Study, StudyError, compute_point, read_shards, run_shard,
+    run_to_dir, sbatch_script, write_shard,
 };
 
 /// A fresh scratch directory for one test, removed when dropped.
@@ -70,6 +70,54 @@ y = { parameter = "v0", start = -0.1, end = 0.1, points = 5 }
 transient = 300
 record = 40
 "#;
+
+/// The impact surface moves along the grid (lanes are grouped by it) and the last rows of
+/// the amplitude axis are cut short by a step cap (failed points).
+const MOVING_STOP: &str = r#"
+name = "stop"
+[system]
+model = "paper"
+parameters = { omega = 20.5 }
+[grid]
+x = { parameter = "x_i", start = -3e-3, end = -1.5e-3, points = 4 }
+y = { parameter = "omega", start = 19.0, end = 23.0, points = 3 }
+[periods]
+transient = 30
+record = 10
+[record]
+q = { lo = 0.05, hi = 0.3, step = 0.001 }
+"#;
+
+#[test]
+fn lanes_give_the_scalar_records_to_the_bit() {
+    // `run_shard` runs the paper model's points in SIMD lanes; `compute_point` is the
+    // scalar path, point by point. Every field, and every failure message, must agree.
+    let capped = MOVING_STOP.replace(
+        "name = \"stop\"",
+        "name = \"capped\"\n[integration]\nmax_steps = 3000",
+    );
+    for text in [MAP, BASIN, MOVING_STOP, capped.as_str()] {
+        let study = Study::from_toml(text).unwrap();
+        let lanes = run_shard(&study, Shard::WHOLE, || {});
+        assert_eq!(lanes.len(), study.points());
+        let mut failed = 0;
+        for (i, got) in lanes.iter().enumerate() {
+            let want = compute_point(&study, i);
+            // Debug prints every f64 exactly (and NaN as NaN).
+            assert_eq!(
+                format!("{got:?}"),
+                format!("{want:?}"),
+                "point {i} of\n{text}"
+            );
+            failed += usize::from(!got.is_ok());
+        }
+        if text == capped {
+            assert!(failed > 0, "the step cap must fail some points");
+        } else {
+            assert_eq!(failed, 0, "{text}");
+        }
+    }
+}
 
 fn run_in_shards(study: &Study, dir: &Path, n: usize) {
     for i in 1..=n {

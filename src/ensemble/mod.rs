@@ -128,4 +128,4 @@ pub use model::Member;
 pub use simd::Simd;
 #[cfg(feature = "parallel")]
 pub use sweep::sweep_independent_parallel;
-pub use sweep::{IndependentSweep, sweep_independent};
+pub use sweep::{IndependentSweep, sweep_independent, sweep_starts};

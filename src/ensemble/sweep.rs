@@ -248,6 +248,59 @@ pub fn sweep_independent_parallel<V: Lanes>(
     finish(settings, members, &obs, out)
 }
 
+/// Independent starts, each from its own initial state, with a result per start: the
+/// lane form of calling [`run_point`](crate::sweep::run_point) once per start with
+/// [`IndependentSweep::config`]'s settings and `Dopri5` (to the bit with
+/// [`LaneMath::Exact`](super::LaneMath::Exact); the record's `param` is the member's ω).
+/// A start that fails does not stop the others: its entry is the integration error
+/// (what [`run_point`](crate::sweep::run_point) wraps in [`SweepError::Failed`]). This is
+/// what a basin or parameter-plane study runs (`study` feature `cli`).
+///
+/// # Errors
+/// The outer error: [`SweepError`] for invalid settings or no starts.
+pub fn sweep_starts<V: Lanes>(
+    ensemble: &Ensemble,
+    settings: &IndependentSweep,
+    starts: &[(Member, SVector<f64, 2>)],
+    stop: Stop,
+) -> Result<Vec<crate::Result<SweepPoint<2>>>, SweepError> {
+    settings.check()?;
+    if starts.is_empty() {
+        return Err(SweepError::EmptyRange);
+    }
+    let omega0 = starts[0].0.omega();
+    let e = ensemble
+        .clone()
+        .with_event(Event::new(stop, Direction::Rising))
+        .and_then(|e| e.max_steps(settings.max_steps))
+        .map_err(|e| SweepError::failed(omega0, e))?;
+    let periods = f64::from(settings.transient) + f64::from(settings.record);
+    // Starts that cannot begin (a non-finite state) fail alone; the others run.
+    let mut results: Vec<Option<crate::Result<SweepPoint<2>>>> = Vec::with_capacity(starts.len());
+    let (mut jobs, mut obs, mut slot) = (Vec::new(), Vec::new(), Vec::new());
+    for (k, (m, y0)) in starts.iter().enumerate() {
+        match Trajectory::periods(*m, *y0, periods) {
+            Ok(j) => {
+                obs.push(observers(m, settings, stop)?);
+                jobs.push(j);
+                slot.push(k);
+                results.push(None);
+            }
+            Err(err) => results.push(Some(Err(err))),
+        }
+    }
+    if !jobs.is_empty() {
+        let out = e
+            .run::<V, _>(&jobs, &mut obs)
+            .map_err(|e| SweepError::failed(omega0, e))?;
+        for ((k, o), r) in slot.into_iter().zip(&obs).zip(out) {
+            let m = &starts[k].0;
+            results[k] = Some(r.map(|outcome| point(settings, m.omega(), o, &outcome)));
+        }
+    }
+    Ok(results.into_iter().flatten().collect())
+}
+
 /// An error of the whole batch, reported at the first member.
 fn fail_first(members: &[Member], e: crate::Error) -> SweepError {
     SweepError::failed(members.first().map_or(f64::NAN, Member::omega), e)

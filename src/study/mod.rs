@@ -11,7 +11,10 @@
 //! ([`run_point`](crate::sweep::run_point)): the stroboscopic points, the regime (period
 //! detection), impacts per forcing period, optionally the top Lyapunov exponent (two
 //! trajectories from the end of the window) and the entropy index `q*` of the inter-impact
-//! intervals; and the attractor's fingerprint.
+//! intervals; and the attractor's fingerprint. A shard runs the paper model's points in
+//! SIMD lanes ([`ensemble::sweep_starts`](crate::ensemble::sweep_starts), exact math),
+//! 64 points per task, which reproduces [`compute_point`]'s scalar run to the bit (tested
+//! field by field, failures included); the Lyapunov exponent stays a scalar run.
 //!
 //! # Sharding and determinism
 //! Point `i = ix + nx·iy` belongs to shard `I` of `N` when `i ≡ I − 1 (mod N)`
