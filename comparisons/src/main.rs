@@ -136,6 +136,7 @@ struct Args {
     profile: Option<(String, f64, String)>,
     accuracy: Option<(String, f64)>,
     rhs_bench: Option<String>,
+    agreement_only: bool,
 }
 
 fn parse_args() -> Args {
@@ -148,6 +149,7 @@ fn parse_args() -> Args {
         profile: None,
         accuracy: None,
         rhs_bench: None,
+        agreement_only: false,
     };
     let v: Vec<String> = std::env::args().skip(1).collect();
     let mut i = 0;
@@ -184,6 +186,7 @@ fn parse_args() -> Args {
                 ));
                 i += 3;
             }
+            "rhs-agreement" => a.agreement_only = true,
             "rhs-bench" => {
                 a.rhs_bench = Some(v[i + 1].clone());
                 i += 1;
@@ -197,7 +200,7 @@ fn parse_args() -> Args {
             }
             "-h" | "--help" => {
                 println!(
-                    "usage: nonsmooth-comparisons [--reps N] [--budget S] [--rtols a,b] [--only STR]... [--out DIR]\n       nonsmooth-comparisons profile LABEL RTOL [w1|w2]"
+                    "usage: nonsmooth-comparisons [--reps N] [--budget S] [--rtols a,b] [--only STR]... [--out DIR]\n       nonsmooth-comparisons profile LABEL RTOL [w1|w2]\n       nonsmooth-comparisons rhs-agreement"
                 );
                 std::process::exit(0);
             }
@@ -1003,6 +1006,16 @@ fn main() {
     println!(
         "the peers' hand-written RHS vs nonsmooth's: max |Δf| = {dr:.1e} (relative), Jacobian {dj:.1e}"
     );
+    // The README promises bitwise agreement: a peer integrating a different function
+    // would make the table unfair, so a difference stops the run.
+    if dr != 0.0 || dj != 0.0 {
+        eprintln!("the peers' right-hand side or Jacobian differs from nonsmooth's: not comparable");
+        std::process::exit(1);
+    }
+    if args.agreement_only {
+        println!("right-hand side and Jacobian agree to the bit on the grid");
+        return;
+    }
     println!("building the reference (nonsmooth Dop853, rtol {REF_RTOL:e}) ...");
     let t = std::time::Instant::now();
     let reference = reference();
