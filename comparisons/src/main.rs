@@ -1009,7 +1009,9 @@ fn main() {
     // The README promises bitwise agreement: a peer integrating a different function
     // would make the table unfair, so a difference stops the run.
     if dr != 0.0 || dj != 0.0 {
-        eprintln!("the peers' right-hand side or Jacobian differs from nonsmooth's: not comparable");
+        eprintln!(
+            "the peers' right-hand side or Jacobian differs from nonsmooth's: not comparable"
+        );
         std::process::exit(1);
     }
     if args.agreement_only {
