@@ -69,6 +69,9 @@
 //! * [`sweep_independent`] (and [`sweep_independent_parallel`]): a bifurcation sweep with
 //!   independent starts, one parameter value per lane, returning the records of
 //!   [`sweep`](crate::sweep::sweep) — to the bit with [`LaneMath::Exact`].
+//! * [`sweep_starts`]: independent starts, each from its own initial state, with a result
+//!   per start — the points of a basin picture or a parameter plane; the study tool
+//!   (`study`, feature `cli`) runs the paper model's points through it.
 //! * [`tle_independent`] (and [`tle_independent_parallel`]): the two-trajectory top
 //!   exponent of many parameter values from the same start, both copies of every pair in
 //!   lanes, renormalized every interval as
