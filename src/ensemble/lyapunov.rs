@@ -79,15 +79,6 @@ struct Pair {
     stats: Stats,
 }
 
-fn add(s: &mut Stats, o: &Stats) {
-    s.rhs_evals += o.rhs_evals;
-    s.accepted += o.accepted;
-    s.rejected += o.rejected;
-    s.jacobian_evals += o.jacobian_evals;
-    s.decompositions += o.decompositions;
-    s.events += o.events;
-}
-
 fn estimate(
     members: &[Member],
     y0: SVector<f64, 2>,
@@ -169,8 +160,8 @@ fn estimate(
             };
             let (oa, ob) = (ra?, rb?);
             if recording {
-                add(&mut p.stats, &oa.stats);
-                add(&mut p.stats, &ob.stats);
+                p.stats += &oa.stats;
+                p.stats += &ob.stats;
             }
             let a = oa.y;
             let mut delta = ob.y - a;

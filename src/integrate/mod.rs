@@ -325,6 +325,18 @@ pub struct Stats {
     pub events: u64,
 }
 
+impl core::ops::AddAssign<&Stats> for Stats {
+    /// Adds another run's counters (a run made of several integrations).
+    fn add_assign(&mut self, o: &Stats) {
+        self.rhs_evals += o.rhs_evals;
+        self.accepted += o.accepted;
+        self.rejected += o.rejected;
+        self.jacobian_evals += o.jacobian_evals;
+        self.decompositions += o.decompositions;
+        self.events += o.events;
+    }
+}
+
 /// Interpolation inside the last accepted step.
 ///
 /// Valid only for the last accepted step; its span is `[t0, t1]` of that step.

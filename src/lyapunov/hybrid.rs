@@ -50,15 +50,6 @@ impl<T: Real, const N: usize> Observer<T, N> for ResetCount {
     }
 }
 
-fn add_stats(a: &mut Stats, b: &Stats) {
-    a.rhs_evals += b.rhs_evals;
-    a.accepted += b.accepted;
-    a.rejected += b.rejected;
-    a.jacobian_evals += b.jacobian_evals;
-    a.decompositions += b.decompositions;
-    a.events += b.events;
-}
-
 /// The two-trajectory (Benettin) estimate of the top exponent for a system with events and
 /// resets (see the [module docs](self)).
 #[derive(Debug, Clone)]
@@ -144,8 +135,8 @@ where
         let mut t1 = t + tau;
         let oy = self.reference.run(t, y, t1, &mut cy)?;
         let oz = self.perturbed.run(t, z, t1, &mut cz)?;
-        add_stats(stats, &oy.stats);
-        add_stats(stats, &oz.stats);
+        *stats += &oy.stats;
+        *stats += &oz.stats;
         let (mut y1, mut z1) = (oy.y, oz.y);
         let step = tau * lit(1e-3);
         let mut extensions = 0;
@@ -160,8 +151,8 @@ where
             let t2 = t1 + step;
             let oy = self.reference.run(t1, y1, t2, &mut cy)?;
             let oz = self.perturbed.run(t1, z1, t2, &mut cz)?;
-            add_stats(stats, &oy.stats);
-            add_stats(stats, &oz.stats);
+            *stats += &oy.stats;
+            *stats += &oz.stats;
             y1 = oy.y;
             z1 = oz.y;
             t1 = t2;
@@ -418,7 +409,7 @@ where
     fn interval(&mut self, tau: T, stats: &mut Stats) -> Result<[T; K]> {
         let (t, z) = self.state.ok_or(LyapunovError::NotStarted)?;
         let out = self.sim.run(t, z, t + tau, &mut ())?;
-        add_stats(stats, &out.stats);
+        *stats += &out.stats;
         let (y, mut psi) = self.sim.system().split(&out.y);
         let r = gram_schmidt(&mut psi);
         let mut logs = [T::zero(); K];
