@@ -51,14 +51,13 @@ impl IndependentSweep {
     /// # Errors
     /// [`SweepError::NoRecordedPeriods`] if `record == 0`.
     pub fn new(transient: u32, record: u32) -> Result<Self, SweepError> {
-        if record == 0 {
-            return Err(SweepError::NoRecordedPeriods);
-        }
-        Ok(Self {
+        let s = Self {
             transient,
             record,
             ..Self::default()
-        })
+        };
+        s.check()?;
+        Ok(s)
     }
 
     /// Period detection: relative tolerance and largest period tested.
@@ -67,11 +66,9 @@ impl IndependentSweep {
     /// [`SweepError::InvalidPeriodDetection`] unless `tol` is finite and > 0 and
     /// `max_period ≥ 1`.
     pub fn period_detection(mut self, tol: f64, max_period: usize) -> Result<Self, SweepError> {
-        if !(tol.is_finite() && tol > 0.0) || max_period == 0 {
-            return Err(SweepError::InvalidPeriodDetection { tol, max_period });
-        }
         self.period_tol = tol;
         self.max_period = max_period;
+        self.check()?;
         Ok(self)
     }
 
@@ -97,10 +94,9 @@ impl IndependentSweep {
             .map(|c| c.max_steps(self.max_steps))
     }
 
+    /// The settings checked by [`SweepConfig`]'s own rules (one place for them).
     fn check(&self) -> Result<(), SweepError> {
-        Self::new(self.transient, self.record)?
-            .period_detection(self.period_tol, self.max_period)?;
-        Ok(())
+        self.config(vec![0.0]).map(|_| ())
     }
 }
 
@@ -220,11 +216,11 @@ pub fn sweep_independent<V: Lanes>(
     y0: SVector<f64, 2>,
     stop: Stop,
 ) -> Result<Vec<SweepPoint<2>>, SweepError> {
-    let (e, jobs, mut obs) = prepare(ensemble, settings, members, y0, stop)?;
-    let out = e
-        .run::<V, _>(&jobs, &mut obs)
-        .map_err(|e| fail_first(members, e))?;
-    finish(settings, members, &obs, out)
+    let starts: Vec<_> = members.iter().map(|m| (*m, y0)).collect();
+    first_failure(
+        &starts,
+        run_starts::<V>(ensemble, settings, &starts, stop, None)?,
+    )
 }
 
 /// [`sweep_independent`] over the threads of the current rayon pool, `chunk` members per
@@ -241,11 +237,23 @@ pub fn sweep_independent_parallel<V: Lanes>(
     stop: Stop,
     chunk: usize,
 ) -> Result<Vec<SweepPoint<2>>, SweepError> {
-    let (e, jobs, mut obs) = prepare(ensemble, settings, members, y0, stop)?;
-    let out = e
-        .run_parallel::<V, _>(&jobs, &mut obs, chunk)
-        .map_err(|e| fail_first(members, e))?;
-    finish(settings, members, &obs, out)
+    let starts: Vec<_> = members.iter().map(|m| (*m, y0)).collect();
+    first_failure(
+        &starts,
+        run_starts::<V>(ensemble, settings, &starts, stop, Some(chunk))?,
+    )
+}
+
+/// The records, or the first failure in start order (reported at its member's ω).
+fn first_failure(
+    starts: &[(Member, SVector<f64, 2>)],
+    results: Vec<crate::Result<SweepPoint<2>>>,
+) -> Result<Vec<SweepPoint<2>>, SweepError> {
+    starts
+        .iter()
+        .zip(results)
+        .map(|((m, _), r)| r.map_err(|e| SweepError::failed(m.omega(), e)))
+        .collect()
 }
 
 /// Independent starts, each from its own initial state, with a result per start: the
@@ -264,16 +272,29 @@ pub fn sweep_starts<V: Lanes>(
     starts: &[(Member, SVector<f64, 2>)],
     stop: Stop,
 ) -> Result<Vec<crate::Result<SweepPoint<2>>>, SweepError> {
+    run_starts::<V>(ensemble, settings, starts, stop, None)
+}
+
+/// The lane runs of every start: on the calling thread, or over the rayon pool with
+/// `chunk` starts per task.
+fn run_starts<V: Lanes>(
+    ensemble: &Ensemble,
+    settings: &IndependentSweep,
+    starts: &[(Member, SVector<f64, 2>)],
+    stop: Stop,
+    chunk: Option<usize>,
+) -> Result<Vec<crate::Result<SweepPoint<2>>>, SweepError> {
     settings.check()?;
     if starts.is_empty() {
         return Err(SweepError::EmptyRange);
     }
     let omega0 = starts[0].0.omega();
+    let batch_error = |e| SweepError::failed(omega0, e);
     let e = ensemble
         .clone()
         .with_event(Event::new(stop, Direction::Rising))
         .and_then(|e| e.max_steps(settings.max_steps))
-        .map_err(|e| SweepError::failed(omega0, e))?;
+        .map_err(batch_error)?;
     let periods = f64::from(settings.transient) + f64::from(settings.record);
     // Starts that cannot begin (a non-finite state) fail alone; the others run.
     let mut results: Vec<Option<crate::Result<SweepPoint<2>>>> = Vec::with_capacity(starts.len());
@@ -290,67 +311,18 @@ pub fn sweep_starts<V: Lanes>(
         }
     }
     if !jobs.is_empty() {
-        let out = e
-            .run::<V, _>(&jobs, &mut obs)
-            .map_err(|e| SweepError::failed(omega0, e))?;
+        let out = match chunk {
+            None => e.run::<V, _>(&jobs, &mut obs),
+            #[cfg(feature = "parallel")]
+            Some(c) => e.run_parallel::<V, _>(&jobs, &mut obs, c),
+            #[cfg(not(feature = "parallel"))]
+            Some(_) => e.run::<V, _>(&jobs, &mut obs),
+        }
+        .map_err(batch_error)?;
         for ((k, o), r) in slot.into_iter().zip(&obs).zip(out) {
             let m = &starts[k].0;
             results[k] = Some(r.map(|outcome| point(settings, m.omega(), o, &outcome)));
         }
     }
     Ok(results.into_iter().flatten().collect())
-}
-
-/// An error of the whole batch, reported at the first member.
-fn fail_first(members: &[Member], e: crate::Error) -> SweepError {
-    SweepError::failed(members.first().map_or(f64::NAN, Member::omega), e)
-}
-
-type Prepared = (Ensemble<Stop>, Vec<Trajectory>, Vec<PointObserver>);
-
-/// The ensemble with the impact event, the trajectories and their observers.
-fn prepare(
-    ensemble: &Ensemble,
-    settings: &IndependentSweep,
-    members: &[Member],
-    y0: SVector<f64, 2>,
-    stop: Stop,
-) -> Result<Prepared, SweepError> {
-    settings.check()?;
-    if members.is_empty() {
-        return Err(SweepError::EmptyRange);
-    }
-    let e = ensemble
-        .clone()
-        .with_event(Event::new(stop, Direction::Rising))
-        .and_then(|e| e.max_steps(settings.max_steps))
-        .map_err(|e| fail_first(members, e))?;
-    let periods = f64::from(settings.transient) + f64::from(settings.record);
-    let mut jobs = Vec::with_capacity(members.len());
-    let mut obs = Vec::with_capacity(members.len());
-    for m in members {
-        obs.push(observers(m, settings, stop)?);
-        jobs.push(
-            Trajectory::periods(*m, y0, periods).map_err(|e| SweepError::failed(m.omega(), e))?,
-        );
-    }
-    Ok((e, jobs, obs))
-}
-
-/// The records, or the first failure in member order.
-fn finish(
-    settings: &IndependentSweep,
-    members: &[Member],
-    obs: &[PointObserver],
-    out: Vec<crate::Result<Outcome<f64, 2>>>,
-) -> Result<Vec<SweepPoint<2>>, SweepError> {
-    members
-        .iter()
-        .zip(obs)
-        .zip(out)
-        .map(|((m, o), r)| {
-            let outcome = r.map_err(|e| SweepError::failed(m.omega(), e))?;
-            Ok(point(settings, m.omega(), o, &outcome))
-        })
-        .collect()
 }
