@@ -13,7 +13,7 @@ use crate::entropy::{Histogram, QRange, entropy_index};
 use crate::integrate::{Dopri5, Tolerances};
 use crate::lyapunov::{Norm, TwoTrajectory};
 use crate::sample::Regime;
-use crate::sweep::{Stop, SweepConfig, SweepError, SweepPoint, SweepSystem, run_point};
+use crate::sweep::{Stop, SweepError, SweepPoint, SweepSystem, run_point};
 use crate::systems::paper::PaperParameters;
 
 /// What one grid point gave. Every field is a function of the spec and the point index
@@ -150,7 +150,7 @@ fn fill(y0: Option<[f64; 2]>, rest: [f64; 2]) -> Vector2<f64> {
 }
 
 /// The integration tolerances and the sweep settings of every point.
-fn integration(study: &Study) -> Result<(Tolerances<f64, 2>, SweepConfig), String> {
+fn integration(study: &Study) -> Result<(Tolerances<f64, 2>, IndependentSweep), String> {
     let spec = study.spec();
     let s = |e: &dyn std::fmt::Display| e.to_string();
     let rtol = spec.integration.rtol;
@@ -159,12 +159,11 @@ fn integration(study: &Study) -> Result<(Tolerances<f64, 2>, SweepConfig), Strin
         [a[0] * rtol, a[1] * rtol]
     });
     let tol = Tolerances::per_component(rtol, atol).map_err(|e| s(&e))?;
-    let cfg = SweepConfig::new(vec![0.0])
-        .and_then(|c| c.record(spec.periods.record))
+    let settings = IndependentSweep::new(spec.periods.transient, spec.periods.record)
         .and_then(|c| c.period_detection(spec.record.period_tol, spec.record.max_period))
         .map_err(|e| s(&e))?
         .max_steps(spec.integration.max_steps);
-    Ok((tol, cfg))
+    Ok((tol, settings))
 }
 
 fn run_model<S, F>(
@@ -180,7 +179,8 @@ where
     F: Fn() -> crate::Result<S>,
 {
     let s = |e: &dyn std::fmt::Display| e.to_string();
-    let (tol, cfg) = integration(study)?;
+    let (tol, settings) = integration(study)?;
+    let cfg = settings.config(vec![0.0]).map_err(|e| s(&e))?;
     let system = make().map_err(|e| s(&e))?;
     let pt = run_point(
         &cfg,
@@ -192,7 +192,7 @@ where
         },
         Dopri5::new(tol),
         y0,
-        study.spec().periods.transient,
+        settings.transient,
     )
     .map_err(|e| s(&e))?;
     Ok(record(study, index, make, period, &tol, &pt))
@@ -353,7 +353,7 @@ pub fn run_shard<F: Fn() + Sync>(study: &Study, shard: Shard, progress: F) -> Ve
 /// The paper model's points `indices` in lanes: the records of [`compute_point`], to the
 /// bit, with the same messages for what fails.
 fn paper_batch(study: &Study, indices: &[usize]) -> Vec<PointRecord> {
-    let (tol, _) = match integration(study) {
+    let (tol, settings) = match integration(study) {
         Ok(v) => v,
         Err(m) => {
             return indices
@@ -362,10 +362,6 @@ fn paper_batch(study: &Study, indices: &[usize]) -> Vec<PointRecord> {
                 .collect();
         }
     };
-    let spec = study.spec();
-    let settings = IndependentSweep::new(spec.periods.transient, spec.periods.record)
-        .and_then(|c| c.period_detection(spec.record.period_tol, spec.record.max_period))
-        .map(|c| c.max_steps(spec.integration.max_steps));
     let mut recs: Vec<Option<PointRecord>> = vec![None; indices.len()];
     // One impact surface per batch of lanes: points are grouped by x_I (a grid axis may
     // move it).
@@ -384,14 +380,15 @@ fn paper_batch(study: &Study, indices: &[usize]) -> Vec<PointRecord> {
     for group in groups.values() {
         let stop = impact_stop(group[0].1.params());
         let starts: Vec<(Member, Vector2<f64>)> = group.iter().map(|(_, m, y)| (*m, *y)).collect();
-        let run = settings.clone().and_then(|settings| {
-            let e = Ensemble::new(tol).map_err(|e| SweepError::failed(0.0, e))?;
-            if wide {
-                sweep_starts::<F64x16>(&e, &settings, &starts, stop)
-            } else {
-                sweep_starts::<F64x8>(&e, &settings, &starts, stop)
-            }
-        });
+        let run = Ensemble::new(tol)
+            .map_err(|e| SweepError::failed(0.0, e))
+            .and_then(|e| {
+                if wide {
+                    sweep_starts::<F64x16>(&e, &settings, &starts, stop)
+                } else {
+                    sweep_starts::<F64x8>(&e, &settings, &starts, stop)
+                }
+            });
         match run {
             Err(e) => {
                 for (k, _, _) in group {
