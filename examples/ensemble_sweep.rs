@@ -58,25 +58,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let e = Ensemble::new(tol)?;
     // Sixteen lanes pay on AVX-512, eight on AVX2 (see the `ensemble` module docs).
     let wide = Simd::Auto.resolve() == Simd::Avx512;
-    let lanes = if wide {
-        nonsmooth::ensemble::sweep_independent_parallel::<F64x16>(
-            &e,
-            &settings,
-            &members,
-            y0,
-            stop(),
-            32,
-        )?
+    let sweep_lanes = if wide {
+        nonsmooth::ensemble::sweep_independent_parallel::<F64x16>
     } else {
-        nonsmooth::ensemble::sweep_independent_parallel::<F64x8>(
-            &e,
-            &settings,
-            &members,
-            y0,
-            stop(),
-            16,
-        )?
+        nonsmooth::ensemble::sweep_independent_parallel::<F64x8>
     };
+    let chunk = if wide { 32 } else { 16 };
+    let lanes = sweep_lanes(&e, &settings, &members, y0, stop(), chunk)?;
     let t_lanes = start.elapsed().as_secs_f64();
     println!(
         "independent starts, ensemble ({} lanes, exact): {t_lanes:7.2} s",

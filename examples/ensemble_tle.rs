@@ -51,30 +51,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // so the vector math costs nothing in agreement; sixteen lanes pay on AVX-512.
     let e = Ensemble::new(tol)?.with_math(LaneMath::Vector);
     let wide = Simd::Auto.resolve() == Simd::Avx512;
-    let run = |chunk| {
-        if wide {
-            nonsmooth::ensemble::tle_independent_parallel::<F64x16>(
-                &e,
-                &members,
-                y0,
-                PAPER_D0,
-                Norm::paper(),
-                &settings,
-                chunk,
-            )
-        } else {
-            nonsmooth::ensemble::tle_independent_parallel::<F64x8>(
-                &e,
-                &members,
-                y0,
-                PAPER_D0,
-                Norm::paper(),
-                &settings,
-                chunk,
-            )
-        }
+    let tle = if wide {
+        nonsmooth::ensemble::tle_independent_parallel::<F64x16>
+    } else {
+        nonsmooth::ensemble::tle_independent_parallel::<F64x8>
     };
-    let lanes = run(64)?;
+    let lanes = tle(&e, &members, y0, PAPER_D0, Norm::paper(), &settings, 64)?;
     let t_lanes = start.elapsed().as_secs_f64();
     println!(
         "independent starts, ensemble ({} lanes, vector math): {t_lanes:7.2} s",
