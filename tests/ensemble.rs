@@ -522,6 +522,15 @@ fn vector_exp_and_ln_against_libm() {
         -744.0,
         1e-300,
         1.0,
+        // The edges of ln's bit test for positive normal numbers.
+        f64::from_bits(f64::MIN_POSITIVE.to_bits() - 1),
+        -5e-324,
+        -f64::MIN_POSITIVE,
+        -f64::MAX,
+        f64::from_bits(0xfff8_0000_0000_0000),
+        f64::from_bits(0x7ff0_0000_0000_0001),
+        f64::from_bits(f64::INFINITY.to_bits() - 1),
+        2.0 * f64::MIN_POSITIVE,
     ];
     for c in special.chunks(8) {
         let v = F64x8::load(c);

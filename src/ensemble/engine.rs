@@ -341,7 +341,11 @@ struct Engine<'a, V: Lanes, G> {
     jobs: &'a [Trajectory],
     next: usize,
     slots: Vec<Slot>,
-    st: LaneState<V>,
+    /// On the heap, like the step's output: on the stack, the speed of the vector step
+    /// depended on where the stack began (the program's path and environment) by up to
+    /// 30 % (measured with AVX2, 16 lanes: 0.38–0.50 s for the same binary); boxed, it
+    /// stays at the fast end.
+    st: Box<LaneState<V>>,
     consts: StepConsts,
 }
 
@@ -354,6 +358,18 @@ fn sign_of(x: f64) -> i8 {
     } else {
         0
     }
+}
+
+/// The lanes whose bit is set in `mask`, in increasing order.
+#[inline(always)]
+fn lanes_of(mut mask: u32) -> impl Iterator<Item = usize> {
+    core::iter::from_fn(move || {
+        (mask != 0).then(|| {
+            let i = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            i
+        })
+    })
 }
 
 /// The next landing point after `t` (the driver's rule), capped at `t_end`.
@@ -383,7 +399,7 @@ impl<'a, V: Lanes, G: EventFunction<f64, 2>> Engine<'a, V, G> {
             jobs,
             next: 0,
             slots: (0..V::LANES).map(|_| Slot::idle()).collect(),
-            st: LaneState {
+            st: Box::new(LaneState {
                 packed,
                 t: V::splat(t),
                 x: V::splat(x),
@@ -395,7 +411,7 @@ impl<'a, V: Lanes, G: EventFunction<f64, 2>> Engine<'a, V, G> {
                 ln_err_old: V::splat(1e-4f64.ln()),
                 rej_last: z,
                 active: z,
-            },
+            }),
             consts: StepConsts::new(&cfg.tol, &cfg.opts, cfg.math, cfg.simd),
         }
     }
@@ -547,32 +563,28 @@ impl<'a, V: Lanes, G: EventFunction<f64, 2>> Engine<'a, V, G> {
         for i in 0..V::LANES {
             self.fill(i, observers, out);
         }
-        let mut step = StepOut::new();
+        let mut step = Box::new(StepOut::new());
         while self.st.active.bits() != 0 {
-            let act = self.st.active.bits();
             V::step_lanes(&mut self.st, &self.consts, &mut step);
             if step.too_small != 0 {
-                for i in 0..V::LANES {
-                    if step.too_small & (1 << i) != 0 {
-                        let e = IntegrateError::StepSizeTooSmall {
-                            t: step.buf[row::T0][i],
-                            h: step.buf[row::H][i],
-                        };
-                        self.finish(i, Err(e.into()), observers, out);
-                    }
+                for i in lanes_of(step.too_small) {
+                    let e = IntegrateError::StepSizeTooSmall {
+                        t: step.buf[row::T0][i],
+                        h: step.buf[row::H][i],
+                    };
+                    self.finish(i, Err(e.into()), observers, out);
                 }
                 continue;
             }
-            for i in 0..V::LANES {
-                if act & (1 << i) != 0 {
-                    self.slots[i].stats.rhs_evals += 6;
-                }
-                if step.rejected & (1 << i) != 0 {
-                    self.slots[i].stats.rejected += 1;
-                }
+            // Every active lane made one trial step (six evaluations): rejected here,
+            // accepted in after_step. Only the lanes named by the masks are visited.
+            for i in lanes_of(step.rejected) {
+                let slot = &mut self.slots[i];
+                slot.stats.rhs_evals += 6;
+                slot.stats.rejected += 1;
                 if step.non_finite & (1 << i) != 0 {
-                    self.slots[i].nonfinite += 1;
-                    if self.slots[i].nonfinite > 20 {
+                    slot.nonfinite += 1;
+                    if slot.nonfinite > 20 {
                         let e = IntegrateError::NonFiniteRhs {
                             t: step.buf[row::T0][i],
                         };
@@ -580,14 +592,7 @@ impl<'a, V: Lanes, G: EventFunction<f64, 2>> Engine<'a, V, G> {
                     }
                 }
             }
-            if step.accepted == 0 {
-                continue;
-            }
-            #[allow(clippy::needless_range_loop)]
-            for i in 0..V::LANES {
-                if step.accepted & (1 << i) == 0 {
-                    continue;
-                }
+            for i in lanes_of(step.accepted) {
                 let g = |k: usize| step.buf[k][i];
                 let sv = |k: usize| SVector::<f64, 2>::new(g(k), g(k + 1));
                 let dense = LaneDense {
@@ -618,6 +623,7 @@ impl<'a, V: Lanes, G: EventFunction<f64, 2>> Engine<'a, V, G> {
     ) {
         let Some(j) = self.slots[i].job else { return };
         let slot = &mut self.slots[i];
+        slot.stats.rhs_evals += 6;
         slot.stats.accepted += 1;
         slot.steps += 1;
         slot.nonfinite = 0;

@@ -17,6 +17,8 @@ pub(crate) mod sealed {
         /// The biased exponent field `bits(x) >> 52` as an `f64` (exact; the sign bit must
         /// be clear), lane-wise.
         fn exponent_field(self) -> Self;
+        /// The bits plus `c` (wrapping), as an `f64`, lane-wise.
+        fn add_bits(self, c: u64) -> Self;
     }
 }
 
@@ -192,6 +194,10 @@ macro_rules! lanes_type {
             #[inline(always)]
             fn pow2_from_rounded(self) -> Self {
                 self.map(|y| f64::from_bits(y.to_bits().wrapping_add(1023) << 52))
+            }
+            #[inline(always)]
+            fn add_bits(self, c: u64) -> Self {
+                self.map(|x| f64::from_bits(x.to_bits().wrapping_add(c)))
             }
             #[inline(always)]
             fn exponent_field(self) -> Self {
