@@ -475,41 +475,14 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
         Ok(())
     }
 
+    /// The driver's loop: a step to the next landing point, then the step's events and
+    /// observer ([`scan_step`](Self::scan_step)), until the end, a stop or an error.
     fn advance<O: Observer<T, N>>(&mut self, t_end: T, observer: &mut O) -> Result<Outcome<T, N>> {
         let stats0 = *self.stepper.stats();
-        let n_ev = E::LEN;
-        // Per event: the side (+1/−1) of the surface the trajectory is on (used when g is
-        // exactly zero at a step boundary; 0 = not known yet, for a start exactly on the
-        // surface), and whether it is armed (false right after a reset that left the state
-        // on the far side while moving back out).
-        let mut side = [0i8; MAX_EVENTS];
-        let mut armed = [true; MAX_EVENTS];
-        {
-            let (t, y) = self.stepper.current();
-            let mut f = SVector::zeros();
-            let mut have_f = false;
-            for (i, s) in side.iter_mut().enumerate().take(n_ev) {
-                let g = self.events.value(i, t, y);
-                if !g.is_finite() {
-                    return Err(non_finite(i, t, g));
-                }
-                *s = sign_of(g);
-                if *s == 0 {
-                    // Start on the surface: it has not been crossed; the side is the one
-                    // the trajectory moves to (from the rate, else from the first step).
-                    if !have_f {
-                        self.system.rhs(t, y, &mut f);
-                        have_f = true;
-                    }
-                    if let Some(r) = self.events.rate(i, t, y, &f) {
-                        *s = sign_of(r);
-                    }
-                }
-            }
-        }
+        let mut sides = self.initial_sides()?;
         let mut steps = 0usize;
         let mut termination = Termination::ReachedEnd;
-        'outer: loop {
+        loop {
             let t_now = self.stepper.current().0;
             if t_now >= t_end {
                 break;
@@ -521,20 +494,7 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
                 }
                 .into());
             }
-            let limit = match self.grid {
-                Some((o, dt)) => {
-                    let k = ((t_now - o) / dt).floor() + T::one();
-                    let mut next = o + k * dt;
-                    if next
-                        <= t_now * (T::one() + lit::<T>(4.0) * T::default_epsilon())
-                            + T::default_epsilon() * dt
-                    {
-                        next = o + (k + T::one()) * dt;
-                    }
-                    next.min(t_end)
-                }
-                None => t_end,
-            };
+            let limit = landing_limit(t_now, t_end, self.grid);
             // Events with a time scale (moving surfaces) bound the step.
             let limit = match self.events.max_step(t_now) {
                 Some(h) => limit.min(t_now + h),
@@ -542,255 +502,8 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
             };
             self.stepper.step(&self.system, limit)?;
             steps += 1;
-            let dense = self.stepper.dense();
-            let (ts0, ts1) = dense.span();
-            let (y_start, y_end) = dense.endpoints();
-            let (f_start, f_end) = dense.end_derivatives();
-            let (y_start, y_end, f_start, f_end) = (*y_start, *y_end, *f_start, *f_end);
-            // Scan starts per event, and the crossing found from each (cached).
-            let mut st_t = [ts0; MAX_EVENTS];
-            let mut st_g = [T::zero(); MAX_EVENTS];
-            let mut st_r = [None; MAX_EVENTS];
-            let mut g_end = [T::zero(); MAX_EVENTS];
-            let mut r_end = [None; MAX_EVENTS];
-            let mut found: [Option<Crossing<T>>; MAX_EVENTS] = [None; MAX_EVENTS];
-            for i in 0..n_ev {
-                let g0 = self.events.value(i, ts0, &y_start);
-                g_end[i] = self.events.value(i, ts1, &y_end);
-                if !(g0.is_finite() && g_end[i].is_finite()) {
-                    let (t, g) = if g0.is_finite() {
-                        (ts1, g_end[i])
-                    } else {
-                        (ts0, g0)
-                    };
-                    return Err(non_finite(i, t, g));
-                }
-                if side[i] == 0 {
-                    // Started on the surface with no rate: the side is where it goes.
-                    side[i] = if g_end[i] != T::zero() {
-                        sign_of(g_end[i])
-                    } else {
-                        1
-                    };
-                }
-                st_g[i] = if g0 == T::zero() {
-                    signed_tiny(side[i])
-                } else {
-                    g0
-                };
-                st_r[i] = self.events.rate(i, ts0, &y_start, &f_start);
-                r_end[i] = self.events.rate(i, ts1, &y_end, &f_end);
-                found[i] =
-                    self.find_crossing(i, st_t[i], st_g[i], st_r[i], ts1, g_end[i], r_end[i]);
-            }
-            let mut t_lo = ts0;
-            let mut y_lo = y_start;
-            loop {
-                let mut best: Option<(usize, Crossing<T>)> = None;
-                for (i, f) in found.iter().enumerate().take(n_ev) {
-                    if let Some(c) = f {
-                        if best.is_none_or(|(_, b)| c.t < b.t) {
-                            best = Some((i, *c));
-                        }
-                    }
-                }
-                let Some((i, c)) = best else { break };
-                // Where the scan of event i resumes (None: no further crossing this step).
-                found[i] = match c.resume {
-                    Some((tr, gr)) => {
-                        st_t[i] = tr;
-                        st_g[i] = gr;
-                        st_r[i] = None;
-                        self.find_crossing(i, tr, gr, None, ts1, g_end[i], r_end[i])
-                    }
-                    None => None,
-                };
-                let was_armed = armed[i];
-                armed[i] = true;
-                side[i] = if c.rising { 1 } else { -1 };
-                if !was_armed || !self.events.direction(i).accepts(c.rising) {
-                    // Re-arming crossing (the exit after a reset) or an unwanted direction.
-                    continue;
-                }
-                let tc = c.t;
-                let dense = self.stepper.dense();
-                let mut yc = SVector::zeros();
-                dense.interpolate_unchecked(tc, &mut yc);
-                let view = StepView {
-                    t0: t_lo,
-                    t1: tc,
-                    y0: y_lo,
-                    y1: yc,
-                    dense,
-                };
-                let stop_obs = observer.on_step(&view) == Control::Stop;
-                let direction = if c.rising {
-                    Direction::Rising
-                } else {
-                    Direction::Falling
-                };
-                self.stepper.stats_mut().events += 1;
-                if let Some((count, last)) = self.history.push(tc, &self.zeno) {
-                    // Leave the simulation at the event (after its reset) so that the
-                    // caller can change the model and continue from there.
-                    let mut ya = yc;
-                    if self.events.resets(i) {
-                        self.events.apply_reset(i, tc, &mut ya);
-                    }
-                    self.stepper.reset_state(tc, ya);
-                    return Err(EventError::Zeno {
-                        t: to_f64(tc),
-                        count,
-                        last_interval: to_f64(last),
-                        state: ya.iter().map(|&v| to_f64(v)).collect(),
-                    }
-                    .into());
-                }
-                if self.events.resets(i) {
-                    let mut ya = yc;
-                    self.events.apply_reset(i, tc, &mut ya);
-                    let rec = EventRecord {
-                        index: i,
-                        t: tc,
-                        y: yc,
-                        y_after: Some(ya),
-                        direction,
-                    };
-                    let stop_ev = observer.on_event(&rec) == Control::Stop;
-                    self.stepper.reset_state(tc, ya);
-                    let mut fa = SVector::zeros();
-                    self.system.rhs(tc, &ya, &mut fa);
-                    self.stepper.stats_mut().rhs_evals += 1;
-                    for (j, s) in side.iter_mut().enumerate().take(n_ev) {
-                        let g = self.events.value(j, tc, &ya);
-                        if g != T::zero() {
-                            *s = sign_of(g);
-                        }
-                        if j == i {
-                            // Left on the far side but moving back out: disarmed until it
-                            // has crossed back.
-                            let r = self.events.rate(j, tc, &ya, &fa).unwrap_or(T::zero());
-                            armed[j] =
-                                !(g != T::zero() && r != T::zero() && sign_of(g) != sign_of(r));
-                            if g == T::zero() && r != T::zero() {
-                                *s = sign_of(r);
-                            }
-                        }
-                    }
-                    if self.events.is_terminal(i) {
-                        termination = Termination::TerminalEvent(i);
-                        break 'outer;
-                    }
-                    if stop_obs || stop_ev {
-                        termination = Termination::ObserverStopped;
-                        break 'outer;
-                    }
-                    continue 'outer;
-                }
-                let rec = EventRecord {
-                    index: i,
-                    t: tc,
-                    y: yc,
-                    y_after: None,
-                    direction,
-                };
-                let stop_ev = observer.on_event(&rec) == Control::Stop;
-                if self.events.restarts(i) && !(self.events.is_terminal(i) || stop_obs || stop_ev) {
-                    // A switching point: cut the step here and start the next one on it.
-                    self.stepper.reset_state(tc, yc);
-                    continue 'outer;
-                }
-                if self.events.is_terminal(i) || stop_obs || stop_ev {
-                    // Rewind the stepper to the event.
-                    self.stepper.reset_state(tc, yc);
-                    termination = if self.events.is_terminal(i) {
-                        Termination::TerminalEvent(i)
-                    } else {
-                        Termination::ObserverStopped
-                    };
-                    break 'outer;
-                }
-                t_lo = tc;
-                y_lo = yc;
-            }
-            // Sticking: an event disarmed after a reset (or an impact event on its far side),
-            // still on the far side at the step end and moving deeper again, never left the
-            // surface: the reset could not separate the trajectory from it. Never silence: stop where it turned (the
-            // extremum of g on the dense output), with the state to go on from.
-            for i in 0..n_ev {
-                // For an impact (a resetting event with a direction) the far side is the
-                // wrong side at any step end: its crossings are reset away from it.
-                let wrong_side = match self.events.direction(i) {
-                    Direction::Rising => 1,
-                    Direction::Falling => -1,
-                    Direction::Either => 0,
-                };
-                let stuck = if !armed[i] {
-                    true
-                } else {
-                    self.events.resets(i) && sign_of(g_end[i]) == wrong_side
-                };
-                if stuck
-                    && g_end[i] != T::zero()
-                    && r_end[i].is_some_and(|r| r != T::zero() && sign_of(r) == sign_of(g_end[i]))
-                {
-                    let dense = self.stepper.dense();
-                    let tol = self
-                        .event_tol
-                        .max(lit::<T>(4.0) * T::default_epsilon() * ts1.abs());
-                    let sg = if g_end[i] > T::zero() {
-                        T::one()
-                    } else {
-                        -T::one()
-                    };
-                    let events = &self.events;
-                    let (te, _) = crate::roots::golden_max(
-                        |t| {
-                            let mut y = SVector::<T, N>::zeros();
-                            dense.interpolate_unchecked(t, &mut y);
-                            -sg * events.value(i, t, &y)
-                        },
-                        t_lo,
-                        ts1,
-                        tol,
-                    );
-                    let mut ye = SVector::zeros();
-                    dense.interpolate_unchecked(te, &mut ye);
-                    let view = StepView {
-                        t0: t_lo,
-                        t1: te,
-                        y0: y_lo,
-                        y1: ye,
-                        dense,
-                    };
-                    observer.on_step(&view);
-                    let depth = self.events.value(i, te, &ye).abs();
-                    self.stepper.reset_state(te, ye);
-                    return Err(EventError::Sticking {
-                        index: i,
-                        t: to_f64(te),
-                        depth: to_f64(depth),
-                        state: ye.iter().map(|&v| to_f64(v)).collect(),
-                    }
-                    .into());
-                }
-            }
-            let dense = self.stepper.dense();
-            let view = StepView {
-                t0: t_lo,
-                t1: ts1,
-                y0: y_lo,
-                y1: y_end,
-                dense,
-            };
-            let stop = observer.on_step(&view) == Control::Stop;
-            for (i, s) in side.iter_mut().enumerate().take(n_ev) {
-                if g_end[i] != T::zero() {
-                    *s = sign_of(g_end[i]);
-                }
-            }
-            if stop {
-                termination = Termination::ObserverStopped;
+            if let Some(t) = self.scan_step(&mut sides, observer)? {
+                termination = t;
                 break;
             }
         }
@@ -812,6 +525,322 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
         };
         observer.on_finish(&out);
         Ok(out)
+    }
+
+    /// Each event's side at the current state, every event armed.
+    fn initial_sides(&self) -> Result<Sides> {
+        let mut sides = Sides {
+            side: [0; MAX_EVENTS],
+            armed: [true; MAX_EVENTS],
+        };
+        let (t, y) = self.stepper.current();
+        let mut f = SVector::zeros();
+        let mut have_f = false;
+        for (i, s) in sides.side.iter_mut().enumerate().take(E::LEN) {
+            let g = self.events.value(i, t, y);
+            if !g.is_finite() {
+                return Err(non_finite(i, t, g));
+            }
+            *s = sign_of(g);
+            if *s == 0 {
+                // Start on the surface: it has not been crossed; the side is the one
+                // the trajectory moves to (from the rate, else from the first step).
+                if !have_f {
+                    self.system.rhs(t, y, &mut f);
+                    have_f = true;
+                }
+                if let Some(r) = self.events.rate(i, t, y, &f) {
+                    *s = sign_of(r);
+                }
+            }
+        }
+        Ok(sides)
+    }
+
+    /// The events and observer calls of the step just taken: its crossings in time order
+    /// ([`crossings`](Self::crossings)), the sticking check, then the observer's view of
+    /// the rest of the step. Returns how the run ends, if it ends here.
+    fn scan_step<O: Observer<T, N>>(
+        &mut self,
+        sides: &mut Sides,
+        observer: &mut O,
+    ) -> Result<Option<Termination>> {
+        let mut scan = self.start_scan(sides)?;
+        let (t_lo, y_lo) = match self.crossings(&mut scan, sides, observer)? {
+            Crossings::Through(t_lo, y_lo) => (t_lo, y_lo),
+            // The state was reset or cut at an event: the next step starts there.
+            Crossings::Cut => return Ok(None),
+            Crossings::End(t) => return Ok(Some(t)),
+        };
+        self.check_sticking(&scan, sides, t_lo, y_lo, observer)?;
+        let dense = self.stepper.dense();
+        let view = StepView {
+            t0: t_lo,
+            t1: scan.t1,
+            y0: y_lo,
+            y1: scan.y1,
+            dense,
+        };
+        let stop = observer.on_step(&view) == Control::Stop;
+        for (i, s) in sides.side.iter_mut().enumerate().take(E::LEN) {
+            if scan.g_end[i] != T::zero() {
+                *s = sign_of(scan.g_end[i]);
+            }
+        }
+        Ok(stop.then_some(Termination::ObserverStopped))
+    }
+
+    /// Every event's values and rates at both ends of the step and its first crossing.
+    fn start_scan(&self, sides: &mut Sides) -> Result<StepScan<T, N>> {
+        let dense = self.stepper.dense();
+        let (ts0, ts1) = dense.span();
+        let (y_start, y_end) = dense.endpoints();
+        let (f_start, f_end) = dense.end_derivatives();
+        let (y_start, y_end, f_start, f_end) = (*y_start, *y_end, *f_start, *f_end);
+        let mut scan = StepScan {
+            t0: ts0,
+            t1: ts1,
+            y0: y_start,
+            y1: y_end,
+            g_end: [T::zero(); MAX_EVENTS],
+            r_end: [None; MAX_EVENTS],
+            found: [None; MAX_EVENTS],
+        };
+        for i in 0..E::LEN {
+            let g0 = self.events.value(i, ts0, &y_start);
+            let ge = self.events.value(i, ts1, &y_end);
+            scan.g_end[i] = ge;
+            if !(g0.is_finite() && ge.is_finite()) {
+                let (t, g) = if g0.is_finite() { (ts1, ge) } else { (ts0, g0) };
+                return Err(non_finite(i, t, g));
+            }
+            if sides.side[i] == 0 {
+                // Started on the surface with no rate: the side is where it goes.
+                sides.side[i] = if ge != T::zero() { sign_of(ge) } else { 1 };
+            }
+            let st_g = if g0 == T::zero() {
+                signed_tiny(sides.side[i])
+            } else {
+                g0
+            };
+            let st_r = self.events.rate(i, ts0, &y_start, &f_start);
+            scan.r_end[i] = self.events.rate(i, ts1, &y_end, &f_end);
+            scan.found[i] = self.find_crossing(i, ts0, st_g, st_r, ts1, ge, scan.r_end[i]);
+        }
+        Ok(scan)
+    }
+
+    /// The step's crossings, earliest first: the observer's view up to each accepted one,
+    /// its record, its reset (which ends the step there), a restart, a terminal event or
+    /// an observer's stop. Returns where the step's last piece starts if it goes on to the
+    /// step's end.
+    fn crossings<O: Observer<T, N>>(
+        &mut self,
+        scan: &mut StepScan<T, N>,
+        sides: &mut Sides,
+        observer: &mut O,
+    ) -> Result<Crossings<T, N>> {
+        let n_ev = E::LEN;
+        let mut t_lo = scan.t0;
+        let mut y_lo = scan.y0;
+        loop {
+            let mut best: Option<(usize, Crossing<T>)> = None;
+            for (i, f) in scan.found.iter().enumerate().take(n_ev) {
+                if let Some(c) = f {
+                    if best.is_none_or(|(_, b)| c.t < b.t) {
+                        best = Some((i, *c));
+                    }
+                }
+            }
+            let Some((i, c)) = best else {
+                return Ok(Crossings::Through(t_lo, y_lo));
+            };
+            // Where the scan of event i resumes (None: no further crossing this step).
+            scan.found[i] = match c.resume {
+                Some((tr, gr)) => {
+                    self.find_crossing(i, tr, gr, None, scan.t1, scan.g_end[i], scan.r_end[i])
+                }
+                None => None,
+            };
+            let was_armed = sides.armed[i];
+            sides.armed[i] = true;
+            sides.side[i] = if c.rising { 1 } else { -1 };
+            if !was_armed || !self.events.direction(i).accepts(c.rising) {
+                // Re-arming crossing (the exit after a reset) or an unwanted direction.
+                continue;
+            }
+            let tc = c.t;
+            let dense = self.stepper.dense();
+            let mut yc = SVector::zeros();
+            dense.interpolate_unchecked(tc, &mut yc);
+            let view = StepView {
+                t0: t_lo,
+                t1: tc,
+                y0: y_lo,
+                y1: yc,
+                dense,
+            };
+            let stop_obs = observer.on_step(&view) == Control::Stop;
+            let direction = if c.rising {
+                Direction::Rising
+            } else {
+                Direction::Falling
+            };
+            self.stepper.stats_mut().events += 1;
+            if let Some((count, last)) = self.history.push(tc, &self.zeno) {
+                // Leave the simulation at the event (after its reset) so that the
+                // caller can change the model and continue from there.
+                let mut ya = yc;
+                if self.events.resets(i) {
+                    self.events.apply_reset(i, tc, &mut ya);
+                }
+                self.stepper.reset_state(tc, ya);
+                return Err(EventError::Zeno {
+                    t: to_f64(tc),
+                    count,
+                    last_interval: to_f64(last),
+                    state: ya.iter().map(|&v| to_f64(v)).collect(),
+                }
+                .into());
+            }
+            let terminal = self.events.is_terminal(i);
+            if self.events.resets(i) {
+                let mut ya = yc;
+                self.events.apply_reset(i, tc, &mut ya);
+                let rec = EventRecord {
+                    index: i,
+                    t: tc,
+                    y: yc,
+                    y_after: Some(ya),
+                    direction,
+                };
+                let stop_ev = observer.on_event(&rec) == Control::Stop;
+                self.stepper.reset_state(tc, ya);
+                self.after_reset(i, tc, &ya, sides);
+                return Ok(if terminal {
+                    Crossings::End(Termination::TerminalEvent(i))
+                } else if stop_obs || stop_ev {
+                    Crossings::End(Termination::ObserverStopped)
+                } else {
+                    Crossings::Cut
+                });
+            }
+            let rec = EventRecord {
+                index: i,
+                t: tc,
+                y: yc,
+                y_after: None,
+                direction,
+            };
+            let stop_ev = observer.on_event(&rec) == Control::Stop;
+            if self.events.restarts(i) && !(terminal || stop_obs || stop_ev) {
+                // A switching point: cut the step here and start the next one on it.
+                self.stepper.reset_state(tc, yc);
+                return Ok(Crossings::Cut);
+            }
+            if terminal || stop_obs || stop_ev {
+                // Rewind the stepper to the event.
+                self.stepper.reset_state(tc, yc);
+                return Ok(Crossings::End(if terminal {
+                    Termination::TerminalEvent(i)
+                } else {
+                    Termination::ObserverStopped
+                }));
+            }
+            t_lo = tc;
+            y_lo = yc;
+        }
+    }
+
+    /// The sides after event `i`'s reset to `ya` at `tc`; event `i` is disarmed if the
+    /// reset left the state on the far side while moving back out.
+    fn after_reset(&mut self, i: usize, tc: T, ya: &SVector<T, N>, sides: &mut Sides) {
+        let mut fa = SVector::zeros();
+        self.system.rhs(tc, ya, &mut fa);
+        self.stepper.stats_mut().rhs_evals += 1;
+        for (j, s) in sides.side.iter_mut().enumerate().take(E::LEN) {
+            let g = self.events.value(j, tc, ya);
+            if g != T::zero() {
+                *s = sign_of(g);
+            }
+            if j == i {
+                // Left on the far side but moving back out: disarmed until it has
+                // crossed back.
+                let r = self.events.rate(j, tc, ya, &fa).unwrap_or(T::zero());
+                sides.armed[j] = !(g != T::zero() && r != T::zero() && sign_of(g) != sign_of(r));
+                if g == T::zero() && r != T::zero() {
+                    *s = sign_of(r);
+                }
+            }
+        }
+    }
+
+    /// Sticking: an event disarmed after a reset (or an impact event on its far side),
+    /// still on the far side at the step end and moving deeper again, never left the
+    /// surface: the reset could not separate the trajectory from it. Never silent: stops
+    /// where it turned (the extremum of g on the dense output), with the state to go on
+    /// from, and an [`EventError::Sticking`].
+    fn check_sticking<O: Observer<T, N>>(
+        &mut self,
+        scan: &StepScan<T, N>,
+        sides: &Sides,
+        t_lo: T,
+        y_lo: SVector<T, N>,
+        observer: &mut O,
+    ) -> Result<()> {
+        for i in 0..E::LEN {
+            // For an impact (a resetting event with a direction) the far side is the
+            // wrong side at any step end: its crossings are reset away from it.
+            let wrong_side = match self.events.direction(i) {
+                Direction::Rising => 1,
+                Direction::Falling => -1,
+                Direction::Either => 0,
+            };
+            let (ge, re) = (scan.g_end[i], scan.r_end[i]);
+            let stuck = !sides.armed[i] || (self.events.resets(i) && sign_of(ge) == wrong_side);
+            if !(stuck
+                && ge != T::zero()
+                && re.is_some_and(|r| r != T::zero() && sign_of(r) == sign_of(ge)))
+            {
+                continue;
+            }
+            let dense = self.stepper.dense();
+            let tol = self
+                .event_tol
+                .max(lit::<T>(4.0) * T::default_epsilon() * scan.t1.abs());
+            let sg = if ge > T::zero() { T::one() } else { -T::one() };
+            let events = &self.events;
+            let (te, _) = crate::roots::golden_max(
+                |t| {
+                    let mut y = SVector::<T, N>::zeros();
+                    dense.interpolate_unchecked(t, &mut y);
+                    -sg * events.value(i, t, &y)
+                },
+                t_lo,
+                scan.t1,
+                tol,
+            );
+            let mut ye = SVector::zeros();
+            dense.interpolate_unchecked(te, &mut ye);
+            let view = StepView {
+                t0: t_lo,
+                t1: te,
+                y0: y_lo,
+                y1: ye,
+                dense,
+            };
+            observer.on_step(&view);
+            let depth = self.events.value(i, te, &ye).abs();
+            self.stepper.reset_state(te, ye);
+            return Err(EventError::Sticking {
+                index: i,
+                t: to_f64(te),
+                depth: to_f64(depth),
+                state: ye.iter().map(|&v| to_f64(v)).collect(),
+            }
+            .into());
+        }
+        Ok(())
     }
 
     /// The earliest crossing (any direction) of event `i` in `(t_lo, t1]`, starting from
@@ -929,6 +958,59 @@ fn non_finite<T: Real>(index: usize, t: T, g: T) -> crate::Error {
         value: to_f64(g),
     }
     .into()
+}
+
+/// The next landing point after `t` on the grid `origin + k·dt` (computed from `k`,
+/// never accumulated; a point within rounding of `t` is skipped), capped at `t_end`;
+/// `t_end` without a grid. The driver's rule, also used by the ensemble's lanes.
+#[inline]
+pub(crate) fn landing_limit<T: Real>(t: T, t_end: T, grid: Option<(T, T)>) -> T {
+    match grid {
+        Some((o, dt)) => {
+            let k = ((t - o) / dt).floor() + T::one();
+            let mut next = o + k * dt;
+            if next
+                <= t * (T::one() + lit::<T>(4.0) * T::default_epsilon()) + T::default_epsilon() * dt
+            {
+                next = o + (k + T::one()) * dt;
+            }
+            next.min(t_end)
+        }
+        None => t_end,
+    }
+}
+
+/// Each event's side of its surface (+1/−1; 0 = not known yet, for a start exactly on it,
+/// used when g is exactly zero at a step boundary) and whether it is armed (false right
+/// after a reset that left the state on the far side while moving back out). Carried
+/// from step to step.
+#[derive(Debug, Clone, Copy)]
+struct Sides {
+    side: [i8; MAX_EVENTS],
+    armed: [bool; MAX_EVENTS],
+}
+
+/// One step's event data: its ends, each event's value and rate at the end, and the next
+/// crossing found for each (cached while earlier crossings are handled).
+#[derive(Debug, Clone, Copy)]
+struct StepScan<T: Real, const N: usize> {
+    t0: T,
+    t1: T,
+    y0: SVector<T, N>,
+    y1: SVector<T, N>,
+    g_end: [T; MAX_EVENTS],
+    r_end: [Option<T>; MAX_EVENTS],
+    found: [Option<Crossing<T>>; MAX_EVENTS],
+}
+
+/// How a step's crossings ended.
+enum Crossings<T: Real, const N: usize> {
+    /// No crossing stopped the step: its last piece starts at this time and state.
+    Through(T, SVector<T, N>),
+    /// The state was reset or restarted at an event: the next step starts there.
+    Cut,
+    /// The run ends.
+    End(Termination),
 }
 
 /// A crossing found on a step.

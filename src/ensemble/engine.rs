@@ -6,7 +6,7 @@ use super::kernel::{ALL, LaneState, StepConsts, StepOut, row};
 use super::math::LaneMath;
 use super::model::{Member, Packed, scalar_rhs};
 use super::{Lanes, Simd};
-use crate::drive::{Control, EventRecord, Observer, Outcome, StepView, Termination};
+use crate::drive::{Control, EventRecord, Observer, Outcome, StepView, Termination, landing_limit};
 use crate::error::{ParameterError, Result};
 use crate::event::{Direction, Event, EventError, EventFunction, EventHistory, ZenoGuard, locate};
 use crate::integrate::{DenseOutput, IntegrateError, Stats, StepOptions, Tolerances};
@@ -372,21 +372,6 @@ fn lanes_of(mut mask: u32) -> impl Iterator<Item = usize> {
     })
 }
 
-/// The next landing point after `t` (the driver's rule), capped at `t_end`.
-fn next_limit(t: f64, t_end: f64, grid: Option<(f64, f64)>) -> f64 {
-    match grid {
-        Some((o, dt)) => {
-            let k = ((t - o) / dt).floor() + 1.0;
-            let mut next = o + k * dt;
-            if next <= t * (1.0 + 4.0 * f64::EPSILON) + f64::EPSILON * dt {
-                next = o + (k + 1.0) * dt;
-            }
-            next.min(t_end)
-        }
-        None => t_end,
-    }
-}
-
 impl<'a, V: Lanes, G: EventFunction<f64, 2>> Engine<'a, V, G> {
     fn new(cfg: &'a Ensemble<G>, jobs: &'a [Trajectory], first: &Trajectory) -> Self {
         let z = V::splat(0.0);
@@ -493,7 +478,7 @@ impl<'a, V: Lanes, G: EventFunction<f64, 2>> Engine<'a, V, G> {
         if !(f0[0].is_finite() && f0[1].is_finite()) {
             return Err(IntegrateError::NonFiniteRhs { t: t0 }.into());
         }
-        let limit = next_limit(t0, t_end, job.grid);
+        let limit = landing_limit(t0, t_end, job.grid);
         let h = match cfg.opts.h_init {
             Some(h) => h,
             None => crate::integrate::initial_step(
@@ -652,7 +637,7 @@ impl<'a, V: Lanes, G: EventFunction<f64, 2>> Engine<'a, V, G> {
                     let limit = self.st.limit.lane(i);
                     let scale = t1.abs() + slot.grid.map_or(0.0, |(o, dt)| o.abs() + dt);
                     if limit - t1 <= 64.0 * f64::EPSILON * scale {
-                        let l = next_limit(t1, slot.t_end, slot.grid);
+                        let l = landing_limit(t1, slot.t_end, slot.grid);
                         self.st.limit = self.st.limit.with_lane(i, l);
                     }
                 }
