@@ -7,10 +7,9 @@ use nalgebra::SVector;
 
 use super::{
     Controller, Core, DenseOutput, HermiteDense, IntegrateError, Stats, StepOptions, Stepper,
-    Tolerances, adaptive_checks, adaptive_constructors, all_finite, clamp_to_limit, core_accessors,
-    dense_endpoints, step_too_small,
+    Tolerances, Trial, adaptive_checks, adaptive_constructors, core_accessors, dense_endpoints,
 };
-use crate::scalar::{lit, to_f64};
+use crate::scalar::lit;
 use crate::{Dynamics, Real};
 
 const C: [f64; 16] = [
@@ -323,92 +322,76 @@ impl<T: Real, const N: usize> Stepper<T, N> for Dop853<T, N> {
     fn step<S: Dynamics<T, N>>(&mut self, sys: &S, t_limit: T) -> Result<(), IntegrateError> {
         self.core.begin(sys, t_limit)?;
         let (t, y) = (self.core.t, self.core.y);
-        let mut h = self
+        let h = self
             .core
             .proposed(sys, 8, &self.tol, self.ctrl.opts.h_max, t_limit);
         let mut k = [SVector::<T, N>::zeros(); 16];
         k[0] = self.core.f;
-        let mut nonfinite = 0u32;
-        loop {
-            let (hs, lands) = clamp_to_limit(t, h, t_limit);
-            if step_too_small(t, hs, self.ctrl.opts.h_min) && !lands {
-                return Err(IntegrateError::StepSizeTooSmall {
-                    t: to_f64(t),
-                    h: to_f64(hs),
-                });
-            }
-            for i in 1..12 {
-                Self::stage(sys, t, &y, hs, &mut k, i);
-            }
-            let mut inc = SVector::<T, N>::zeros();
-            for &(j, a) in A[12] {
-                inc += k[j] * lit::<T>(a);
-            }
-            let y_new = y + inc * hs;
-            let t_new = if lands { t_limit } else { t + hs };
-            let mut f_new = SVector::zeros();
-            sys.rhs(t_new, &y_new, &mut f_new);
-            self.core.stats.rhs_evals += 12;
-            let err = if all_finite(&y_new) && all_finite(&f_new) {
-                let mut e3 = inc;
-                for &(j, b) in &BHH {
-                    e3 -= k[j] * lit::<T>(b);
-                }
-                let mut e5 = SVector::<T, N>::zeros();
-                for &(j, e) in &E5 {
-                    e5 += k[j] * lit::<T>(e);
-                }
-                let (mut s5, mut s3) = (T::zero(), T::zero());
-                for i in 0..N {
-                    let sk = self.tol.atol[i] + self.tol.rtol[i] * y[i].abs().max(y_new[i].abs());
-                    s3 += (e3[i] / sk) * (e3[i] / sk);
-                    s5 += (e5[i] / sk) * (e5[i] / sk);
-                }
-                let mut deno = s5 + lit::<T>(0.01) * s3;
-                if deno <= T::zero() {
-                    deno = T::one();
-                }
-                hs.abs() * s5 * (T::one() / (lit::<T>(N as f64) * deno)).sqrt()
-            } else {
-                nonfinite += 1;
-                if nonfinite > 20 {
-                    return Err(IntegrateError::NonFiniteRhs { t: to_f64(t) });
-                }
-                crate::scalar::nan()
-            };
-            let (accept, h_next) = self.ctrl.propose(err, hs);
-            if accept {
-                k[12] = f_new;
-                for i in 13..16 {
+        let tol = &self.tol;
+        let a = self
+            .core
+            .adapt(&mut self.ctrl, t_limit, h, |stats, hs, t_new| {
+                for i in 1..12 {
                     Self::stage(sys, t, &y, hs, &mut k, i);
                 }
-                self.core.stats.rhs_evals += 3;
-                let ydiff = y_new - y;
-                let bspl = k[0] * hs - ydiff;
-                let mut r = [SVector::<T, N>::zeros(); 7];
-                r[0] = ydiff;
-                r[1] = bspl;
-                r[2] = ydiff - f_new * hs - bspl;
-                for (m, drow) in D.iter().enumerate() {
-                    let mut acc = SVector::<T, N>::zeros();
-                    for (j, &d) in drow.iter().enumerate() {
-                        if d != 0.0 {
-                            acc += k[j] * lit::<T>(d);
-                        }
-                    }
-                    r[3 + m] = acc * hs;
+                let mut inc = SVector::<T, N>::zeros();
+                for &(j, a) in A[12] {
+                    inc += k[j] * lit::<T>(a);
                 }
-                self.dense = Dop853Dense {
-                    ends: HermiteDense::new(t, t_new, y, y_new, k[0], f_new),
-                    h: hs,
-                    r,
-                };
-                self.core.accept(t_new, y_new, f_new, h_next, lands, h);
-                return Ok(());
-            }
-            self.core.stats.rejected += 1;
-            h = h_next;
+                let y_new = y + inc * hs;
+                let mut f_new = SVector::zeros();
+                sys.rhs(t_new, &y_new, &mut f_new);
+                stats.rhs_evals += 12;
+                Ok(Trial::new(y_new, f_new, || {
+                    let mut e3 = inc;
+                    for &(j, b) in &BHH {
+                        e3 -= k[j] * lit::<T>(b);
+                    }
+                    let mut e5 = SVector::<T, N>::zeros();
+                    for &(j, e) in &E5 {
+                        e5 += k[j] * lit::<T>(e);
+                    }
+                    let (mut s5, mut s3) = (T::zero(), T::zero());
+                    for i in 0..N {
+                        let sk = tol.atol[i] + tol.rtol[i] * y[i].abs().max(y_new[i].abs());
+                        s3 += (e3[i] / sk) * (e3[i] / sk);
+                        s5 += (e5[i] / sk) * (e5[i] / sk);
+                    }
+                    let mut deno = s5 + lit::<T>(0.01) * s3;
+                    if deno <= T::zero() {
+                        deno = T::one();
+                    }
+                    hs.abs() * s5 * (T::one() / (lit::<T>(N as f64) * deno)).sqrt()
+                }))
+            })?;
+        let (hs, y_new, f_new) = (a.hs, a.y, a.f);
+        k[12] = f_new;
+        for i in 13..16 {
+            Self::stage(sys, t, &y, hs, &mut k, i);
         }
+        self.core.stats.rhs_evals += 3;
+        let ydiff = y_new - y;
+        let bspl = k[0] * hs - ydiff;
+        let mut r = [SVector::<T, N>::zeros(); 7];
+        r[0] = ydiff;
+        r[1] = bspl;
+        r[2] = ydiff - f_new * hs - bspl;
+        for (m, drow) in D.iter().enumerate() {
+            let mut acc = SVector::<T, N>::zeros();
+            for (j, &d) in drow.iter().enumerate() {
+                if d != 0.0 {
+                    acc += k[j] * lit::<T>(d);
+                }
+            }
+            r[3 + m] = acc * hs;
+        }
+        self.dense = Dop853Dense {
+            ends: HermiteDense::new(t, a.t_new, y, y_new, k[0], f_new),
+            h: hs,
+            r,
+        };
+        self.core.accept(&a);
+        Ok(())
     }
 
     fn order(&self) -> u8 {

@@ -4,10 +4,9 @@ use nalgebra::SVector;
 
 use super::{
     Controller, Core, DenseOutput, HermiteDense, IntegrateError, Stats, StepOptions, Stepper,
-    Tolerances, adaptive_checks, adaptive_constructors, all_finite, clamp_to_limit, core_accessors,
-    dense_endpoints, step_too_small,
+    Tolerances, Trial, adaptive_checks, adaptive_constructors, core_accessors, dense_endpoints,
 };
-use crate::scalar::{lit, to_f64};
+use crate::scalar::lit;
 use crate::{Dynamics, Real};
 
 /// The Dormand–Prince 5(4) tableau and Hairer's dense-output coefficients (shared with the
@@ -128,7 +127,7 @@ impl<T: Real, const N: usize> Stepper<T, N> for Dopri5<T, N> {
     fn step<S: Dynamics<T, N>>(&mut self, sys: &S, t_limit: T) -> Result<(), IntegrateError> {
         self.core.begin(sys, t_limit)?;
         let (t, y, k1) = (self.core.t, self.core.y, self.core.f);
-        let mut h = self
+        let h = self
             .core
             .proposed(sys, 5, &self.tol, self.ctrl.opts.h_max, t_limit);
         let c = |x: f64| lit::<T>(x);
@@ -146,58 +145,42 @@ impl<T: Real, const N: usize> Stepper<T, N> for Dopri5<T, N> {
         let mut k5 = SVector::zeros();
         let mut k6 = SVector::zeros();
         let mut k7 = SVector::zeros();
-        let mut nonfinite = 0u32;
-        loop {
-            let (hs, lands) = clamp_to_limit(t, h, t_limit);
-            if step_too_small(t, hs, self.ctrl.opts.h_min) && !lands {
-                return Err(IntegrateError::StepSizeTooSmall {
-                    t: to_f64(t),
-                    h: to_f64(hs),
-                });
-            }
-            let yt = y + k1 * (a21 * hs);
-            sys.rhs(t + c2 * hs, &yt, &mut k2);
-            let yt = y + (k1 * a31 + k2 * a32) * hs;
-            sys.rhs(t + c3 * hs, &yt, &mut k3);
-            let yt = y + (k1 * a41 + k2 * a42 + k3 * a43) * hs;
-            sys.rhs(t + c4 * hs, &yt, &mut k4);
-            let yt = y + (k1 * a51 + k2 * a52 + k3 * a53 + k4 * a54) * hs;
-            sys.rhs(t + c5 * hs, &yt, &mut k5);
-            let yt = y + (k1 * a61 + k2 * a62 + k3 * a63 + k4 * a64 + k5 * a65) * hs;
-            let t_new = if lands { t_limit } else { t + hs };
-            sys.rhs(t_new, &yt, &mut k6);
-            let y_new = y + (k1 * a71 + k3 * a73 + k4 * a74 + k5 * a75 + k6 * a76) * hs;
-            sys.rhs(t_new, &y_new, &mut k7);
-            self.core.stats.rhs_evals += 6;
-            let errv = (k1 * e1 + k3 * e3 + k4 * e4 + k5 * e5 + k6 * e6 + k7 * e7) * hs;
-            let err = if all_finite(&y_new) && all_finite(&k7) {
-                self.tol.error_norm(&errv, &y, &y_new)
-            } else {
-                nonfinite += 1;
-                if nonfinite > 20 {
-                    return Err(IntegrateError::NonFiniteRhs { t: to_f64(t) });
-                }
-                crate::scalar::nan()
-            };
-            let (accept, h_next) = self.ctrl.propose(err, hs);
-            if accept {
-                let ydiff = y_new - y;
-                let bspl = k1 * hs - ydiff;
-                let [d1, d3, d4, d5, d6, d7] = tableau::D.map(c);
-                self.dense = Dopri5Dense {
-                    ends: HermiteDense::new(t, t_new, y, y_new, k1, k7),
-                    h: hs,
-                    r2: ydiff,
-                    r3: bspl,
-                    r4: ydiff - k7 * hs - bspl,
-                    r5: (k1 * d1 + k3 * d3 + k4 * d4 + k5 * d5 + k6 * d6 + k7 * d7) * hs,
-                };
-                self.core.accept(t_new, y_new, k7, h_next, lands, h);
-                return Ok(());
-            }
-            self.core.stats.rejected += 1;
-            h = h_next;
-        }
+        let tol = &self.tol;
+        let a = self
+            .core
+            .adapt(&mut self.ctrl, t_limit, h, |stats, hs, t_new| {
+                let yt = y + k1 * (a21 * hs);
+                sys.rhs(t + c2 * hs, &yt, &mut k2);
+                let yt = y + (k1 * a31 + k2 * a32) * hs;
+                sys.rhs(t + c3 * hs, &yt, &mut k3);
+                let yt = y + (k1 * a41 + k2 * a42 + k3 * a43) * hs;
+                sys.rhs(t + c4 * hs, &yt, &mut k4);
+                let yt = y + (k1 * a51 + k2 * a52 + k3 * a53 + k4 * a54) * hs;
+                sys.rhs(t + c5 * hs, &yt, &mut k5);
+                let yt = y + (k1 * a61 + k2 * a62 + k3 * a63 + k4 * a64 + k5 * a65) * hs;
+                sys.rhs(t_new, &yt, &mut k6);
+                let y_new = y + (k1 * a71 + k3 * a73 + k4 * a74 + k5 * a75 + k6 * a76) * hs;
+                sys.rhs(t_new, &y_new, &mut k7);
+                stats.rhs_evals += 6;
+                Ok(Trial::new(y_new, k7, || {
+                    let errv = (k1 * e1 + k3 * e3 + k4 * e4 + k5 * e5 + k6 * e6 + k7 * e7) * hs;
+                    tol.error_norm(&errv, &y, &y_new)
+                }))
+            })?;
+        let (hs, y_new) = (a.hs, a.y);
+        let ydiff = y_new - y;
+        let bspl = k1 * hs - ydiff;
+        let [d1, d3, d4, d5, d6, d7] = tableau::D.map(c);
+        self.dense = Dopri5Dense {
+            ends: HermiteDense::new(t, a.t_new, y, y_new, k1, k7),
+            h: hs,
+            r2: ydiff,
+            r3: bspl,
+            r4: ydiff - k7 * hs - bspl,
+            r5: (k1 * d1 + k3 * d3 + k4 * d4 + k5 * d5 + k6 * d6 + k7 * d7) * hs,
+        };
+        self.core.accept(&a);
+        Ok(())
     }
 
     fn order(&self) -> u8 {

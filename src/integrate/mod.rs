@@ -560,25 +560,105 @@ impl<T: Real, const N: usize> Core<T, N> {
         }
     }
 
+    /// The adaptive retry loop of every embedded stepper: trial steps from the proposal
+    /// `h`, each cut to land on `t_limit` when it would reach it ([`clamp_to_limit`]), the
+    /// rejected ones retried with the controller's smaller step, until one is accepted.
+    /// `trial(stats, hs, t_new)` computes one trial step of size `hs` ending at `t_new`
+    /// (counting its own work in `stats`). A step below the minimum, or more than 20
+    /// non-finite trials in a row, end the step with an error: it never loops without
+    /// progress. The accepted trial is returned for the stepper's dense output and
+    /// [`accept`](Self::accept).
+    #[inline(always)]
+    pub(crate) fn adapt<F>(
+        &mut self,
+        ctrl: &mut Controller<T>,
+        t_limit: T,
+        mut h: T,
+        mut trial: F,
+    ) -> Result<Accepted<T, N>, IntegrateError>
+    where
+        F: FnMut(&mut Stats, T, T) -> Result<Trial<T, N>, IntegrateError>,
+    {
+        let t = self.t;
+        let mut nonfinite = 0u32;
+        loop {
+            let (hs, lands) = clamp_to_limit(t, h, t_limit);
+            if step_too_small(t, hs, ctrl.opts.h_min) && !lands {
+                return Err(IntegrateError::StepSizeTooSmall {
+                    t: to_f64(t),
+                    h: to_f64(hs),
+                });
+            }
+            let t_new = if lands { t_limit } else { t + hs };
+            let tr = trial(&mut self.stats, hs, t_new)?;
+            let err = match tr.err {
+                Some(e) => e,
+                None => {
+                    nonfinite += 1;
+                    if nonfinite > 20 {
+                        return Err(IntegrateError::NonFiniteRhs { t: to_f64(t) });
+                    }
+                    crate::scalar::nan()
+                }
+            };
+            let (accept, h_next) = ctrl.propose(err, hs);
+            if accept {
+                return Ok(Accepted {
+                    hs,
+                    t_new,
+                    lands,
+                    h,
+                    h_next,
+                    y: tr.y,
+                    f: tr.f,
+                });
+            }
+            self.stats.rejected += 1;
+            h = h_next;
+        }
+    }
+
     /// Takes an accepted step: the new state and derivative, and the next proposed step
     /// (not shrunk below the untruncated proposal `h` when the step was cut to land on the
     /// limit).
     #[inline(always)]
-    pub(crate) fn accept(
-        &mut self,
-        t: T,
-        y: SVector<T, N>,
-        f: SVector<T, N>,
-        h_next: T,
-        lands: bool,
-        h: T,
-    ) {
-        self.t = t;
-        self.y = y;
-        self.f = f;
-        self.h = Some(if lands { h_next.max(h) } else { h_next });
+    pub(crate) fn accept(&mut self, a: &Accepted<T, N>) {
+        self.t = a.t_new;
+        self.y = a.y;
+        self.f = a.f;
+        self.h = Some(if a.lands { a.h_next.max(a.h) } else { a.h_next });
         self.stats.accepted += 1;
     }
+}
+
+/// One trial step: the new state, its derivative, and the error norm (`None` where the
+/// state or the derivative is not finite).
+pub(crate) struct Trial<T: Real, const N: usize> {
+    pub(crate) y: SVector<T, N>,
+    pub(crate) f: SVector<T, N>,
+    pub(crate) err: Option<T>,
+}
+
+impl<T: Real, const N: usize> Trial<T, N> {
+    /// The trial `(y, f)`, with the error norm `err()` computed only where both are finite.
+    #[inline(always)]
+    pub(crate) fn new(y: SVector<T, N>, f: SVector<T, N>, err: impl FnOnce() -> T) -> Self {
+        let err = (all_finite(&y) && all_finite(&f)).then(err);
+        Self { y, f, err }
+    }
+}
+
+/// The accepted trial of [`Core::adapt`]: its size `hs`, end `t_new`, whether it was cut
+/// to land on the limit, the untruncated proposal `h`, the controller's next step, and
+/// the new state and derivative.
+pub(crate) struct Accepted<T: Real, const N: usize> {
+    pub(crate) hs: T,
+    pub(crate) t_new: T,
+    pub(crate) lands: bool,
+    pub(crate) h: T,
+    pub(crate) h_next: T,
+    pub(crate) y: SVector<T, N>,
+    pub(crate) f: SVector<T, N>,
 }
 
 /// The accessors every stepper implements the same way from its `core` and `dense` fields.

@@ -2,7 +2,9 @@
 
 use nalgebra::SVector;
 
-use super::{Core, DenseOutput, IntegrateError, Stats, Stepper, all_finite, core_accessors};
+use super::{
+    Accepted, Core, DenseOutput, IntegrateError, Stats, Stepper, all_finite, core_accessors,
+};
 use crate::error::ParameterError;
 use crate::scalar::{lit, to_f64};
 use crate::validate::positive;
@@ -148,7 +150,15 @@ impl<T: Real, const N: usize> Stepper<T, N> for Rk4<T, N> {
             return Err(IntegrateError::NonFiniteRhs { t: to_f64(t) });
         }
         self.dense = HermiteDense::new(t, t_new, y, y_new, k1, f_new);
-        self.core.accept(t_new, y_new, f_new, self.h, false, self.h);
+        self.core.accept(&Accepted {
+            hs: self.h,
+            t_new,
+            lands: false,
+            h: self.h,
+            h_next: self.h,
+            y: y_new,
+            f: f_new,
+        });
         Ok(())
     }
 

@@ -4,8 +4,7 @@ use nalgebra::{SMatrix, SVector};
 
 use super::{
     Controller, Core, DenseOutput, HermiteDense, IntegrateError, Stats, StepOptions, Stepper,
-    Tolerances, adaptive_checks, adaptive_constructors, all_finite, clamp_to_limit, core_accessors,
-    dense_endpoints, step_too_small,
+    Tolerances, Trial, adaptive_checks, adaptive_constructors, core_accessors, dense_endpoints,
 };
 use crate::linalg::Lu;
 use crate::scalar::{epsilon, lit, to_f64};
@@ -136,7 +135,7 @@ impl<T: Real, const N: usize> Stepper<T, N> for Rosenbrock23<T, N> {
         self.core.begin(sys, t_limit)?;
         let (t, y) = (self.core.t, self.core.y);
         let f0 = self.core.f;
-        let mut h = self
+        let h = self
             .core
             .proposed(sys, 2, &self.tol, self.ctrl.opts.h_max, t_limit);
         let jac = self.jacobian(sys, t, &y, &f0);
@@ -147,54 +146,38 @@ impl<T: Real, const N: usize> Stepper<T, N> for Rosenbrock23<T, N> {
         let two = lit::<T>(2.0);
         let mut f1 = SVector::zeros();
         let mut f2 = SVector::zeros();
-        let mut nonfinite = 0u32;
-        loop {
-            let (hs, lands) = clamp_to_limit(t, h, t_limit);
-            if step_too_small(t, hs, self.ctrl.opts.h_min) && !lands {
-                return Err(IntegrateError::StepSizeTooSmall {
-                    t: to_f64(t),
-                    h: to_f64(hs),
-                });
-            }
-            let w = SMatrix::<T, N, N>::identity() - jac * (hs * d);
-            let Some(lu) = Lu::new(w) else {
-                return Err(IntegrateError::SingularMatrix { t: to_f64(t) });
-            };
-            self.core.stats.decompositions += 1;
-            let hdt = tdot * (hs * d);
-            let k1 = lu.solve(&(f0 + hdt));
-            sys.rhs(t + half * hs, &(y + k1 * (half * hs)), &mut f1);
-            let k2m = lu.solve(&(f1 - k1));
-            let k2 = k2m + k1;
-            let y_new = y + k2 * hs;
-            let t_new = if lands { t_limit } else { t + hs };
-            sys.rhs(t_new, &y_new, &mut f2);
-            self.core.stats.rhs_evals += 2;
-            let k3 = lu.solve(&(f2 - (k2 - f1) * e32 - (k1 - f0) * two + hdt));
-            let err = if all_finite(&y_new) && all_finite(&f2) {
-                let errv = (k1 - k2 * two + k3) * (hs / lit::<T>(6.0));
-                self.tol.error_norm(&errv, &y, &y_new)
-            } else {
-                nonfinite += 1;
-                if nonfinite > 20 {
-                    return Err(IntegrateError::NonFiniteRhs { t: to_f64(t) });
-                }
-                crate::scalar::nan()
-            };
-            let (accept, h_next) = self.ctrl.propose(err, hs);
-            if accept {
-                self.dense = Rosenbrock23Dense {
-                    ends: HermiteDense::new(t, t_new, y, y_new, f0, f2),
-                    h: hs,
-                    k1,
-                    k2,
+        let tol = &self.tol;
+        let (mut k1, mut k2) = (SVector::zeros(), SVector::zeros());
+        let a = self
+            .core
+            .adapt(&mut self.ctrl, t_limit, h, |stats, hs, t_new| {
+                let w = SMatrix::<T, N, N>::identity() - jac * (hs * d);
+                let Some(lu) = Lu::new(w) else {
+                    return Err(IntegrateError::SingularMatrix { t: to_f64(t) });
                 };
-                self.core.accept(t_new, y_new, f2, h_next, lands, h);
-                return Ok(());
-            }
-            self.core.stats.rejected += 1;
-            h = h_next;
-        }
+                stats.decompositions += 1;
+                let hdt = tdot * (hs * d);
+                k1 = lu.solve(&(f0 + hdt));
+                sys.rhs(t + half * hs, &(y + k1 * (half * hs)), &mut f1);
+                let k2m = lu.solve(&(f1 - k1));
+                k2 = k2m + k1;
+                let y_new = y + k2 * hs;
+                sys.rhs(t_new, &y_new, &mut f2);
+                stats.rhs_evals += 2;
+                let k3 = lu.solve(&(f2 - (k2 - f1) * e32 - (k1 - f0) * two + hdt));
+                Ok(Trial::new(y_new, f2, || {
+                    let errv = (k1 - k2 * two + k3) * (hs / lit::<T>(6.0));
+                    tol.error_norm(&errv, &y, &y_new)
+                }))
+            })?;
+        self.dense = Rosenbrock23Dense {
+            ends: HermiteDense::new(t, a.t_new, y, a.y, f0, a.f),
+            h: a.hs,
+            k1,
+            k2,
+        };
+        self.core.accept(&a);
+        Ok(())
     }
 
     fn order(&self) -> u8 {
