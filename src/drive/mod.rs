@@ -867,7 +867,6 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
             dense.interpolate_unchecked(t, &mut y);
             ev.value(i, t, &y)
         };
-        let s = sign_of(g_lo);
         // Interior samples (grazing safety for functions without a rate).
         let k = ev.interior_samples(i);
         if k > 0 {
@@ -900,55 +899,75 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
             }
             return None;
         }
-        if g1 != T::zero() && sign_of(g1) != s {
-            let (tc, _) = locate(g_at, t_lo, t1, g_lo, g1, tol);
-            return Some(Crossing {
-                t: tc,
-                rising: g1 > T::zero(),
-                resume: None,
-            });
-        }
-        // Same sign at both ends (or g1 == 0): a grazing pair if the rates show an interior
-        // extremum approaching zero.
-        let r_lo = match r_lo {
-            Some(r) => Some(r),
-            None => {
+        let rate_lo = || {
+            r_lo.or_else(|| {
                 let mut y = SVector::zeros();
                 dense.interpolate_unchecked(t_lo, &mut y);
                 let mut f = SVector::zeros();
                 self.system.rhs(t_lo, &y, &mut f);
                 ev.rate(i, t_lo, &y, &f)
-            }
+            })
         };
-        let (Some(r_lo), Some(r1)) = (r_lo, r1) else {
-            return None;
-        };
-        let towards = if s > 0 {
-            r_lo < T::zero()
-        } else {
-            r_lo > T::zero()
-        };
-        let away = if s > 0 {
-            r1 > T::zero()
-        } else {
-            r1 < T::zero()
-        };
-        if !(towards && (away || g1 == T::zero())) {
-            return None;
-        }
-        let sg = if s > 0 { T::one() } else { -T::one() };
-        let (te, neg) = crate::roots::golden_max(|t| -sg * g_at(t), t_lo, t1, tol);
-        let ge = -neg * sg;
-        if ge == T::zero() || sign_of(ge) == s {
-            return None;
-        }
-        let (tc, _) = locate(g_at, t_lo, te, g_lo, ge, tol);
-        Some(Crossing {
-            t: tc,
-            rising: ge > T::zero(),
-            resume: Some((te, ge)),
-        })
+        crossing_between(g_at, rate_lo, tol, t_lo, g_lo, t1, g1, r1)
     }
+}
+
+/// The earliest crossing of `g` (its value on the step's dense output: `g_at`) in
+/// `(t_lo, t1]`, from `g_lo ≠ 0` to `g1` with the rate `r1` at `t1`: a sign change of the
+/// ends, located by the bracketing solver; else, with the same sign at both ends (or
+/// `g1 = 0`), a grazing pair when the rates show an interior extremum that reaches the
+/// other side (`rate_lo`, the rate at `t_lo`, is evaluated only then): the extremum by
+/// golden-section search, the crossing before it, and the extremum as where the scan
+/// resumes. The search of the driver and of the ensemble's lanes.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub(crate) fn crossing_between<T: Real>(
+    g_at: impl Fn(T) -> T,
+    rate_lo: impl FnOnce() -> Option<T>,
+    tol: T,
+    t_lo: T,
+    g_lo: T,
+    t1: T,
+    g1: T,
+    r1: Option<T>,
+) -> Option<Crossing<T>> {
+    let s = sign_of(g_lo);
+    if g1 != T::zero() && sign_of(g1) != s {
+        let (tc, _) = locate(&g_at, t_lo, t1, g_lo, g1, tol);
+        return Some(Crossing {
+            t: tc,
+            rising: g1 > T::zero(),
+            resume: None,
+        });
+    }
+    let (Some(r_lo), Some(r1)) = (rate_lo(), r1) else {
+        return None;
+    };
+    let towards = if s > 0 {
+        r_lo < T::zero()
+    } else {
+        r_lo > T::zero()
+    };
+    let away = if s > 0 {
+        r1 > T::zero()
+    } else {
+        r1 < T::zero()
+    };
+    if !(towards && (away || g1 == T::zero())) {
+        return None;
+    }
+    let sg = if s > 0 { T::one() } else { -T::one() };
+    let (te, neg) = crate::roots::golden_max(|t| -sg * g_at(t), t_lo, t1, tol);
+    let ge = -neg * sg;
+    if ge == T::zero() || sign_of(ge) == s {
+        return None;
+    }
+    let (tc, _) = locate(&g_at, t_lo, te, g_lo, ge, tol);
+    Some(Crossing {
+        t: tc,
+        rising: ge > T::zero(),
+        resume: Some((te, ge)),
+    })
 }
 
 fn non_finite<T: Real>(index: usize, t: T, g: T) -> crate::Error {
@@ -1015,11 +1034,11 @@ enum Crossings<T: Real, const N: usize> {
 
 /// A crossing found on a step.
 #[derive(Debug, Clone, Copy)]
-struct Crossing<T> {
-    t: T,
-    rising: bool,
+pub(crate) struct Crossing<T> {
+    pub(crate) t: T,
+    pub(crate) rising: bool,
     /// Where to resume scanning this event after it (`None`: nothing more this step).
-    resume: Option<(T, T)>,
+    pub(crate) resume: Option<(T, T)>,
 }
 
 #[inline(always)]
