@@ -124,6 +124,23 @@ pub enum IntegrateError {
         /// Where.
         t: f64,
     },
+    /// A partial derivative of the right-hand side is infinite at the step's start (a
+    /// law with a cusp reports it as the largest finite value, which the system's
+    /// Jacobian may scale: an entry beyond `√MAX` counts as infinite; the exact
+    /// contact-rate law `sgn(v)|v|^{n3}`, `n3 < 1`, at `v = 0` in contact). A linearly implicit method
+    /// linearizes there: its stage and its error estimate in that direction vanish, and
+    /// it would step on with a wrong state instead of failing.
+    #[error(
+        "the Jacobian is infinite at t = {t} (entry ({row}, {col})): a linearly implicit method cannot step from this state; use an explicit method, or a regularized law (η > 0)"
+    )]
+    InfiniteJacobian {
+        /// Where.
+        t: f64,
+        /// Row of the entry (the component of the right-hand side).
+        row: usize,
+        /// Column of the entry (the state component).
+        col: usize,
+    },
     /// A parameter of the integrator is invalid.
     #[error(transparent)]
     Parameter(#[from] ParameterError),

@@ -139,6 +139,17 @@ impl<T: Real, const N: usize> Stepper<T, N> for Rosenbrock23<T, N> {
             .core
             .proposed(sys, 2, &self.tol, self.ctrl.opts.h_max, t_limit);
         let jac = self.jacobian(sys, t, &y, &f0);
+        // A law reports an infinite partial as the largest finite value; the system's
+        // Jacobian scales it (by the inverse mass, …), so anything beyond √MAX ≈ 1.3e154,
+        // far from any physical partial, is taken for one.
+        let big = T::max_value().unwrap_or(T::zero()).sqrt();
+        if let Some(k) = jac.iter().position(|v| !v.is_finite() || v.abs() >= big) {
+            return Err(IntegrateError::InfiniteJacobian {
+                t: to_f64(t),
+                row: k % N,
+                col: k / N,
+            });
+        }
         let tdot = self.dfdt(sys, t, &y, &f0);
         let d = d_const::<T>();
         let e32 = lit::<T>(6.0) + lit::<T>(2.0).sqrt();
