@@ -79,8 +79,13 @@ pub struct RunResult {
     pub status: Status,
     /// CPU time of the run (s, [`cpu_now`]), construction of the solver included.
     pub elapsed: f64,
-    /// Right-hand-side evaluations (counted in the right-hand side itself for the peers).
+    /// Right-hand-side evaluations, counted inside the right-hand side itself (a [`Counter`]
+    /// bumped on every call, for every library).
     pub rhs_evals: u64,
+    /// The library's own count of its right-hand-side evaluations, where it reports one
+    /// (`nonsmooth`: `Stats::rhs_evals`; `differential-equations`: `Solution::evals.function`),
+    /// for the check that it agrees with [`rhs_evals`](Self::rhs_evals).
+    pub lib_rhs_evals: Option<u64>,
     /// Jacobian(-vector) evaluations, if any.
     pub jac_evals: u64,
     /// Impact times (upward crossings of x = x_I).
@@ -97,6 +102,7 @@ impl RunResult {
             status: Status::Unsupported(msg.into()),
             elapsed: f64::NAN,
             rhs_evals: 0,
+            lib_rhs_evals: None,
             jac_evals: 0,
             impacts: vec![],
             strobe: vec![],

@@ -119,8 +119,9 @@ pub fn run(m: DeMethod, job: &Job) -> RunResult {
     };
     let elapsed = crate::common::cpu_now() - cpu0;
     let frac = rec.fraction(job);
+    let lib_rhs_evals = res.as_ref().ok().map(|(_, n)| *n as u64);
     let status = match res {
-        Ok((st, _lib_evals)) => {
+        Ok((st, _)) => {
             if rec.timed_out {
                 Status::Timeout(frac)
             } else {
@@ -137,6 +138,7 @@ pub fn run(m: DeMethod, job: &Job) -> RunResult {
         status,
         elapsed,
         rhs_evals: sys.evals.get(),
+        lib_rhs_evals,
         jac_evals: sys.jacs.get(),
         impacts: std::mem::take(&mut rec.impacts),
         strobe: std::mem::take(&mut rec.strobe),

@@ -110,6 +110,7 @@ pub fn run(m: DsMethod, job: &Job) -> RunResult {
         status,
         elapsed,
         rhs_evals: evals.get(),
+        lib_rhs_evals: None,
         jac_evals: jacs.get(),
         impacts: std::mem::take(&mut rec.impacts),
         strobe: std::mem::take(&mut rec.strobe),

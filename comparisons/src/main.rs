@@ -366,9 +366,32 @@ struct Timing {
     /// Median seconds per 1000 periods (extrapolated from the part done on a timeout).
     s_per_1000: f64,
     reps: usize,
+    /// RHS evaluations per period, counted inside the right-hand side (every library).
     rhs_per_period: f64,
+    /// The library's own count per period, where it reports one (`Stats::rhs_evals` for
+    /// nonsmooth).
+    lib_rhs_per_period: Option<f64>,
+    /// The library's own count minus the count inside the right-hand side, per run (shown
+    /// next to `rhs_per_period` when it is not zero).
+    lib_minus_counted: Option<i64>,
     impacts: usize,
     status: Status,
+}
+
+/// Prints (stderr) a run whose RHS count inside the right-hand side differs from the
+/// library's own count.
+fn check_rhs_count(m: Method, r: &RunResult) {
+    if let Some(lib) = r.lib_rhs_evals
+        && lib != r.rhs_evals
+    {
+        eprintln!(
+            "{}: {} RHS evaluations counted inside the right-hand side, {} by the library's own count ({:+})",
+            m.label(),
+            r.rhs_evals,
+            lib,
+            r.rhs_evals as i64 - lib as i64
+        );
+    }
 }
 
 fn timing(m: Method, j: &Job, reps: usize) -> Timing {
@@ -387,6 +410,7 @@ fn timing(m: Method, j: &Job, reps: usize) -> Timing {
         } else {
             f64::NAN
         });
+        check_rhs_count(m, &r);
         let ok = r.status.is_ok();
         last = Some((r, periods));
         if !ok {
@@ -403,6 +427,14 @@ fn timing(m: Method, j: &Job, reps: usize) -> Timing {
         } else {
             f64::NAN
         },
+        lib_rhs_per_period: r.lib_rhs_evals.map(|n| {
+            if periods > 0.0 {
+                n as f64 / periods
+            } else {
+                f64::NAN
+            }
+        }),
+        lib_minus_counted: r.lib_rhs_evals.map(|n| n as i64 - r.rhs_evals as i64),
         impacts: r.impacts.len(),
         status: r.status,
     }
@@ -419,6 +451,7 @@ fn measure(m: Method, rtol: f64, reference: &Reference, args: &Args) -> Row {
         let seg = &reference.segs[k];
         let s = seg.start;
         let r = m.run(&job(i, [s[1], s[2]], ACC_PERIODS, rtol, args.budget));
+        check_rhs_count(m, &r);
         if !r.status.is_ok() {
             acc_status = r.status.clone();
             err_x = f64::NAN;
@@ -477,6 +510,25 @@ fn fmt_t(t: &Timing) -> String {
     format!("{approx}{:.3}", t.s_per_1000)
 }
 
+/// RHS evaluations per period (counted inside the right-hand side); where the library's own
+/// count differs, by how much per run.
+fn fmt_rhs(t: &Timing) -> String {
+    match t.lib_minus_counted {
+        Some(d) if d != 0 => format!("{:.0} (lib {d:+}/run)", t.rhs_per_period),
+        _ => format!("{:.0}", t.rhs_per_period),
+    }
+}
+
+/// CPU time per RHS evaluation, everything included (W2 time / evaluations).
+fn fmt_ns(t: &Timing) -> String {
+    let ns = t.s_per_1000 / t.rhs_per_period * 1e6;
+    if ns.is_finite() {
+        format!("{ns:.1}")
+    } else {
+        "—".into()
+    }
+}
+
 fn fmt_e(x: f64) -> String {
     if x.is_nan() {
         "—".into()
@@ -505,7 +557,10 @@ fn markdown_table(rows: &[Row], reference: &Reference) -> String {
     let _ = writeln!(
         s,
         "ω = {OMEGA} rad/s. Times: median of the repetitions, CPU seconds per 1000 forcing periods \
-         (`~`: extrapolated from the part done before a timeout/failure). RHS/period: W2. \
+         (`~`: extrapolated from the part done before a timeout/failure). RHS/period: W2, counted \
+         inside the right-hand side for every library (`lib ±n/run`: the library's own count \
+         differs by n evaluations per run); ns/RHS: W2 CPU time per evaluation, everything \
+         included (stepping, events, sections). \
          Reference impacts: W1 {}, W2 {}. err x₁₀: worst |x − x_ref| after 10 periods over the \
          brief's 5 starts (periods 100, 120, …, 180; m); RMS err x: root mean square of \
          x − x_ref over the 10 section times of 40 starts (periods 100, 110, …, 490: 400 \
@@ -516,19 +571,23 @@ fn markdown_table(rows: &[Row], reference: &Reference) -> String {
     );
     let _ = writeln!(
         s,
-        "| library | method | rtol | W1 s/1000P | W2 s/1000P | RHS/period | impacts W1 | impacts W2 | err x₁₀ (m) | RMS err x (m) | Δt impact (s) | missed/extra | notes |"
+        "| library | method | rtol | W1 s/1000P | W2 s/1000P | RHS/period | ns/RHS | impacts W1 | impacts W2 | err x₁₀ (m) | RMS err x (m) | Δt impact (s) | missed/extra | notes |"
     );
-    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(
+        s,
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+    );
     for r in rows {
         let _ = writeln!(
             s,
-            "| {} | {} | {:.0e} | {} | {} | {:.0} | {} | {} | {} | {} | {} | {}/{} | {} |",
+            "| {} | {} | {:.0e} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {}/{} | {} |",
             r.method.library(),
             r.method.name(),
             r.rtol,
             fmt_t(&r.w1),
             fmt_t(&r.w2),
-            r.w2.rhs_per_period,
+            fmt_rhs(&r.w2),
+            fmt_ns(&r.w2),
             r.w1.impacts,
             r.w2.impacts,
             fmt_e(r.err_x),
@@ -544,24 +603,33 @@ fn markdown_table(rows: &[Row], reference: &Reference) -> String {
 
 fn csv_table(rows: &[Row]) -> String {
     let mut s = String::from(
-        "library,method,rtol,w1_s_per_1000_periods,w1_reps,w1_rhs_per_period,w1_impacts,w1_status,w2_s_per_1000_periods,w2_reps,w2_rhs_per_period,w2_impacts,w2_status,err_x_m,err_x_rms_m,err_t_impact_s,missed_impacts,extra_impacts,accuracy_status\n",
+        "library,method,rtol,w1_s_per_1000_periods,w1_reps,w1_rhs_per_period,w1_lib_rhs_per_period,w1_lib_minus_counted_rhs,w1_impacts,w1_status,w2_s_per_1000_periods,w2_reps,w2_rhs_per_period,w2_lib_rhs_per_period,w2_lib_minus_counted_rhs,w2_impacts,w2_status,err_x_m,err_x_rms_m,err_t_impact_s,missed_impacts,extra_impacts,accuracy_status\n",
     );
     let q = |st: &Status| format!("\"{}\"", st.short().replace('"', "'"));
+    // The library's own RHS count per period (empty where it reports none).
+    let lib = |t: &Timing| {
+        t.lib_rhs_per_period
+            .map_or(String::new(), |n| format!("{n:e}"))
+            + ","
+            + &t.lib_minus_counted.map_or(String::new(), |d| d.to_string())
+    };
     for r in rows {
         let _ = writeln!(
             s,
-            "{},{},{:e},{:e},{},{:e},{},{},{:e},{},{:e},{},{},{:e},{:e},{:e},{},{},{}",
+            "{},{},{:e},{:e},{},{:e},{},{},{},{:e},{},{:e},{},{},{},{:e},{:e},{:e},{},{},{}",
             r.method.library(),
             r.method.name(),
             r.rtol,
             r.w1.s_per_1000,
             r.w1.reps,
             r.w1.rhs_per_period,
+            lib(&r.w1),
             r.w1.impacts,
             q(&r.w1.status),
             r.w2.s_per_1000,
             r.w2.reps,
             r.w2.rhs_per_period,
+            lib(&r.w2),
             r.w2.impacts,
             q(&r.w2.status),
             r.err_x,
@@ -627,12 +695,37 @@ fn curve(rows: &[Row], m: Method, y: impl Fn(&Row) -> (bool, f64)) -> Vec<(f64, 
         .collect()
 }
 
-/// Our time / peer time at our error level, per workload.
-fn ratios(rows: &[Row], w1: bool) -> (String, String) {
+/// What [`ratios`] compares at equal accuracy.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Quantity {
+    /// CPU seconds per 1000 periods of W1.
+    TimeW1,
+    /// CPU seconds per 1000 periods of W2.
+    TimeW2,
+    /// RHS evaluations per period of W2 (counted inside the right-hand side; deterministic,
+    /// unlike the times).
+    RhsW2,
+}
+
+/// Our value / peer value at our error level (time per workload, or RHS evaluations).
+fn ratios(rows: &[Row], quantity: Quantity) -> (String, String) {
+    let w1 = quantity == Quantity::TimeW1;
     fn sel(r: &Row, w1: bool) -> &Timing {
         if w1 { &r.w1 } else { &r.w2 }
     }
     let pick = |r: &Row| -> Timing { sel(r, w1).clone() };
+    let value = |t: &Timing| -> f64 {
+        if quantity == Quantity::RhsW2 {
+            t.rhs_per_period
+        } else {
+            t.s_per_1000
+        }
+    };
+    let (unit, unit_csv) = if quantity == Quantity::RhsW2 {
+        ("RHS/period", "rhs_per_period")
+    } else {
+        ("s/1000P", "s_per_1000")
+    };
     let ours: Vec<&Row> = rows
         .iter()
         .filter(|r| {
@@ -652,11 +745,11 @@ fn ratios(rows: &[Row], w1: bool) -> (String, String) {
         }
     }
     let mut md = String::new();
-    let mut csv = String::from(
-        "workload,ours,rtol,our_rms_err_x_m,our_s_per_1000,peer,peer_s_per_1000_at_our_err,ratio_ours_over_peer,how\n",
+    let mut csv = format!(
+        "workload,ours,rtol,our_rms_err_x_m,our_{unit_csv},peer,peer_{unit_csv}_at_our_err,ratio_ours_over_peer,how\n",
     );
     let wl = if w1 { "W1" } else { "W2" };
-    let _ = write!(md, "| ours ({wl}) | rtol | RMS err x | s/1000P |");
+    let _ = write!(md, "| ours ({wl}) | rtol | RMS err x | {unit} |");
     for p in &peers {
         let _ = write!(md, " {} |", p.label());
     }
@@ -667,17 +760,21 @@ fn ratios(rows: &[Row], w1: bool) -> (String, String) {
     }
     let _ = writeln!(md);
     for o in &ours {
-        let ot = pick(o).s_per_1000;
+        let ot = value(&pick(o));
+        let ot_cell = if quantity == Quantity::RhsW2 {
+            format!("{ot:.0}")
+        } else {
+            format!("{ot:.3}")
+        };
         let _ = write!(
             md,
-            "| {} | {:.0e} | {:.1e} | {:.3} |",
+            "| {} | {:.0e} | {:.1e} | {ot_cell} |",
             o.method.name(),
             o.rtol,
             o.err_rms,
-            ot
         );
         for p in &peers {
-            let pts = curve(rows, *p, |r| (pick(r).status.is_ok(), pick(r).s_per_1000));
+            let pts = curve(rows, *p, |r| (pick(r).status.is_ok(), value(&pick(r))));
             match time_at_error(&pts, o.err_rms) {
                 Some((pt, how)) => {
                     let q = ot / pt;
@@ -961,12 +1058,13 @@ fn main() {
         };
         let r = m.run(&j);
         println!(
-            "{} {what} rtol {rtol:e}: {} in {:.3} s, {} RHS ({:.1}/period), {} jac, {} impacts",
+            "{} {what} rtol {rtol:e}: {} in {:.3} s, {} RHS ({:.1}/period; library's own count: {}), {} jac, {} impacts",
             m.label(),
             r.status.short(),
             r.elapsed,
             r.rhs_evals,
             r.rhs_evals as f64 / j.n_periods as f64,
+            r.lib_rhs_evals.map_or("none".into(), |n| n.to_string()),
             r.jac_evals,
             r.impacts.len()
         );
@@ -1073,8 +1171,9 @@ fn main() {
         }
     }
     let table = markdown_table(&rows, &reference);
-    let (r2, r2csv) = ratios(&rows, false);
-    let (r1, r1csv) = ratios(&rows, true);
+    let (r2, r2csv) = ratios(&rows, Quantity::TimeW2);
+    let (r1, r1csv) = ratios(&rows, Quantity::TimeW1);
+    let (rr, rrcsv) = ratios(&rows, Quantity::RhsW2);
     let mut md = String::from("# nonsmooth vs peers: work–precision\n\n");
     md.push_str(PEER_NOTES);
     md.push('\n');
@@ -1083,6 +1182,8 @@ fn main() {
     md.push_str(&r2);
     md.push('\n');
     md.push_str(&r1);
+    md.push_str("\n## Our RHS evaluations / peer's at equal accuracy\n\nThe same interpolation on RHS evaluations per period (W2, counted inside the right-hand side). Unlike the times, these do not depend on the load of the machine; time ratio ≈ this ratio × (our ns per evaluation / the peer's).\n\n");
+    md.push_str(&rr);
     let (ns_rhs, contact) = rhs_cost_ns(reference.w2_start);
     md.push_str("\n## The floor\n\n");
     md.push_str(&floor_table(&rows, ns_rhs, contact));
@@ -1101,4 +1202,5 @@ fn main() {
             .as_str(),
     );
     write(&args.out, "ratios.csv", &rc);
+    write(&args.out, "rhs_ratios.csv", &rrcsv);
 }

@@ -84,6 +84,8 @@ pub fn run(m: OsMethod, job: &Job) -> RunResult {
     let mut y = Vector2::new(job.y0[0] / SX, job.y0[1] / SV);
     let mut h = 0.0; // 0: the solver picks the first step
     let mut status = Status::Ok;
+    // ode_solvers' own count (`Stats::num_eval`, summed over the per-period calls).
+    let (mut lib_evals, mut lib_ok) = (0u64, true);
     let (rtol, atol) = (job.rtol, job.rtol);
     for i in 0..job.n_periods {
         let ta = job.t0 + i as f64 * period;
@@ -114,7 +116,11 @@ pub fn run(m: OsMethod, job: &Job) -> RunResult {
                     OutputType::Sparse,
                 );
                 let r = s.integrate();
-                (r.map(|_| ()), tail2(s.x_out()), s.y_out().last().copied())
+                (
+                    r.map(|st| st.num_eval),
+                    tail2(s.x_out()),
+                    s.y_out().last().copied(),
+                )
             }
             OsMethod::Dop853 => {
                 let mut s = Dop853::from_param(
@@ -136,12 +142,20 @@ pub fn run(m: OsMethod, job: &Job) -> RunResult {
                     OutputType::Sparse,
                 );
                 let r = s.integrate();
-                (r.map(|_| ()), tail2(s.x_out()), s.y_out().last().copied())
+                (
+                    r.map(|st| st.num_eval),
+                    tail2(s.x_out()),
+                    s.y_out().last().copied(),
+                )
             }
         };
-        if let Err(e) = res {
-            status = Status::Failed(format!("{e:?}"), st.rec.fraction(job));
-            break;
+        match res {
+            Ok(n) => lib_evals += u64::from(n),
+            Err(e) => {
+                status = Status::Failed(format!("{e:?}"), st.rec.fraction(job));
+                lib_ok = false;
+                break;
+            }
         }
         if st.stop {
             status = Status::Timeout(st.rec.fraction(job));
@@ -161,6 +175,7 @@ pub fn run(m: OsMethod, job: &Job) -> RunResult {
         status,
         elapsed,
         rhs_evals: evals.get(),
+        lib_rhs_evals: lib_ok.then_some(lib_evals),
         jac_evals: 0,
         impacts: std::mem::take(&mut st.rec.impacts),
         strobe: std::mem::take(&mut st.rec.strobe),
