@@ -508,15 +508,7 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
             }
         }
         let (t, y) = self.stepper.current();
-        let s1 = *self.stepper.stats();
-        let stats = Stats {
-            rhs_evals: s1.rhs_evals - stats0.rhs_evals,
-            accepted: s1.accepted - stats0.accepted,
-            rejected: s1.rejected - stats0.rejected,
-            jacobian_evals: s1.jacobian_evals - stats0.jacobian_evals,
-            decompositions: s1.decompositions - stats0.decompositions,
-            events: s1.events - stats0.events,
-        };
+        let stats = self.stepper.stats().since(&stats0);
         let out = Outcome {
             t,
             y: *y,

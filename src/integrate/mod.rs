@@ -354,6 +354,21 @@ impl core::ops::AddAssign<&Stats> for Stats {
     }
 }
 
+impl Stats {
+    /// The work done since the counters read `earlier` (`self − earlier`, counter by
+    /// counter; the counters only grow).
+    pub(crate) fn since(&self, earlier: &Stats) -> Stats {
+        Stats {
+            rhs_evals: self.rhs_evals - earlier.rhs_evals,
+            accepted: self.accepted - earlier.accepted,
+            rejected: self.rejected - earlier.rejected,
+            jacobian_evals: self.jacobian_evals - earlier.jacobian_evals,
+            decompositions: self.decompositions - earlier.decompositions,
+            events: self.events - earlier.events,
+        }
+    }
+}
+
 /// Interpolation inside the last accepted step.
 ///
 /// Valid only for the last accepted step; its span is `[t0, t1]` of that step.

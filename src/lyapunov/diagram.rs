@@ -294,7 +294,7 @@ where
                     let s0 = *e.stepper().stats();
                     e.transient(tau, settings.first_transient)?;
                     let r = e.estimate(tau, settings.intervals)?;
-                    let stats = super::stats_since(&s0, e.stepper().stats());
+                    let stats = e.stepper().stats().since(&s0);
                     est = Some(e);
                     (r, stats)
                 }
@@ -304,7 +304,7 @@ where
                     let s0 = *e.stepper().stats();
                     e.transient(tau, settings.step_transient)?;
                     let r = e.estimate(tau, settings.intervals)?;
-                    (r, super::stats_since(&s0, e.stepper().stats()))
+                    (r, e.stepper().stats().since(&s0))
                 }
             };
             out.push(DiagramPoint {

@@ -582,18 +582,6 @@ pub(crate) fn integrate_to<T: Real, const M: usize, D: Dynamics<T, M>, St: Stepp
     Ok(())
 }
 
-/// `s1 − s0` for the work counters.
-pub(crate) fn stats_since(s0: &Stats, s1: &Stats) -> Stats {
-    Stats {
-        rhs_evals: s1.rhs_evals - s0.rhs_evals,
-        accepted: s1.accepted - s0.accepted,
-        rejected: s1.rejected - s0.rejected,
-        jacobian_evals: s1.jacobian_evals - s0.jacobian_evals,
-        decompositions: s1.decompositions - s0.decompositions,
-        events: s1.events - s0.events,
-    }
-}
-
 /// Drops a stepper's derivative cache at its current state (after its system changed).
 pub(crate) fn refresh_cache<T: Real, const M: usize, St: crate::integrate::Stepper<T, M>>(
     stepper: &mut St,

@@ -5,7 +5,7 @@ use nalgebra::{SMatrix, SVector};
 use super::{
     DEFAULT_BLOCKS, DEFAULT_MAX_STEPS_PER_INTERVAL, Estimate, LyapunovError, Norm,
     block_standard_error, check_blocks, check_interval, check_interval_at, check_intervals,
-    check_state, grid_time, integrate_to, stats_since,
+    check_state, grid_time, integrate_to,
 };
 use crate::error::Result;
 use crate::integrate::{Stepper, Tolerances};
@@ -377,7 +377,7 @@ where
             local,
             interval: tau,
             blocks,
-            stats: stats_since(&s0, self.stepper.stats()),
+            stats: self.stepper.stats().since(&s0),
         })
     }
 
