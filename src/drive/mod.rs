@@ -916,7 +916,7 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
 /// the driver's bit for bit.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-pub(crate) fn crossing_between<T: Real>(
+fn crossing_between<T: Real>(
     g_at: impl Fn(T) -> T + Copy,
     rate_lo: impl FnOnce() -> Option<T>,
     tol: T,
@@ -1029,11 +1029,11 @@ enum Crossings<T: Real, const N: usize> {
 
 /// A crossing found on a step.
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct Crossing<T> {
-    pub(crate) t: T,
-    pub(crate) rising: bool,
+struct Crossing<T> {
+    t: T,
+    rising: bool,
     /// Where to resume scanning this event after it (`None`: nothing more this step).
-    pub(crate) resume: Option<(T, T)>,
+    resume: Option<(T, T)>,
 }
 
 #[inline(always)]
