@@ -9,6 +9,13 @@
 //! - `paper_model_w2_100`: `w2_100` at rtol 1e-8 with the oscillator and with its scalar
 //!   right-hand side written out (the cost of the `Mechanical` layer).
 //!
+//! - `turning_points_w2_100`: `w2_100` with DOPRI5 in time alone and with `TurningPoints`
+//!   (DOPRI5 across `|ẋ| < 3e-3 m/s` in the velocity's power scale). Before it, the bench
+//!   prints the attempts (accepted + rejected steps) per period of both, the segments per
+//!   period and the attempts per switching point: a segment's own, and the time stepper's
+//!   estimated as (attempts of time stepping alone − attempts of the time stepper outside
+//!   the segments) / segments.
+//!
 //! Time per period = reported time / 100.
 
 use criterion::{Criterion, criterion_group, criterion_main};
@@ -16,7 +23,7 @@ use nalgebra::Vector2;
 use nonsmooth::Dynamics;
 use nonsmooth::drive::Simulation;
 use nonsmooth::event::{Direction, Event, Level};
-use nonsmooth::integrate::{Dop853, Dopri5, Stepper, Tolerances};
+use nonsmooth::integrate::{Dop853, Dopri5, Stepper, Tolerances, TurningPoints};
 use nonsmooth::model::paper::PAPER;
 use nonsmooth::sample::{ImpactSequence, Stroboscopic};
 use std::hint::black_box;
@@ -32,6 +39,47 @@ fn tol(rtol: f64) -> Tolerances<f64, 2> {
 
 fn run<St: Stepper<f64, 2>>(st: St, y0: Vector2<f64>, periods: u32) -> (usize, Vector2<f64>) {
     run_system(PAPER.oscillator::<f64>(OMEGA).unwrap(), st, y0, periods)
+}
+
+fn turning(rtol: f64) -> TurningPoints<f64, Dopri5<f64, 2>, Dopri5<f64, 2>> {
+    let seg = Tolerances::per_component(rtol, [rtol, rtol * 1e-4]).unwrap();
+    TurningPoints::new(Dopri5::new(tol(rtol)), Dopri5::new(seg), 3e-3).unwrap()
+}
+
+/// Attempts per period and per switching point, time stepping alone against segments.
+fn print_attempts(on_attractor: Vector2<f64>, periods: u32) {
+    let osc = PAPER.oscillator::<f64>(OMEGA).unwrap();
+    let t1 = periods as f64 * std::f64::consts::TAU / OMEGA;
+    for rtol in [1e-6, 1e-8, 1e-10] {
+        let mut plain = Simulation::new(osc, Dopri5::new(tol(rtol)));
+        let a = plain.run(0.0, on_attractor, t1, &mut ()).unwrap().stats;
+        let mut seg = Simulation::new(osc, turning(rtol));
+        let b = seg.run(0.0, on_attractor, t1, &mut ()).unwrap().stats;
+        let st = seg.stepper();
+        let c = st.segment_counts();
+        let ts = st.time_stepper().stats();
+        let n = f64::from(periods);
+        let (att_plain, att_time) = (
+            (a.accepted + a.rejected) as f64,
+            (ts.accepted + ts.rejected) as f64,
+        );
+        let segs = c.completed.max(1) as f64;
+        println!(
+            "rtol {rtol:e}: attempts/period {:.0} (time) vs {:.0} (time {:.0} + segments {:.0}); \
+             RHS/period {:.0} vs {:.0}; segments/period {:.2}; attempts per switching point: \
+             time stepping ≈ {:.1}, segment {:.1}; abandoned {}",
+            att_plain / n,
+            (att_time + c.attempts as f64) / n,
+            att_time / n,
+            c.attempts as f64 / n,
+            a.rhs_evals as f64 / n,
+            b.rhs_evals as f64 / n,
+            c.completed as f64 / n,
+            (att_plain - att_time) / segs,
+            c.attempts as f64 / segs,
+            c.abandoned
+        );
+    }
 }
 
 fn run_system<S: Dynamics<f64, 2>, St: Stepper<f64, 2>>(
@@ -100,6 +148,18 @@ fn bench(c: &mut Criterion) {
     g.bench_function("oscillator/1e-8", |b| {
         b.iter(|| black_box(run(Dopri5::new(tol(1e-8)), on_attractor, 100)))
     });
+    g.finish();
+    print_attempts(on_attractor, 100);
+    let mut g = c.benchmark_group("turning_points_w2_100");
+    g.sample_size(10);
+    for rtol in [1e-6, 1e-8, 1e-10] {
+        g.bench_function(format!("time/{rtol:e}"), |b| {
+            b.iter(|| black_box(run(Dopri5::new(tol(rtol)), on_attractor, 100)))
+        });
+        g.bench_function(format!("segments/{rtol:e}"), |b| {
+            b.iter(|| black_box(run(turning(rtol), on_attractor, 100)))
+        });
+    }
     g.finish();
 }
 

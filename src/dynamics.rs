@@ -44,6 +44,15 @@ pub trait Dynamics<T: Real, const N: usize> {
     fn time_derivative(&self, _t: T, _y: &SVector<T, N>) -> Option<SVector<T, N>> {
         None
     }
+
+    /// For a one-degree-of-freedom system with state `(x, ẋ)` and `f = (ẋ, ẍ)`: the
+    /// exponent `q ∈ (0, 1)` of a term `∝ sgn(ẋ)|ẋ|^q` in `ẍ`, if it has one (see
+    /// [`ForceLaw::velocity_exponent`](crate::ForceLaw::velocity_exponent)). A
+    /// [`TurningPoints`](crate::integrate::TurningPoints) stepper crosses `ẋ = 0` in the
+    /// variable `u = sgn(ẋ)|ẋ|^q` when it is declared. Default `None`.
+    fn velocity_exponent(&self) -> Option<T> {
+        None
+    }
 }
 
 impl<T: Real, const N: usize, D: Dynamics<T, N> + ?Sized> Dynamics<T, N> for &D {
@@ -58,5 +67,9 @@ impl<T: Real, const N: usize, D: Dynamics<T, N> + ?Sized> Dynamics<T, N> for &D 
     #[inline(always)]
     fn time_derivative(&self, t: T, y: &SVector<T, N>) -> Option<SVector<T, N>> {
         (**self).time_derivative(t, y)
+    }
+    #[inline(always)]
+    fn velocity_exponent(&self) -> Option<T> {
+        (**self).velocity_exponent()
     }
 }

@@ -65,6 +65,7 @@ impl Method {
             Method::Ours(Ours::Dop853),
             Method::Ours(Ours::Dopri5Grid),
             Method::Ours(Ours::Dopri5Pred),
+            Method::Ours(Ours::Dopri5Turning),
             Method::Ours(Ours::Rosenbrock23),
             Method::De(DeMethod::Dopri5),
             Method::De(DeMethod::Dop853),
@@ -96,6 +97,7 @@ impl Method {
             Method::Ours(Ours::Dop853) => "Dop853",
             Method::Ours(Ours::Dopri5Grid) => "Dopri5 + landing_grid",
             Method::Ours(Ours::Dopri5Pred) => "Dopri5 predictive",
+            Method::Ours(Ours::Dopri5Turning) => "Dopri5 + TurningPoints",
             Method::Ours(Ours::Rosenbrock23) => "Rosenbrock23",
             Method::De(DeMethod::Dopri5) => "dopri5",
             Method::De(DeMethod::Dop853) => "dop853",
@@ -733,6 +735,7 @@ fn ratios(rows: &[Row], quantity: Quantity) -> (String, String) {
                 r.method,
                 Method::Ours(Ours::Dopri5)
                     | Method::Ours(Ours::Dopri5Pred)
+                    | Method::Ours(Ours::Dopri5Turning)
                     | Method::Ours(Ours::Dop853)
             ) && r.err_rms.is_finite()
                 && pick(r).status.is_ok()

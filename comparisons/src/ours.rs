@@ -7,7 +7,7 @@ use nonsmooth::Dynamics;
 use nonsmooth::drive::{Control, EventRecord, Observer, Simulation, StepView, Termination};
 use nonsmooth::event::{Direction, Event, Level};
 use nonsmooth::integrate::{
-    DenseOutput, Dop853, Dopri5, Rosenbrock23, StepOptions, Stepper, Tolerances,
+    DenseOutput, Dop853, Dopri5, Rosenbrock23, StepOptions, Stepper, Tolerances, TurningPoints,
 };
 use nonsmooth::model::paper::{PAPER, PaperOscillator};
 use nonsmooth::sample::Stroboscopic;
@@ -25,6 +25,9 @@ pub enum Ours {
     Dopri5Grid,
     /// DOPRI5 with the predictive controller correction on.
     Dopri5Pred,
+    /// DOPRI5 in time, and DOPRI5 across the turning points (`|ẋ| < 3e-3 m/s`) with the
+    /// velocity's power scale as the independent variable (`TurningPoints`).
+    Dopri5Turning,
 }
 
 /// Impact times.
@@ -75,6 +78,9 @@ impl Dynamics<f64, 2> for NoInline {
     fn time_derivative(&self, t: f64, y: &Vector2<f64>) -> Option<Vector2<f64>> {
         self.0.time_derivative(t, y)
     }
+    fn velocity_exponent(&self) -> Option<f64> {
+        self.0.velocity_exponent()
+    }
 }
 
 /// The system as `Simulation` sees it: every right-hand-side (and Jacobian) evaluation bumps
@@ -103,6 +109,9 @@ impl<S: Dynamics<f64, 2>> Dynamics<f64, 2> for Counted<S> {
     fn time_derivative(&self, t: f64, y: &Vector2<f64>) -> Option<Vector2<f64>> {
         self.sys.time_derivative(t, y)
     }
+    fn velocity_exponent(&self) -> Option<f64> {
+        self.sys.velocity_exponent()
+    }
 }
 
 pub fn run(kind: Ours, job: &Job) -> RunResult {
@@ -129,6 +138,13 @@ fn run_with<S: Dynamics<f64, 2>>(sys: S, kind: Ours, job: &Job) -> RunResult {
             start,
             cpu0,
         ),
+        Ours::Dopri5Turning => {
+            // Segment state (τ, x): τ to rtol seconds, x as in time.
+            let seg =
+                Tolerances::per_component(job.rtol, [job.rtol, job.atol()[0]]).expect("tolerances");
+            let st = TurningPoints::new(Dopri5::new(tol), Dopri5::new(seg), 3e-3).expect("band");
+            go(sys, st, job, false, start, cpu0)
+        }
         Ours::Dop853 => go(sys, Dop853::new(tol), job, false, start, cpu0),
         Ours::Rosenbrock23 => go(sys, Rosenbrock23::new(tol), job, false, start, cpu0),
     }

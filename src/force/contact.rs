@@ -264,6 +264,13 @@ impl<T: Real> ForceLaw<T> for HertzContact<T> {
         }
     }
 
+    /// `n3` when the damping term has a cusp (`b > 0`, `n3 < 1`), with or without the rate
+    /// regularization: with `η > 0` the cusp is rounded off inside `|δ̇| ≲ η`, and the
+    /// power scale `u = sgn(δ̇)|δ̇|^{n3}` still straightens the term outside that layer.
+    fn velocity_exponent(&self) -> Option<T> {
+        (self.b > T::zero() && self.n3 < T::one()).then_some(self.n3)
+    }
+
     /// Analytic partials. With `η = 0` and `n3 < 1`, `∂F/∂v` is infinite at `v = 0` in
     /// contact; it is reported as the largest finite value of `T`.
     #[inline(always)]

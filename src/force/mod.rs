@@ -65,6 +65,26 @@ pub trait ForceLaw<T: Real> {
     fn partials(&self, x: T, v: T) -> (T, T) {
         finite_difference_partials(self, x, v)
     }
+
+    /// The exponent `q ∈ (0, 1)` of a term `∝ sgn(v)|v|^q` in the law, if it has one: the
+    /// force then has an infinite slope in `v` at `v = 0` (a cusp), and a trajectory that
+    /// turns round with acceleration `a ≠ 0` has a `|τ|^{1+q}` term in its velocity. Steppers
+    /// that know it cross `v = 0` in the variable `u = sgn(v)|v|^q`, in which the term is
+    /// linear ([`TurningPoints`](crate::integrate::TurningPoints)). Default `None`: no
+    /// cusp in `v` (smooth laws, and smooth layers such as a regularized friction).
+    fn velocity_exponent(&self) -> Option<T> {
+        None
+    }
+}
+
+/// The smaller of two declared exponents (a sum of laws has the strongest cusp of its terms).
+#[inline]
+pub(crate) fn min_exponent<T: Real>(a: Option<T>, b: Option<T>) -> Option<T> {
+    match (a, b) {
+        (Some(a), Some(b)) => Some(if b < a { b } else { a }),
+        (a, None) => a,
+        (None, b) => b,
+    }
 }
 
 /// Central finite-difference partials of any law (the default of [`ForceLaw::partials`]).
@@ -88,6 +108,9 @@ impl<T: Real, F: ForceLaw<T> + ?Sized> ForceLaw<T> for &F {
     fn partials(&self, x: T, v: T) -> (T, T) {
         (**self).partials(x, v)
     }
+    fn velocity_exponent(&self) -> Option<T> {
+        (**self).velocity_exponent()
+    }
 }
 
 /// The sum of two laws, `A + B`, itself a law. Tuples of up to eight laws are laws too.
@@ -105,6 +128,9 @@ impl<T: Real, A: ForceLaw<T>, B: ForceLaw<T>> ForceLaw<T> for Sum<A, B> {
         let (a, b) = self.0.partials(x, v);
         let (c, d) = self.1.partials(x, v);
         (a + c, b + d)
+    }
+    fn velocity_exponent(&self) -> Option<T> {
+        min_exponent(self.0.velocity_exponent(), self.1.velocity_exponent())
     }
 }
 
@@ -137,6 +163,11 @@ macro_rules! tuple_law {
                     dv += b;
                 )+
                 (dx, dv)
+            }
+            fn velocity_exponent(&self) -> Option<T> {
+                let mut q = None;
+                $(q = min_exponent(q, self.$idx.velocity_exponent());)+
+                q
             }
         }
     };

@@ -26,11 +26,13 @@ mod dop853;
 pub(crate) mod dopri5;
 mod rk4;
 mod rosenbrock;
+mod turning;
 
 pub use dop853::{Dop853, Dop853Dense};
 pub use dopri5::{Dopri5, Dopri5Dense};
 pub use rk4::{HermiteDense, Rk4};
 pub use rosenbrock::{Rosenbrock23, Rosenbrock23Dense};
+pub use turning::{SegmentCounts, TurningDense, TurningPoints};
 
 use nalgebra::SVector;
 use thiserror::Error;

@@ -134,6 +134,11 @@ impl<T: Real, L: ForceLaw<T>, E: Excitation<T>> Dynamics<T, 2> for Oscillator<T,
     fn time_derivative(&self, t: T, y: &SVector<T, 2>) -> Option<SVector<T, 2>> {
         self.model.time_derivative(t, y)
     }
+
+    /// The laws' declared cusp exponent (the smallest of them).
+    fn velocity_exponent(&self) -> Option<T> {
+        self.laws().velocity_exponent()
+    }
 }
 
 impl<T: Real, L: ForceLaw<T>, E: Excitation<T>> Oscillator<T, L, E> {
