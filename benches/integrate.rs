@@ -42,8 +42,7 @@ fn run<St: Stepper<f64, 2>>(st: St, y0: Vector2<f64>, periods: u32) -> (usize, V
 }
 
 fn turning(rtol: f64) -> TurningPoints<f64, Dopri5<f64, 2>, Dopri5<f64, 2>> {
-    let seg = Tolerances::per_component(rtol, [rtol, rtol * 1e-4]).unwrap();
-    TurningPoints::new(Dopri5::new(tol(rtol)), Dopri5::new(seg), 3e-3).unwrap()
+    TurningPoints::dopri5(tol(rtol), 3e-3).unwrap()
 }
 
 /// Attempts per period and per switching point, time stepping alone against segments.

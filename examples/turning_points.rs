@@ -4,41 +4,146 @@
 //! For starts on the attractor at ω = 20.465 rad/s (every 5 periods after 100), x after 5
 //! periods is compared with DOP853 at rtol 1e-13; printed per rtol: the RMS error of x,
 //! right-hand-side evaluations and trial steps per forcing period, segments per period,
-//! trial steps per segment, abandoned segments and CPU time per 1000 periods.
+//! trial steps per segment, abandoned segments and CPU time per 1000 periods; then the
+//! work–precision gain on a stable periodic orbit and the exact law's creep from rest.
 //!
-//! Measured (one run, shared machine; band 3e-3 m/s, segment tolerances τ to rtol seconds and
-//! x as in time):
+//! Measured (one run, shared machine; band 3e-3 m/s, `TurningPoints::dopri5`):
 //!
 //! | rtol | RHS/period time → segments | attempts/period | attempts/segment | RMS err x time → segments | CPU |
 //! |---|---|---|---|---|---|
-//! | 1e-6 | 1014 → 750 (−26 %) | 169 → 123 | 7.6 | 4.6e-6 → 3.8e-6 | −21 % |
-//! | 1e-8 | 1928 → 1447 (−25 %) | 321 → 239 | 15.6 | 7.1e-8 → 5.1e-8 | −20 % |
-//! | 1e-10 | 3933 → 3013 (−23 %) | 655 → 500 | 30.6 | 2.6e-9 → 7.6e-10 | −21 % |
+//! | 1e-6 | 1014 → 752 (−26 %) | 169 → 123 | 7.8 | 4.6e-6 → 3.2e-6 | −19 % |
+//! | 1e-8 | 1928 → 1482 (−23 %) | 321 → 245 | 17.2 | 7.1e-8 → 5.9e-8 | −18 % |
+//! | 1e-10 | 3933 → 3130 (−20 %) | 655 → 520 | 35.3 | 2.6e-9 → 5.1e-10 | −15 % |
 //!
 //! Four segments per period (two turning points in contact, two friction reversals in free
-//! flight), none abandoned. Tightening the segments' τ tolerance (1e-3·rtol s, 1e-6·rtol s)
-//! doubled their steps without a measurable gain in this error.
+//! flight), none abandoned. On the chaotic attractor errors grow from period to period, so
+//! the second table measures on the stable period-2 orbit at ω = 19 rad/s: time stepping
+//! needs 1.02–1.47× (median 1.29×) the evaluations to reach the segments' error at rtol
+//! 1e-6…1e-12. With θ to rtol (`--theta-atol 1`) the gain is 0.85–1.13×, with 1000·rtol
+//! 0.94–1.35×.
 //!
-//! The second table runs the exact law (η = 0) from rest: the first period creeps out of
+//! The third table runs the exact law (η = 0) from rest: the first period creeps out of
 //! resting contact with `a ≈ 0` (the damping term balances the forcing), which is not a
-//! turning point, and segments save only 1–8 % there (280 850 → 276 834 evaluations at
+//! turning point, and segments save 0.2–8 % there (280 850 → 277 290 evaluations at
 //! rtol 1e-8).
 //!
-//! `cargo run --release --example turning_points -- [--quick] [--band V] [--tau-atol F]`
-//! (`F`: the segments' absolute τ tolerance in units of rtol seconds, default 1).
+//! `cargo run --release --example turning_points -- [--quick] [--band V] [--theta-atol F]`
+//! (`F`: the segments' absolute tolerance on θ in units of rtol, default 100 as in
+//! `TurningPoints::dopri5`).
 
 use std::f64::consts::TAU;
 use std::time::Instant;
 
 use nalgebra::Vector2;
-use nonsmooth::drive::Simulation;
-use nonsmooth::integrate::{Dop853, Dopri5, Stepper, Tolerances, TurningPoints};
+use nonsmooth::drive::{Control, Observer, Simulation, StepView};
+use nonsmooth::integrate::{DenseOutput, Dop853, Dopri5, Stepper, Tolerances, TurningPoints};
 use nonsmooth::model::paper::PAPER;
 
 const OMEGA: f64 = 20.465;
 
 fn time_tolerances(rtol: f64) -> nonsmooth::Result<Tolerances<f64, 2>> {
     Ok(Tolerances::per_component(rtol, [rtol * 1e-4, rtol * 1e-2])?)
+}
+
+/// Section points (steps land on `t = 2πk/ω`).
+struct Sections {
+    period: f64,
+    points: Vec<Vector2<f64>>,
+}
+
+impl Observer<f64, 2> for Sections {
+    fn on_step<D: DenseOutput<f64, 2>>(&mut self, s: &StepView<'_, f64, 2, D>) -> Control {
+        let k = (s.t1 / self.period).round();
+        if k >= 1.0 && s.t1 == k * self.period {
+            self.points.push(s.y1);
+        }
+        Control::Continue
+    }
+}
+
+/// `periods` periods from `(t0, y0)` landing on the sections: the section points and the
+/// right-hand-side evaluations.
+fn sections<St: Stepper<f64, 2>>(
+    omega: f64,
+    st: St,
+    t0: f64,
+    y0: Vector2<f64>,
+    periods: u32,
+) -> nonsmooth::Result<(Vec<Vector2<f64>>, u64)> {
+    let period = TAU / omega;
+    let mut sim =
+        Simulation::new(PAPER.oscillator::<f64>(omega)?, st).landing_grid(Some((0.0, period)))?;
+    let mut obs = Sections {
+        period,
+        points: vec![],
+    };
+    let out = sim.run(t0, y0, t0 + f64::from(periods) * period, &mut obs)?;
+    Ok((obs.points, out.stats.rhs_evals))
+}
+
+/// The stable period-2 orbit at ω = 19 rad/s, where errors do not grow from period to
+/// period: the largest |x − x_ref| over 20 section points against DOP853 at rtol 1e-13.
+fn periodic(band: f64, theta_atol: f64, rtols: &[f64]) -> nonsmooth::Result<()> {
+    const OMEGA_P2: f64 = 19.0;
+    const H: u32 = 20;
+    let period = TAU / OMEGA_P2;
+    let x0 = PAPER.static_equilibrium()?;
+    let t0 = 200.0 * period;
+    let y0 = Simulation::new(
+        PAPER.oscillator::<f64>(OMEGA_P2)?,
+        Dop853::new(time_tolerances(1e-13)?),
+    )
+    .run(0.0, Vector2::new(x0, 0.0), t0, &mut ())?
+    .y;
+    let (reference, _) = sections(OMEGA_P2, Dop853::new(time_tolerances(1e-13)?), t0, y0, H)?;
+    let worst = |pts: &[Vector2<f64>]| {
+        pts.iter()
+            .zip(&reference)
+            .map(|(a, b)| (a[0] - b[0]).abs())
+            .fold(0.0, f64::max)
+    };
+    println!();
+    println!(
+        "stable period-2 orbit, ω = {OMEGA_P2}: largest |x − x_ref| over {H} section points (DOP853, rtol 1e-13); \
+         gain = evaluations time stepping needs for the same error (log-log interpolation) / evaluations with segments"
+    );
+    println!(
+        "| rtol | time: max err x (m) | time: RHS/period | segments: max err x (m) | segments: RHS/period | gain |"
+    );
+    println!("|---|---|---|---|---|---|");
+    let all: Vec<f64> = (0..=6).map(|k| 10f64.powi(-6 - k)).collect();
+    let mut time = vec![];
+    for &rtol in &all {
+        let (pts, n) = sections(OMEGA_P2, Dopri5::new(time_tolerances(rtol)?), t0, y0, H)?;
+        time.push((worst(&pts), n as f64 / f64::from(H)));
+    }
+    // Evaluations time stepping needs for `err` (log-log interpolation along rtol).
+    let needed = |err: f64| -> Option<f64> {
+        time.windows(2).find_map(|w| {
+            let ((e0, n0), (e1, n1)) = (w[0], w[1]);
+            (err <= e0 && err >= e1).then(|| {
+                let f = (err.ln() - e0.ln()) / (e1.ln() - e0.ln());
+                (n0.ln() + f * (n1.ln() - n0.ln())).exp()
+            })
+        })
+    };
+    let _ = rtols;
+    for (k, &rtol) in all.iter().enumerate() {
+        let seg_tol = Tolerances::per_component(rtol, [rtol * theta_atol, rtol * 1e-4])?;
+        let st = TurningPoints::new(
+            Dopri5::new(time_tolerances(rtol)?),
+            Dopri5::new(seg_tol),
+            band,
+        )?;
+        let (pts, n) = sections(OMEGA_P2, st, t0, y0, H)?;
+        let (e, n) = (worst(&pts), n as f64 / f64::from(H));
+        let gain = needed(e).map_or("–".to_string(), |m| format!("{:.2}", m / n));
+        println!(
+            "| {rtol:e} | {:.2e} | {:.0} | {e:.2e} | {n:.0} | {gain} |",
+            time[k].0, time[k].1
+        );
+    }
+    Ok(())
 }
 
 fn main() -> nonsmooth::Result<()> {
@@ -49,12 +154,12 @@ fn main() -> nonsmooth::Result<()> {
         .position(|a| a == "--band")
         .and_then(|i| args.get(i + 1))
         .map_or(3e-3, |s| s.parse::<f64>().unwrap_or(f64::NAN));
-    // Absolute tolerance of a segment's τ, in units of rtol seconds.
-    let tau_atol = args
+    // Absolute tolerance of a segment's θ, in units of rtol (`TurningPoints::dopri5`: 100).
+    let theta_atol = args
         .iter()
-        .position(|a| a == "--tau-atol")
+        .position(|a| a == "--theta-atol")
         .and_then(|i| args.get(i + 1))
-        .map_or(1.0, |s| s.parse::<f64>().unwrap_or(f64::NAN));
+        .map_or(100.0, |s| s.parse::<f64>().unwrap_or(f64::NAN));
     let osc = PAPER.oscillator::<f64>(OMEGA)?;
     let period = TAU / OMEGA;
     let (n_starts, span) = if quick { (5, 5.0) } else { (20, 5.0) };
@@ -107,7 +212,7 @@ fn main() -> nonsmooth::Result<()> {
             (0u64, 0u64, 0u64, 0u64, 0u64);
         let clock = Instant::now();
         for &(t0, y0, x_ref) in &starts {
-            let seg_tol = Tolerances::per_component(rtol, [rtol * tau_atol, rtol * 1e-4])?;
+            let seg_tol = Tolerances::per_component(rtol, [rtol * theta_atol, rtol * 1e-4])?;
             let stepper = TurningPoints::new(
                 Dopri5::new(time_tolerances(rtol)?),
                 Dopri5::new(seg_tol),
@@ -136,6 +241,7 @@ fn main() -> nonsmooth::Result<()> {
             1000.0 * cpu / periods
         );
     }
+    periodic(band, theta_atol, rtols)?;
     // The exact law (η = 0) from rest in contact: the first period creeps out of resting
     // contact, where the law's rate term has its cusp.
     let mut exact = PAPER;
@@ -160,7 +266,7 @@ fn main() -> nonsmooth::Result<()> {
             ),
             Err(e) => println!("| {rtol:e} | DOPRI5 in time | failed: {e} | – |"),
         }
-        let seg_tol = Tolerances::per_component(rtol, [rtol * tau_atol, rtol * 1e-4])?;
+        let seg_tol = Tolerances::per_component(rtol, [rtol * theta_atol, rtol * 1e-4])?;
         let stepper = TurningPoints::new(
             Dopri5::new(time_tolerances(rtol)?),
             Dopri5::new(seg_tol),

@@ -26,7 +26,7 @@ pub enum Ours {
     /// DOPRI5 with the predictive controller correction on.
     Dopri5Pred,
     /// DOPRI5 in time, and DOPRI5 across the turning points (`|ẋ| < 3e-3 m/s`) with the
-    /// velocity's power scale as the independent variable (`TurningPoints`).
+    /// velocity's power scale as the independent variable (`TurningPoints::dopri5`).
     Dopri5Turning,
 }
 
@@ -139,10 +139,7 @@ fn run_with<S: Dynamics<f64, 2>>(sys: S, kind: Ours, job: &Job) -> RunResult {
             cpu0,
         ),
         Ours::Dopri5Turning => {
-            // Segment state (τ, x): τ to rtol seconds, x as in time.
-            let seg =
-                Tolerances::per_component(job.rtol, [job.rtol, job.atol()[0]]).expect("tolerances");
-            let st = TurningPoints::new(Dopri5::new(tol), Dopri5::new(seg), 3e-3).expect("band");
+            let st = TurningPoints::dopri5(tol, 3e-3).expect("band");
             go(sys, st, job, false, start, cpu0)
         }
         Ours::Dop853 => go(sys, Dop853::new(tol), job, false, start, cpu0),

@@ -24,9 +24,12 @@
 //! for the paper's `n3`: enough for a fifth-order method), and the friction layer is
 //! stretched from `ε` to `≈ ε^{1/p}`. An integer `p` keeps the map `u ↦ ẋ` to a few
 //! multiplications: `p = 1/q` itself (5.36 for the paper) took 6 % fewer steps per segment
-//! (14.7 against 15.6 at rtol 10⁻⁸) but a `powf` per evaluation, and more time per period. The state of a *segment* is `(τ, x)`, the time since the
-//! segment began and the position; it is integrated by a second stepper of the user's choice
-//! in `s = σu` (`σ = sgn(a)`, so that `s` grows) from the band's edge on the near side (or from
+//! (14.7 against 15.6 at rtol 10⁻⁸) but a `powf` per evaluation, and more time per period.
+//!
+//! The state of a *segment* is `(θ, x)`: the time since the segment began in units of its
+//! natural duration, `θ = τ·|a₀|/V*` (`a₀` the acceleration at entry; a segment lasts
+//! `θ ≈ 2`), and the position. A second stepper of the user's choice integrates it in
+//! `s = σu` (`σ = sgn(a₀)`, so that `s` grows) from the band's edge on the near side (or from
 //! `u = 0` for a body at rest) to its edge on the far side, `s = V*^{1/p}`.
 //!
 //! Every step of a segment is an accepted step of this stepper in time: its span is
@@ -44,9 +47,16 @@
 //!   last accepted point and the time stepper goes on from there; no new segment starts until
 //!   `|ẋ|` has left the band. Nothing is stepped over: the abandoned step was never reported.
 //!
-//! The accuracy of a segment is set by the segment stepper's tolerances on `(τ, x)`: an
-//! absolute tolerance on `τ` of `rtol` seconds and the time stepper's on `x` are a good start
-//! (the time error is a phase error of `a·δτ` in `ẋ`).
+//! # Accuracy
+//! A segment's accuracy is set by the segment stepper's tolerances on `(θ, x)`. The error
+//! in `θ` is a phase error: `δτ = δθ·V*/|a₀|` shifts the state by `(ẋ, ẍ)·δτ` at the exit.
+//! [`TurningPoints::dopri5`] uses `rtol` for both, an absolute tolerance of `100·rtol` on
+//! `θ` and the time stepper's on `x`, chosen by work–precision measurements on the paper's
+//! model (`examples/turning_points.rs`): on a stable period-2 orbit (ω = 19 rad/s, where
+//! errors do not grow from period to period), time stepping needs 1.0–1.5× (median 1.3×)
+//! the evaluations to reach the segments' error at rtol 10⁻⁶…10⁻¹²; `θ` to `rtol` gains
+//! nothing (0.85–1.13×: the segment then takes as many steps as time stepping spent), and
+//! to `1000·rtol` 0.94–1.35×.
 
 use nalgebra::{SVector, Vector2};
 
@@ -69,16 +79,15 @@ const MAX_SEGMENT_STEPS: u32 = 10_000;
 ///
 /// ```
 /// use nonsmooth::drive::Simulation;
-/// use nonsmooth::integrate::{Dopri5, Tolerances, TurningPoints};
+/// use nonsmooth::integrate::{Tolerances, TurningPoints};
 /// use nonsmooth::model::paper::PAPER;
 /// use nalgebra::Vector2;
 ///
 /// let osc = PAPER.oscillator::<f64>(20.465)?;
 /// let rtol = 1e-8;
-/// let time = Dopri5::new(Tolerances::per_component(rtol, [rtol * 1e-4, rtol * 1e-2])?);
-/// // Segment state (τ, x): τ to rtol seconds, x as in time.
-/// let segment = Dopri5::new(Tolerances::per_component(rtol, [rtol, rtol * 1e-4])?);
-/// let stepper = TurningPoints::new(time, segment, 3e-3)?;
+/// let tol = Tolerances::per_component(rtol, [rtol * 1e-4, rtol * 1e-2])?;
+/// // DOPRI5 in time and in the segments, |ẋ| < 3 mm/s.
+/// let stepper = TurningPoints::dopri5(tol, 3e-3)?;
 /// let mut sim = Simulation::new(osc, stepper);
 /// let out = sim.run(0.0, Vector2::new(PAPER.static_equilibrium()?, 0.0), 3.0, &mut ())?;
 /// assert!(sim.stepper().segments() > 0);
@@ -124,6 +133,8 @@ enum Mode<T> {
 #[derive(Debug, Clone, Copy)]
 struct Segment<T> {
     t0: T,
+    /// The segment's time unit `V*/|a|` at entry: its state holds `θ = τ/scale`.
+    scale: T,
     sigma: T,
     p: i32,
     s_end: T,
@@ -156,6 +167,7 @@ where
             seg: segment.dense().clone(),
             in_segment: false,
             t_seg: T::zero(),
+            scale: T::one(),
             sigma: T::one(),
             p: 1,
             s0: T::zero(),
@@ -256,6 +268,7 @@ where
         self.seg.reset_state(s0, Vector2::new(T::zero(), y[0]));
         self.mode = Mode::Segment(Segment {
             t0: t,
+            scale: self.band / a.abs(),
             sigma,
             p,
             s_end: self.band.powf(r),
@@ -358,6 +371,7 @@ where
             let r = Reparam {
                 sys,
                 t0: g.t0,
+                scale: g.scale,
                 p: g.p,
                 sigma: g.sigma,
             };
@@ -368,7 +382,7 @@ where
             }
             let (s_b, z_b) = (self.seg.current().0, *self.seg.current().1);
             let (_, dz_b) = self.seg.dense().end_derivatives();
-            let dtau_b = dz_b[0];
+            let dtau_b = dz_b[0] * g.scale;
             let u_b = g.sigma * s_b;
             let v_b = velocity(u_b, g.p);
             // dτ/ds > 0 except at u = 0; a sign change means a changed sign.
@@ -377,7 +391,7 @@ where
                 self.leave(t_a, y_a, true);
                 return Ok(false);
             }
-            let mut t_b = g.t0 + z_b[0];
+            let mut t_b = g.t0 + g.scale * z_b[0];
             if !(t_b > t_a) {
                 // Below the resolution of t: step on in s.
                 if s_b >= g.s_end {
@@ -389,6 +403,7 @@ where
             self.dense.seg = self.seg.dense().clone();
             self.dense.in_segment = true;
             self.dense.t_seg = g.t0;
+            self.dense.scale = g.scale;
             self.dense.sigma = g.sigma;
             self.dense.p = g.p;
             self.dense.s0 = s_a;
@@ -400,7 +415,7 @@ where
             let mut cut = false;
             if t_b > t_limit {
                 // Cut at τ = t_limit − t₀; the segment goes on from there.
-                let target = t_limit - g.t0;
+                let target = (t_limit - g.t0) / g.scale;
                 let s_c = self.dense.invert(target);
                 let mut z_c = SVector::zeros();
                 self.dense.seg.interpolate_unchecked(s_c, &mut z_c);
@@ -430,6 +445,25 @@ where
             }
             return Ok(true);
         }
+    }
+}
+
+impl<T: Real> TurningPoints<T, super::Dopri5<T, 2>, super::Dopri5<T, 2>> {
+    /// DOPRI5 in time with the tolerances `tol` and DOPRI5 in the segments with the
+    /// recommended tolerances (see [Accuracy](self#accuracy)): `rtol` of `tol`'s first
+    /// component for both, absolute `100·rtol` on `θ` and `tol`'s on `x`.
+    ///
+    /// # Errors
+    /// [`ParameterError`] unless `v_band` is finite and > 0, or if a tolerance is invalid.
+    pub fn dopri5(tol: super::Tolerances<T, 2>, v_band: T) -> Result<Self, ParameterError> {
+        tol.validate()?;
+        let rtol = tol.rtol[0];
+        let segment = super::Tolerances {
+            rtol: SVector::repeat(rtol),
+            atol: Vector2::new(rtol * lit(100.0), tol.atol[0]),
+        };
+        segment.validate()?;
+        Self::new(super::Dopri5::new(tol), super::Dopri5::new(segment), v_band)
     }
 }
 
@@ -515,10 +549,11 @@ where
     }
 }
 
-/// The system in `s = σu`, state `(τ, x)`.
+/// The system in `s = σu`, state `(θ, x)` with `τ = scale·θ`.
 struct Reparam<'a, T, S> {
     sys: &'a S,
     t0: T,
+    scale: T,
     p: i32,
     sigma: T,
 }
@@ -537,9 +572,10 @@ impl<T: Real, S: Dynamics<T, 2>> Dynamics<T, 2> for Reparam<'_, T, S> {
             T::zero()
         };
         let mut f = SVector::zeros();
-        self.sys.rhs(self.t0 + z[0], &Vector2::new(z[1], v), &mut f);
+        self.sys
+            .rhs(self.t0 + self.scale * z[0], &Vector2::new(z[1], v), &mut f);
         let dtau = self.sigma * dv / f[1];
-        dz[0] = dtau;
+        dz[0] = dtau / self.scale;
         dz[1] = v * dtau;
     }
 }
@@ -558,6 +594,7 @@ pub struct TurningDense<T: Real, TD, SD> {
     seg: SD,
     in_segment: bool,
     t_seg: T,
+    scale: T,
     sigma: T,
     p: i32,
     s0: T,
@@ -565,7 +602,7 @@ pub struct TurningDense<T: Real, TD, SD> {
 }
 
 impl<T: Real, TD: DenseOutput<T, 2>, SD: DenseOutput<T, 2>> TurningDense<T, TD, SD> {
-    /// The `s ∈ [s0, s1]` where the segment's `τ(s) = target` (Brent's method on the
+    /// The `s ∈ [s0, s1]` where the segment's `θ(s) = target` (Brent's method on the
     /// segment step's dense output; `τ` is monotone on the step).
     fn invert(&self, target: T) -> T {
         let mut z = SVector::zeros();
@@ -614,7 +651,7 @@ impl<T: Real, TD: DenseOutput<T, 2>, SD: DenseOutput<T, 2>> DenseOutput<T, 2>
             *out = self.y1;
             return;
         }
-        let s = self.invert(t - self.t_seg);
+        let s = self.invert((t - self.t_seg) / self.scale);
         let mut z = SVector::zeros();
         self.seg.interpolate_unchecked(s, &mut z);
         let u = self.sigma * s;
