@@ -61,6 +61,88 @@ impl Observer<f64, 2> for Sections {
     }
 }
 
+/// Accepted steps by phase: free flight, contact (`x ≥ x_I` at an end), and the band
+/// `|ẋ| < V*` (both ends inside it, i.e. the segments' steps when segments are on).
+#[derive(Default)]
+struct Phases {
+    band: f64,
+    free: u64,
+    contact: u64,
+    in_band: u64,
+    onset_exit: u64,
+}
+
+impl Observer<f64, 2> for Phases {
+    fn on_step<D: DenseOutput<f64, 2>>(&mut self, s: &StepView<'_, f64, 2, D>) -> Control {
+        let inside = |y: &Vector2<f64>| y[0] >= PAPER.x_i;
+        let edge = self.band * (1.0 + 1e-9);
+        if s.y0[1].abs() <= edge && s.y1[1].abs() <= edge {
+            self.in_band += 1;
+        } else if inside(&s.y0) != inside(&s.y1) {
+            self.onset_exit += 1;
+        } else if inside(&s.y0) {
+            self.contact += 1;
+        } else {
+            self.free += 1;
+        }
+        Control::Continue
+    }
+}
+
+/// Where the accepted steps go, per period, with and without segments (rtol 1e-8).
+fn phases(
+    band: f64,
+    theta_atol: f64,
+    starts: &[(f64, Vector2<f64>, f64)],
+    span: f64,
+) -> nonsmooth::Result<()> {
+    let osc = PAPER.oscillator::<f64>(OMEGA)?;
+    let period = TAU / OMEGA;
+    let rtol = 1e-8;
+    println!();
+    println!("accepted steps per period by phase, rtol {rtol:e} (band: both ends with |ẋ| < V*)");
+    println!("| method | free flight | contact onset/exit | in contact | band | rejected (all) |");
+    println!("|---|---|---|---|---|---|");
+    let periods = starts.len() as f64 * span;
+    for with_segments in [false, true] {
+        let mut ph = Phases {
+            band,
+            ..Phases::default()
+        };
+        let mut rejected = 0;
+        for &(t0, y0, _) in starts {
+            let t1 = t0 + span * period;
+            if with_segments {
+                let seg_tol = Tolerances::per_component(rtol, [rtol * theta_atol, rtol * 1e-4])?;
+                let st = TurningPoints::new(
+                    Dopri5::new(time_tolerances(rtol)?),
+                    Dopri5::new(seg_tol),
+                    band,
+                )?;
+                let mut sim = Simulation::new(osc, st);
+                rejected += sim.run(t0, y0, t1, &mut ph)?.stats.rejected;
+            } else {
+                let mut sim = Simulation::new(osc, Dopri5::new(time_tolerances(rtol)?));
+                rejected += sim.run(t0, y0, t1, &mut ph)?.stats.rejected;
+            }
+        }
+        println!(
+            "| {} | {:.0} | {:.1} | {:.0} | {:.0} | {:.0} |",
+            if with_segments {
+                "DOPRI5 + segments"
+            } else {
+                "DOPRI5 in time"
+            },
+            ph.free as f64 / periods,
+            ph.onset_exit as f64 / periods,
+            ph.contact as f64 / periods,
+            ph.in_band as f64 / periods,
+            rejected as f64 / periods
+        );
+    }
+    Ok(())
+}
+
 /// `periods` periods from `(t0, y0)` landing on the sections: the section points and the
 /// right-hand-side evaluations.
 fn sections<St: Stepper<f64, 2>>(
@@ -241,6 +323,7 @@ fn main() -> nonsmooth::Result<()> {
             1000.0 * cpu / periods
         );
     }
+    phases(band, theta_atol, &starts, span)?;
     periodic(band, theta_atol, rtols)?;
     // The exact law (η = 0) from rest in contact: the first period creeps out of resting
     // contact, where the law's rate term has its cusp.
