@@ -27,9 +27,15 @@
 //! turning point, and segments save 0.2–8 % there (280 850 → 277 290 evaluations at
 //! rtol 1e-8).
 //!
-//! `cargo run --release --example turning_points -- [--quick] [--band V] [--theta-atol F]`
-//! (`F`: the segments' absolute tolerance on θ in units of rtol, default 100 as in
-//! `TurningPoints::dopri5`).
+//! With `--onset 1e-5` the first 10 µm of each contact are crossed in contact segments as
+//! well (`with_onset_band`): 4 per period, 2.9 / 6.7 / 13.4 trial steps each at rtol
+//! 1e-6 / 1e-8 / 1e-10; evaluations per period 853 / 1609 / 3234 (more than the velocity
+//! segments alone) at RMS errors 2.3e-6 / 6.4e-8 / 8.8e-10, and a period-2 gain of
+//! 0.95–1.69× (median 1.33×): no clear gain.
+//!
+//! `cargo run --release --example turning_points -- [--quick] [--band V] [--theta-atol F]
+//! [--onset D]` (`F`: the segments' absolute tolerance on θ in units of rtol, default 100
+//! as in `TurningPoints::dopri5`; `D`: the contact band δ* in m, off by default).
 
 use std::f64::consts::TAU;
 use std::time::Instant;
@@ -40,6 +46,35 @@ use nonsmooth::integrate::{DenseOutput, Dop853, Dopri5, Stepper, Tolerances, Tur
 use nonsmooth::model::paper::PAPER;
 
 const OMEGA: f64 = 20.465;
+
+/// The segments' settings.
+#[derive(Clone, Copy)]
+struct Config {
+    /// The velocity band V* (m/s).
+    band: f64,
+    /// Absolute tolerance of a segment's θ in units of rtol.
+    theta_atol: f64,
+    /// The contact band δ* (m), if contact segments are on.
+    onset: Option<f64>,
+}
+
+impl Config {
+    fn stepper(
+        &self,
+        rtol: f64,
+    ) -> nonsmooth::Result<TurningPoints<f64, Dopri5<f64, 2>, Dopri5<f64, 2>>> {
+        let seg_tol = Tolerances::per_component(rtol, [rtol * self.theta_atol, rtol * 1e-4])?;
+        let st = TurningPoints::new(
+            Dopri5::new(time_tolerances(rtol)?),
+            Dopri5::new(seg_tol),
+            self.band,
+        )?;
+        Ok(match self.onset {
+            Some(d) => st.with_onset_band(d)?,
+            None => st,
+        })
+    }
+}
 
 fn time_tolerances(rtol: f64) -> nonsmooth::Result<Tolerances<f64, 2>> {
     Ok(Tolerances::per_component(rtol, [rtol * 1e-4, rtol * 1e-2])?)
@@ -90,12 +125,7 @@ impl Observer<f64, 2> for Phases {
 }
 
 /// Where the accepted steps go, per period, with and without segments (rtol 1e-8).
-fn phases(
-    band: f64,
-    theta_atol: f64,
-    starts: &[(f64, Vector2<f64>, f64)],
-    span: f64,
-) -> nonsmooth::Result<()> {
+fn phases(cfg: Config, starts: &[(f64, Vector2<f64>, f64)], span: f64) -> nonsmooth::Result<()> {
     let osc = PAPER.oscillator::<f64>(OMEGA)?;
     let period = TAU / OMEGA;
     let rtol = 1e-8;
@@ -106,19 +136,14 @@ fn phases(
     let periods = starts.len() as f64 * span;
     for with_segments in [false, true] {
         let mut ph = Phases {
-            band,
+            band: cfg.band,
             ..Phases::default()
         };
         let mut rejected = 0;
         for &(t0, y0, _) in starts {
             let t1 = t0 + span * period;
             if with_segments {
-                let seg_tol = Tolerances::per_component(rtol, [rtol * theta_atol, rtol * 1e-4])?;
-                let st = TurningPoints::new(
-                    Dopri5::new(time_tolerances(rtol)?),
-                    Dopri5::new(seg_tol),
-                    band,
-                )?;
+                let st = cfg.stepper(rtol)?;
                 let mut sim = Simulation::new(osc, st);
                 rejected += sim.run(t0, y0, t1, &mut ph)?.stats.rejected;
             } else {
@@ -165,7 +190,7 @@ fn sections<St: Stepper<f64, 2>>(
 
 /// The stable period-2 orbit at ω = 19 rad/s, where errors do not grow from period to
 /// period: the largest |x − x_ref| over 20 section points against DOP853 at rtol 1e-13.
-fn periodic(band: f64, theta_atol: f64, rtols: &[f64]) -> nonsmooth::Result<()> {
+fn periodic(cfg: Config) -> nonsmooth::Result<()> {
     const OMEGA_P2: f64 = 19.0;
     const H: u32 = 20;
     let period = TAU / OMEGA_P2;
@@ -209,14 +234,8 @@ fn periodic(band: f64, theta_atol: f64, rtols: &[f64]) -> nonsmooth::Result<()> 
             })
         })
     };
-    let _ = rtols;
     for (k, &rtol) in all.iter().enumerate() {
-        let seg_tol = Tolerances::per_component(rtol, [rtol * theta_atol, rtol * 1e-4])?;
-        let st = TurningPoints::new(
-            Dopri5::new(time_tolerances(rtol)?),
-            Dopri5::new(seg_tol),
-            band,
-        )?;
+        let st = cfg.stepper(rtol)?;
         let (pts, n) = sections(OMEGA_P2, st, t0, y0, H)?;
         let (e, n) = (worst(&pts), n as f64 / f64::from(H));
         let gain = needed(e).map_or("–".to_string(), |m| format!("{:.2}", m / n));
@@ -242,6 +261,17 @@ fn main() -> nonsmooth::Result<()> {
         .position(|a| a == "--theta-atol")
         .and_then(|i| args.get(i + 1))
         .map_or(100.0, |s| s.parse::<f64>().unwrap_or(f64::NAN));
+    // The contact band δ* (m): contact segments on if given.
+    let onset = args
+        .iter()
+        .position(|a| a == "--onset")
+        .and_then(|i| args.get(i + 1))
+        .map(|s| s.parse::<f64>().unwrap_or(f64::NAN));
+    let cfg = Config {
+        band,
+        theta_atol,
+        onset,
+    };
     let osc = PAPER.oscillator::<f64>(OMEGA)?;
     let period = TAU / OMEGA;
     let (n_starts, span) = if quick { (5, 5.0) } else { (20, 5.0) };
@@ -292,14 +322,10 @@ fn main() -> nonsmooth::Result<()> {
         let mut sq = 0.0;
         let (mut evals, mut attempts, mut segs, mut seg_attempts, mut abandoned) =
             (0u64, 0u64, 0u64, 0u64, 0u64);
+        let (mut contact, mut contact_attempts) = (0u64, 0u64);
         let clock = Instant::now();
         for &(t0, y0, x_ref) in &starts {
-            let seg_tol = Tolerances::per_component(rtol, [rtol * theta_atol, rtol * 1e-4])?;
-            let stepper = TurningPoints::new(
-                Dopri5::new(time_tolerances(rtol)?),
-                Dopri5::new(seg_tol),
-                band,
-            )?;
+            let stepper = cfg.stepper(rtol)?;
             let mut sim = Simulation::new(osc, stepper);
             let out = sim.run(t0, y0, t0 + span * period, &mut ())?;
             sq += (out.y[0] - x_ref).powi(2);
@@ -307,7 +333,10 @@ fn main() -> nonsmooth::Result<()> {
             let st = sim.stepper();
             let c = st.segment_counts();
             let ts = st.time_stepper().stats();
-            attempts += ts.accepted + ts.rejected + c.attempts;
+            attempts += ts.accepted + ts.rejected + c.attempts + c.contact_attempts;
+            contact += c.contact_completed;
+            contact_attempts += c.contact_attempts;
+            abandoned += c.contact_abandoned;
             segs += c.completed;
             seg_attempts += c.attempts;
             abandoned += c.abandoned;
@@ -322,9 +351,16 @@ fn main() -> nonsmooth::Result<()> {
             seg_attempts as f64 / segs.max(1) as f64,
             1000.0 * cpu / periods
         );
+        if cfg.onset.is_some() {
+            println!(
+                "|  | contact segments: {:.2}/period, {:.1} trial steps each |  |  |  |  |  |  |  |",
+                contact as f64 / periods,
+                contact_attempts as f64 / contact.max(1) as f64
+            );
+        }
     }
-    phases(band, theta_atol, &starts, span)?;
-    periodic(band, theta_atol, rtols)?;
+    phases(cfg, &starts, span)?;
+    periodic(cfg)?;
     // The exact law (η = 0) from rest in contact: the first period creeps out of resting
     // contact, where the law's rate term has its cusp.
     let mut exact = PAPER;
@@ -349,12 +385,7 @@ fn main() -> nonsmooth::Result<()> {
             ),
             Err(e) => println!("| {rtol:e} | DOPRI5 in time | failed: {e} | – |"),
         }
-        let seg_tol = Tolerances::per_component(rtol, [rtol * theta_atol, rtol * 1e-4])?;
-        let stepper = TurningPoints::new(
-            Dopri5::new(time_tolerances(rtol)?),
-            Dopri5::new(seg_tol),
-            band,
-        )?;
+        let stepper = cfg.stepper(rtol)?;
         let mut sim = Simulation::new(osc0, stepper);
         match sim.run(0.0, y0, t1, &mut ()) {
             Ok(o) => println!(

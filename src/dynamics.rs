@@ -53,6 +53,13 @@ pub trait Dynamics<T: Real, const N: usize> {
     fn velocity_exponent(&self) -> Option<T> {
         None
     }
+
+    /// For a one-degree-of-freedom system with state `(x, ẋ)`: where a contact force starts
+    /// as a power of the penetration, if it does (see
+    /// [`ForceLaw::contact_onset`](crate::ForceLaw::contact_onset)). Default `None`.
+    fn contact_onset(&self) -> Option<crate::force::ContactOnset<T>> {
+        None
+    }
 }
 
 impl<T: Real, const N: usize, D: Dynamics<T, N> + ?Sized> Dynamics<T, N> for &D {
@@ -71,5 +78,9 @@ impl<T: Real, const N: usize, D: Dynamics<T, N> + ?Sized> Dynamics<T, N> for &D 
     #[inline(always)]
     fn velocity_exponent(&self) -> Option<T> {
         (**self).velocity_exponent()
+    }
+    #[inline(always)]
+    fn contact_onset(&self) -> Option<crate::force::ContactOnset<T>> {
+        (**self).contact_onset()
     }
 }

@@ -388,3 +388,126 @@ fn periodic_orbit_sections_are_as_accurate_for_fewer_evaluations() {
         );
     }
 }
+
+/// Contact segments (`with_onset_band`) on the paper's attractor: every contact is entered
+/// and left through them, the impacts (upward crossings of x_I, at the start of each
+/// entering segment) are located as by time stepping, and the end states follow the
+/// reference as closely as time stepping's.
+#[test]
+fn contact_segments_on_the_attractor() {
+    let (t0, y0) = attractor_start();
+    let osc = PAPER.oscillator::<f64>(OMEGA).unwrap();
+    let t1 = t0 + 5.0 * PaperParameters::period(OMEGA);
+    let impact = Event::new(
+        Stop {
+            position: 0,
+            velocity: 1,
+            level: PAPER.x_i,
+        },
+        Direction::Rising,
+    );
+    let mut reference = Log::default();
+    let end_ref = Simulation::new(osc, Dop853::new(tol(1e-13)))
+        .with_events(impact)
+        .run(t0, y0, t1, &mut reference)
+        .unwrap()
+        .y;
+    for rtol in [1e-8, 1e-10] {
+        let mut plain = Log::default();
+        let end_plain = Simulation::new(osc, Dopri5::new(tol(rtol)))
+            .with_events(impact)
+            .run(t0, y0, t1, &mut plain)
+            .unwrap()
+            .y;
+        let mut log = Log::default();
+        let st = turning(rtol).with_onset_band(1e-5).unwrap();
+        let mut sim = Simulation::new(osc, st).with_events(impact);
+        let end = sim.run(t0, y0, t1, &mut log).unwrap().y;
+        let c = sim.stepper().segment_counts();
+        // Two contacts per period, each entered and left through a segment.
+        assert!(c.contact_completed >= 18, "rtol {rtol}: {c:?}");
+        assert_eq!(c.contact_abandoned, 0, "rtol {rtol}: {c:?}");
+        assert!(c.completed >= 18, "rtol {rtol}: {c:?}");
+        assert_eq!(log.events.len(), reference.events.len());
+        assert_eq!(plain.events.len(), reference.events.len());
+        let worst = |l: &Log| {
+            l.events
+                .iter()
+                .zip(&reference.events)
+                .map(|(a, b)| (a.1 - b.1).abs())
+                .fold(0.0, f64::max)
+        };
+        let (dt_seg, dt_plain) = (worst(&log), worst(&plain));
+        // Measured: 1e-8: 1.1e-7 s (segments) / 6.7e-7 s (time); 1e-10: 9.4e-9 / 1.4e-8.
+        assert!(
+            dt_seg <= 3.0 * dt_plain + 1e-10,
+            "rtol {rtol}: impacts off by {dt_seg:e} s (time stepping {dt_plain:e} s)"
+        );
+        let (e_seg, e_plain) = (
+            (end[0] - end_ref[0]).abs(),
+            (end_plain[0] - end_ref[0]).abs(),
+        );
+        // Measured: 1e-8: 2.8e-9 / 3.6e-8 m; 1e-10: 3.3e-10 / 7.5e-10 m.
+        assert!(
+            e_seg <= 3.0 * e_plain + rtol * 1e-2,
+            "rtol {rtol}: end x off by {e_seg:e} m (time stepping {e_plain:e} m)"
+        );
+    }
+}
+
+/// A stop on the lower side (`Side::Lower`), a Hertz contact with a cusped damping term
+/// (`n3 = 1/2`) and a linear spring, forced: segments at the turning points and through
+/// both ends of each contact give the reference's end state and contact crossings.
+#[test]
+fn a_lower_stop_with_contact_segments() {
+    use nonsmooth::force::{HertzContact, Side};
+    let contact = HertzContact::new(-0.01, 1e7)
+        .unwrap()
+        .with_side(Side::Lower)
+        .with_damping(0.5, 1.5, 0.5)
+        .unwrap();
+    let osc = Oscillator::new(
+        1.0,
+        (
+            LinearSpring::new(400.0).unwrap(),
+            ViscousDamper::new(0.5).unwrap(),
+            contact,
+        ),
+        nonsmooth::excite::Harmonic::new(8.0, 15.0, 0.0).unwrap(),
+    )
+    .unwrap();
+    assert_eq!(osc.velocity_exponent(), Some(0.5));
+    let onset = osc.contact_onset().unwrap();
+    assert_eq!(
+        (onset.position, onset.side, onset.exponent),
+        (-0.01, Side::Lower, 1.5)
+    );
+    // Downward crossings of the stop.
+    let entering = Event::new(Level::new(0, -0.01).unwrap(), Direction::Falling);
+    let (y0, t1) = (Vector2::new(0.0, 0.0), 4.0);
+    let mut reference = Log::default();
+    let end_ref = Simulation::new(osc, Dop853::new(tol(1e-13)))
+        .with_events(entering)
+        .run(0.0, y0, t1, &mut reference)
+        .unwrap()
+        .y;
+    assert!(reference.events.len() >= 10, "{}", reference.events.len());
+    let mut log = Log::default();
+    let st = TurningPoints::dopri5(tol(1e-10), 1e-2)
+        .unwrap()
+        .with_onset_band(1e-5)
+        .unwrap();
+    let mut sim = Simulation::new(osc, st).with_events(entering);
+    let end = sim.run(0.0, y0, t1, &mut log).unwrap().y;
+    let c = sim.stepper().segment_counts();
+    // Measured: 36 contact segments (18 contacts), 37 velocity segments, none abandoned;
+    // event times within 1.7e-9 s and the end state within 1.3e-8 of the reference.
+    assert!(c.contact_completed >= 30, "{c:?}");
+    assert_eq!(c.contact_abandoned, 0, "{c:?}");
+    assert!(c.completed >= 30, "{c:?}");
+    assert_eq!(log.events.len(), reference.events.len());
+    for (a, b) in log.events.iter().zip(&reference.events) {
+        assert!((a.1 - b.1).abs() < 1e-8, "{a:?} vs {b:?}");
+    }
+    assert!((end - end_ref).norm() < 1e-7, "{end:?} vs {end_ref:?}");
+}

@@ -264,6 +264,21 @@ impl<T: Real> ForceLaw<T> for HertzContact<T> {
         }
     }
 
+    /// The stop, its side and the smaller of `n1` and (with damping) `n2`.
+    fn contact_onset(&self) -> Option<crate::force::ContactOnset<T>> {
+        let n1 = self.n1.value();
+        let n = if self.b > T::zero() && self.n2.value() < n1 {
+            self.n2.value()
+        } else {
+            n1
+        };
+        Some(crate::force::ContactOnset {
+            position: self.x_i,
+            side: self.side,
+            exponent: n,
+        })
+    }
+
     /// `n3` when the damping term has a cusp (`b > 0`, `n3 < 1`), with or without the rate
     /// regularization: with `η > 0` the cusp is rounded off inside `|δ̇| ≲ η`, and the
     /// power scale `u = sgn(δ̇)|δ̇|^{n3}` still straightens the term outside that layer.

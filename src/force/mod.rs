@@ -75,6 +75,50 @@ pub trait ForceLaw<T: Real> {
     fn velocity_exponent(&self) -> Option<T> {
         None
     }
+
+    /// Where the law's force starts as a power of a penetration, if it does: a contact law
+    /// `F ∝ δ^n` for `δ = ±(x − x_I) > 0` and zero on the other side (see
+    /// [`ContactOnset`]). A trajectory that enters or leaves contact with `ẋ ≠ 0` then has
+    /// a `|τ|^{n}` term in its acceleration; [`TurningPoints`](crate::integrate::TurningPoints)
+    /// (with [`with_onset_band`](crate::integrate::TurningPoints::with_onset_band)) crosses
+    /// the first `δ*` of the contact with `δ = w^m` as the independent variable. Default
+    /// `None`.
+    fn contact_onset(&self) -> Option<ContactOnset<T>> {
+        None
+    }
+}
+
+/// The onset of a contact force: `F ∝ δ^n` near `δ = 0⁺`, with the penetration
+/// `δ = x − x_I` ([`Side::Upper`]) or `δ = x_I − x` ([`Side::Lower`]), and no force for
+/// `δ < 0`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContactOnset<T> {
+    /// The stop `x_I`.
+    pub position: T,
+    /// Which side of the stop is in contact.
+    pub side: Side,
+    /// The smallest exponent of `δ` in the force near `δ = 0⁺` (`n > 0`).
+    pub exponent: T,
+}
+
+impl<T: Real> ContactOnset<T> {
+    /// The penetration `δ` at `x` (negative when separated).
+    #[inline(always)]
+    pub fn penetration(&self, x: T) -> T {
+        match self.side {
+            Side::Upper => x - self.position,
+            Side::Lower => self.position - x,
+        }
+    }
+
+    /// `+1` if the penetration grows with `x` ([`Side::Upper`]), else `−1`.
+    #[inline(always)]
+    pub fn direction(&self) -> T {
+        match self.side {
+            Side::Upper => T::one(),
+            Side::Lower => -T::one(),
+        }
+    }
 }
 
 /// The smaller of two declared exponents (a sum of laws has the strongest cusp of its terms).
@@ -111,6 +155,9 @@ impl<T: Real, F: ForceLaw<T> + ?Sized> ForceLaw<T> for &F {
     fn velocity_exponent(&self) -> Option<T> {
         (**self).velocity_exponent()
     }
+    fn contact_onset(&self) -> Option<ContactOnset<T>> {
+        (**self).contact_onset()
+    }
 }
 
 /// The sum of two laws, `A + B`, itself a law. Tuples of up to eight laws are laws too.
@@ -131,6 +178,10 @@ impl<T: Real, A: ForceLaw<T>, B: ForceLaw<T>> ForceLaw<T> for Sum<A, B> {
     }
     fn velocity_exponent(&self) -> Option<T> {
         min_exponent(self.0.velocity_exponent(), self.1.velocity_exponent())
+    }
+    /// The first term's onset, else the second's (one stop is used).
+    fn contact_onset(&self) -> Option<ContactOnset<T>> {
+        self.0.contact_onset().or_else(|| self.1.contact_onset())
     }
 }
 
@@ -168,6 +219,11 @@ macro_rules! tuple_law {
                 let mut q = None;
                 $(q = min_exponent(q, self.$idx.velocity_exponent());)+
                 q
+            }
+            fn contact_onset(&self) -> Option<ContactOnset<T>> {
+                let mut o = None;
+                $(o = o.or_else(|| self.$idx.contact_onset());)+
+                o
             }
         }
     };

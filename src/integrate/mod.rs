@@ -26,7 +26,7 @@ mod dop853;
 pub(crate) mod dopri5;
 mod rk4;
 mod rosenbrock;
-mod turning;
+pub mod turning;
 
 pub use dop853::{Dop853, Dop853Dense};
 pub use dopri5::{Dopri5, Dopri5Dense};

@@ -38,6 +38,30 @@
 //! observers work inside segments unchanged. A step never passes the driver's `t_limit`: a
 //! segment step that would is cut at `τ(s) = t_limit − t₀` and the segment goes on from there.
 //!
+//! # Contact onset and exit
+//! A contact force `∝ δ^n` (`n = 3/2` for Hertz) switched on at `δ = 0` gives the
+//! acceleration a `|τ|^n` term where the body enters or leaves contact with `ẋ ≠ 0`. With
+//! [`TurningPoints::with_onset_band`] and a contact the system declares
+//! ([`Dynamics::contact_onset`]), the first `δ*` of each contact is crossed with the
+//! penetration's power scale as the independent variable, `δ = w^m` (`m` the smallest
+//! integer with `m·n` integral, `m = 2` for Hertz: `δ^{3/2} = w³`), state `(θ, ẋ)`:
+//!
+//! ```text
+//! dτ/dw = δ'(w)/ẋ,   dẋ/dw = ẍ·δ'(w)/ẋ,
+//! ```
+//!
+//! from `w = 0` (the crossing of the stop, located on the time step's dense output) to
+//! `w = δ*^{1/m}` entering, and back from `δ = δ*` to exactly `δ = 0` leaving. It needs
+//! `ẋ ≠ 0` across the band; a contact shallower than `δ*` (the body turns round inside
+//! it) abandons the segment and is stepped in time. Measured on the paper's model
+//! (`examples/turning_points.rs -- --onset 1e-5`), this does not pay: time stepping spends
+//! about 7 attempts per crossing of `[0, 10⁻⁵ m]` at rtol 10⁻⁸, a segment 6.7 plus two
+//! restarts, after which the time stepper regrows its step inside the contact (80 → 88
+//! accepted steps per period there). On the attractor it costs 9 % more evaluations than
+//! the velocity segments alone at about the same error; on the stable period-2 orbit the
+//! work–precision gain over time stepping is 0.95–1.69× (median 1.33×) against 1.02–1.47×
+//! (median 1.29×) without it. It is off by default.
+//!
 //! # When a segment is not used, or is left
 //! - The system declares no exponent, or its `f₀ ≠ ẋ` (not a one-degree-of-freedom system in
 //!   `(x, ẋ)`): the time stepper alone (the generic path).
@@ -62,20 +86,22 @@ use nalgebra::{SVector, Vector2};
 
 use super::{DenseOutput, IntegrateError, Stats, Stepper};
 use crate::error::ParameterError;
+use crate::force::ContactOnset;
 use crate::roots::brent;
 use crate::scalar::lit;
 use crate::validate::positive;
 use crate::{Dynamics, Real};
 
 /// The most accepted steps a segment may take before it is abandoned (a guard against a
-/// segment that crawls because `a → 0`; typical segments take 5–30).
+/// segment that crawls because `a → 0` or `ẋ → 0`; typical segments take 3–40).
 const MAX_SEGMENT_STEPS: u32 = 10_000;
 
 /// A stepper that crosses `ẋ = 0` of a one-degree-of-freedom system in the power scale of
-/// the velocity that the system declares (see the [module docs](self) for the method).
+/// the velocity that the system declares, and optionally the first `δ*` of a declared
+/// contact in a power scale of the penetration (see the [module docs](self) for the method).
 ///
-/// `St` steps in time; `Sg` steps the segments' `(τ, x)` in `s`. Both keep their step-size
-/// history between uses. Without a declared exponent it is the time stepper alone.
+/// `St` steps in time; `Sg` steps the segments in `s`. Both keep their step-size history
+/// between uses. Without a declaration it is the time stepper alone.
 ///
 /// ```
 /// use nonsmooth::drive::Simulation;
@@ -98,6 +124,7 @@ pub struct TurningPoints<T: Real, St: Stepper<T, 2>, Sg: Stepper<T, 2>> {
     time: St,
     seg: Sg,
     band: T,
+    onset_band: Option<T>,
     mode: Mode<T>,
     t: T,
     y: SVector<T, 2>,
@@ -107,20 +134,30 @@ pub struct TurningPoints<T: Real, St: Stepper<T, 2>, Sg: Stepper<T, 2>> {
     own_evals: u64,
     /// Set by `reset_state`: the next step may start a segment at once.
     fresh: bool,
-    /// After an abandoned segment: no new one until `|ẋ|` has left the band.
+    /// After an abandoned velocity segment: no new one until `|ẋ|` has left the band.
     cooldown: bool,
+    /// After an abandoned contact segment: no new one until `δ` has left `[0, δ*]`.
+    cooldown_onset: bool,
     counts: SegmentCounts,
 }
 
 /// What the segments did (cumulative since construction).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct SegmentCounts {
-    /// Segments completed (crossed to the far edge of the band).
+    /// Velocity segments completed (crossed to the far edge of the band).
     pub completed: u64,
-    /// Segments abandoned (the acceleration vanished or changed sign, or a step failed).
+    /// Velocity segments abandoned (the acceleration vanished or changed sign, or a step
+    /// failed).
     pub abandoned: u64,
-    /// Accepted plus rejected steps of the segment stepper.
+    /// Accepted plus rejected steps of the segment stepper in velocity segments.
     pub attempts: u64,
+    /// Contact segments completed (entering or leaving contact).
+    pub contact_completed: u64,
+    /// Contact segments abandoned (the velocity vanished inside `[0, δ*]`, or a step
+    /// failed).
+    pub contact_abandoned: u64,
+    /// Accepted plus rejected steps of the segment stepper in contact segments.
+    pub contact_attempts: u64,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -129,16 +166,81 @@ enum Mode<T> {
     Segment(Segment<T>),
 }
 
-/// A segment under way: its start time, direction and exponent.
+/// The independent variable of a segment and how the state follows from it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Kind<T> {
+    /// Across `ẋ = 0`: `ẋ = sgn(u)|u|^p`, `u = σs`; segment state `(θ, x)`.
+    Velocity { sigma: T, p: i32 },
+    /// Across `δ ∈ [0, δ*]`: `δ = w^m`, `w = σs` (`σ = +1` entering, `−1` leaving);
+    /// segment state `(θ, ẋ)`.
+    Contact {
+        onset: ContactOnset<T>,
+        sigma: T,
+        m: i32,
+    },
+}
+
+impl<T: Real> Kind<T> {
+    /// `(x, ẋ)` at `s` for the segment state `z`.
+    #[inline(always)]
+    fn state(&self, s: T, z: &SVector<T, 2>) -> Vector2<T> {
+        match *self {
+            Kind::Velocity { sigma, p } => Vector2::new(z[1], velocity(sigma * s, p)),
+            Kind::Contact { onset, sigma, m } => {
+                let w = (sigma * s).max(T::zero());
+                Vector2::new(onset.position + onset.direction() * w.powi(m), z[1])
+            }
+        }
+    }
+
+    /// `dτ/ds` at `s` with `ẋ = v`, and `ds`-derivative factor of the second component
+    /// (`d(z₁)/ds = factor·dτ/ds`): `ẋ` for a velocity segment, `ẍ` for a contact one.
+    /// `a` is `ẍ` at the point.
+    #[inline(always)]
+    fn rates(&self, s: T, v: T, a: T) -> (T, T) {
+        match *self {
+            Kind::Velocity { sigma, p } => {
+                let au = (sigma * s).abs();
+                // ẋ'(u) = p|u|^{p−1} = p|ẋ|/|u|: 0 at u = 0 (p ≥ 2).
+                let dv = if au > T::zero() {
+                    lit::<T>(f64::from(p)) * v.abs() / au
+                } else {
+                    T::zero()
+                };
+                (sigma * dv / a, v)
+            }
+            Kind::Contact { onset, sigma, m } => {
+                let w = (sigma * s).max(T::zero());
+                let dx = onset.direction() * lit::<T>(f64::from(m)) * w.powi(m - 1) * sigma;
+                (dx / v, a)
+            }
+        }
+    }
+
+    fn is_contact(&self) -> bool {
+        matches!(self, Kind::Contact { .. })
+    }
+}
+
+/// A segment under way.
 #[derive(Debug, Clone, Copy)]
 struct Segment<T> {
     t0: T,
-    /// The segment's time unit `V*/|a|` at entry: its state holds `θ = τ/scale`.
+    /// The segment's time unit (`V*/|a|` or `δ*/|ẋ|` at entry): its state holds
+    /// `θ = τ/scale`.
     scale: T,
-    sigma: T,
-    p: i32,
     s_end: T,
     steps: u32,
+    /// The segment stepper's attempts when the segment began.
+    attempts0: u64,
+    kind: Kind<T>,
+}
+
+/// A place in a time step where a segment may begin.
+#[derive(Debug, Clone, Copy)]
+enum Entry {
+    Velocity,
+    Contact { leaving: bool },
 }
 
 impl<T: Real, St: Stepper<T, 2>, Sg: Stepper<T, 2>> TurningPoints<T, St, Sg>
@@ -146,7 +248,8 @@ where
     St::Dense: Clone,
     Sg::Dense: Clone,
 {
-    /// A time stepper, a segment stepper and the band `|ẋ| < v_band` in which segments run.
+    /// A time stepper, a segment stepper and the band `|ẋ| < v_band` in which velocity
+    /// segments run.
     ///
     /// The band should hold the turning point's cusp and friction layer (for the paper's
     /// model 3·10⁻³ m/s, where the acceleration is 10²–10⁴ m/s²) and be thin enough for the
@@ -165,11 +268,9 @@ where
             f1: SVector::zeros(),
             time: time.dense().clone(),
             seg: segment.dense().clone(),
-            in_segment: false,
+            kind: None,
             t_seg: T::zero(),
             scale: T::one(),
-            sigma: T::one(),
-            p: 1,
             s0: T::zero(),
             s1: T::zero(),
         };
@@ -177,6 +278,7 @@ where
             time,
             seg: segment,
             band: v_band,
+            onset_band: None,
             mode: Mode::Time,
             t: T::zero(),
             y: SVector::zeros(),
@@ -185,8 +287,20 @@ where
             own_evals: 0,
             fresh: false,
             cooldown: false,
+            cooldown_onset: false,
             counts: SegmentCounts::default(),
         })
+    }
+
+    /// Also crosses the first `delta_band` of a contact that the system declares
+    /// ([`Dynamics::contact_onset`]) in the penetration's power scale, entering and leaving
+    /// (see the [module docs](self#contact-onset-and-exit)).
+    ///
+    /// # Errors
+    /// [`ParameterError`] unless `delta_band` is finite and > 0.
+    pub fn with_onset_band(mut self, delta_band: T) -> Result<Self, ParameterError> {
+        self.onset_band = Some(positive("delta_band", delta_band)?);
+        Ok(self)
     }
 
     /// The time stepper.
@@ -199,17 +313,28 @@ where
         &self.seg
     }
 
-    /// Segments completed so far.
+    /// Velocity segments completed so far.
     pub fn segments(&self) -> u64 {
         self.counts.completed
     }
 
-    /// What the segments did so far.
+    /// What the segments did so far (a segment under way counts its attempts so far).
     pub fn segment_counts(&self) -> SegmentCounts {
         let mut c = self.counts;
-        let s = self.seg.stats();
-        c.attempts = s.accepted + s.rejected;
+        if let Mode::Segment(g) = self.mode {
+            let n = self.seg_attempts() - g.attempts0;
+            if g.kind.is_contact() {
+                c.contact_attempts += n;
+            } else {
+                c.attempts += n;
+            }
+        }
         c
+    }
+
+    fn seg_attempts(&self) -> u64 {
+        let s = self.seg.stats();
+        s.accepted + s.rejected
     }
 
     fn sync_stats(&mut self) {
@@ -229,14 +354,26 @@ where
         f
     }
 
-    /// Starts a segment at `(t, y)` with `f = f(t, y)` if the velocity is in the band and
-    /// heads to zero (or is zero with `a ≠ 0`) and the system is `(x, ẋ)` with a declared
-    /// exponent.
+    fn begin(&mut self, t: T, s0: T, z0: Vector2<T>, scale: T, s_end: T, kind: Kind<T>) {
+        self.seg.reset_state(s0, z0);
+        self.mode = Mode::Segment(Segment {
+            t0: t,
+            scale,
+            s_end,
+            steps: 0,
+            attempts0: self.seg_attempts(),
+            kind,
+        });
+    }
+
+    /// Starts a velocity segment at `(t, y)` with `f = f(t, y)` if the velocity is in the
+    /// band and heads to zero (or is zero with `a ≠ 0`) and the system is `(x, ẋ)` with a
+    /// declared exponent.
     ///
     /// `v_max` bounds `|ẋ|`: the band for a fresh state, a little more at a located edge
     /// (the crossing is located to the rounding of `t`, so `|ẋ|` may exceed the band by a
     /// few ulps there).
-    fn try_enter(
+    fn enter_velocity(
         &mut self,
         q: Option<T>,
         t: T,
@@ -256,41 +393,146 @@ where
         if !usable {
             return false;
         }
-        let Some(p) = power_of(q) else { return false };
+        let Some(p) = velocity_power(q) else {
+            return false;
+        };
         let r = T::one() / lit::<T>(f64::from(p));
         let sigma = if a > T::zero() { T::one() } else { -T::one() };
-        let u0 = v.signum() * v.abs().powf(r);
         let s0 = if v == T::zero() {
             T::zero()
         } else {
-            sigma * u0
+            sigma * v.signum() * v.abs().powf(r)
         };
-        self.seg.reset_state(s0, Vector2::new(T::zero(), y[0]));
-        self.mode = Mode::Segment(Segment {
-            t0: t,
-            scale: self.band / a.abs(),
-            sigma,
-            p,
-            s_end: self.band.powf(r),
-            steps: 0,
-        });
+        let kind = Kind::Velocity { sigma, p };
+        let z0 = Vector2::new(T::zero(), y[0]);
+        self.begin(t, s0, z0, self.band / a.abs(), self.band.powf(r), kind);
+        true
+    }
+
+    /// Starts a contact segment at `(t, y)`: entering at `δ ≈ 0` with `ẋ` into the contact,
+    /// or leaving at `δ ≈ δ*` with `ẋ` out of it.
+    fn enter_contact(
+        &mut self,
+        onset: ContactOnset<T>,
+        t: T,
+        y: &SVector<T, 2>,
+        f: &SVector<T, 2>,
+        leaving: bool,
+    ) -> bool {
+        let Some(band) = self.onset_band else {
+            return false;
+        };
+        let Some(m) = contact_power(onset.exponent) else {
+            return false;
+        };
+        let v = y[1];
+        let inward = v * onset.direction();
+        let moving = if leaving {
+            inward < T::zero()
+        } else {
+            inward > T::zero()
+        };
+        let delta = onset.penetration(y[0]).max(T::zero());
+        if !(moving && f[0] == v && f[1].is_finite() && delta <= band * lit(2.0)) {
+            return false;
+        }
+        let r = T::one() / lit::<T>(f64::from(m));
+        let w0 = delta.powf(r);
+        let (sigma, s0, s_end) = if leaving {
+            (-T::one(), -w0, T::zero())
+        } else {
+            (T::one(), w0, band.powf(r))
+        };
+        if !(s0 < s_end) {
+            return false;
+        }
+        let kind = Kind::Contact { onset, sigma, m };
+        self.begin(
+            t,
+            s0,
+            Vector2::new(T::zero(), v),
+            band / v.abs(),
+            s_end,
+            kind,
+        );
         true
     }
 
     /// Leaves a segment at `(t, y)`: the time stepper goes on from there.
-    fn leave(&mut self, t: T, y: SVector<T, 2>, abandoned: bool) {
+    fn leave(&mut self, g: &Segment<T>, t: T, y: SVector<T, 2>, abandoned: bool) {
         self.mode = Mode::Time;
         self.time.reset_state(t, y);
-        if abandoned {
-            self.counts.abandoned += 1;
-            self.cooldown = true;
+        let n = self.seg_attempts() - g.attempts0;
+        let c = &mut self.counts;
+        match (g.kind.is_contact(), abandoned) {
+            (false, false) => c.completed += 1,
+            (false, true) => c.abandoned += 1,
+            (true, false) => c.contact_completed += 1,
+            (true, true) => c.contact_abandoned += 1,
+        }
+        if g.kind.is_contact() {
+            c.contact_attempts += n;
+            self.cooldown_onset |= abandoned;
         } else {
-            self.counts.completed += 1;
+            c.attempts += n;
+            self.cooldown |= abandoned;
         }
     }
 
-    /// One time step; cut where `|ẋ|` enters the band heading to zero, and a segment is
-    /// started there.
+    /// Where in the time step just taken a segment may begin: the earliest of `|ẋ|`
+    /// entering the band heading to zero, the penetration crossing 0 inward and the
+    /// penetration crossing `δ*` outward.
+    fn entries<S: Dynamics<T, 2>>(
+        &self,
+        sys: &S,
+        t0: T,
+        y0: &SVector<T, 2>,
+    ) -> [Option<(T, Entry)>; 2] {
+        let (t1, y1) = (self.dense.t1, self.dense.y1);
+        let d = &self.dense.time;
+        let mut out = [None, None];
+        let (v0, v1) = (y0[1], y1[1]);
+        if sys.velocity_exponent().is_some() && !self.cooldown && v0.abs() >= self.band {
+            let edge = if v0 > T::zero() {
+                self.band
+            } else {
+                -self.band
+            };
+            if (v1 - edge) * (v0 - edge) < T::zero() || v1 == edge {
+                let tc = if v1 == edge {
+                    t1
+                } else {
+                    crossing(d, t0, v0 - edge, t1, v1 - edge, |y| y[1] - edge)
+                };
+                out[0] = Some((tc, Entry::Velocity));
+            }
+        }
+        if let (Some(band), Some(onset), false) =
+            (self.onset_band, sys.contact_onset(), self.cooldown_onset)
+        {
+            let (d0, d1) = (onset.penetration(y0[0]), onset.penetration(y1[0]));
+            if d0 < T::zero() && d1 >= T::zero() {
+                let tc = if d1 == T::zero() {
+                    t1
+                } else {
+                    crossing(d, t0, d0, t1, d1, |y| onset.penetration(y[0]))
+                };
+                out[1] = Some((tc, Entry::Contact { leaving: false }));
+            } else if d0 > band && d1 <= band {
+                let tc = if d1 == band {
+                    t1
+                } else {
+                    crossing(d, t0, d0 - band, t1, d1 - band, |y| {
+                        onset.penetration(y[0]) - band
+                    })
+                };
+                out[1] = Some((tc, Entry::Contact { leaving: true }));
+            }
+        }
+        out
+    }
+
+    /// One time step; cut where a segment begins (see [`entries`](Self::entries)).
     fn time_step<S: Dynamics<T, 2>>(&mut self, sys: &S, t_limit: T) -> Result<(), IntegrateError> {
         let (t0, y0) = (self.t, self.y);
         self.time.step(sys, t_limit)?;
@@ -299,7 +541,7 @@ where
         let (f0, f1) = d.end_derivatives();
         let (f0, f1) = (*f0, *f1);
         self.dense.time = d.clone();
-        self.dense.in_segment = false;
+        self.dense.kind = None;
         self.dense.t0 = t0;
         self.dense.y0 = y0;
         self.dense.f0 = f0;
@@ -308,52 +550,62 @@ where
         self.dense.f1 = f1;
         self.t = t1;
         self.y = y1;
-        let (v0, v1) = (y0[1], y1[1]);
-        if v1.abs() >= self.band {
+        if y1[1].abs() >= self.band {
             self.cooldown = false;
         }
-        let q = sys.velocity_exponent();
-        if q.is_none() || self.cooldown || !(v0.abs() >= self.band) {
-            return Ok(());
+        if let (Some(band), Some(onset)) = (self.onset_band, sys.contact_onset()) {
+            let d1 = onset.penetration(y1[0]);
+            if d1 < T::zero() || d1 > band {
+                self.cooldown_onset = false;
+            }
         }
-        let edge = if v0 > T::zero() {
-            self.band
-        } else {
-            -self.band
-        };
-        // Entered the band (or crossed it) in this step?
-        if !((v1 - edge) * (v0 - edge) < T::zero() || v1 == edge) {
-            return Ok(());
+        let mut found = self.entries(sys, t0, &y0);
+        // Earliest first.
+        if let [Some(a), Some(b)] = found
+            && b.0 < a.0
+        {
+            found = [Some(b), Some(a)];
         }
-        let (tc, yc) = if v1 == edge {
-            (t1, y1)
-        } else {
-            let tc = velocity_crossing(&self.dense.time, t0, v0 - edge, t1, v1 - edge, edge);
-            let mut yc = SVector::zeros();
-            self.dense.time.interpolate_unchecked(tc, &mut yc);
-            (tc, yc)
-        };
-        if !(tc > t0) {
-            return Ok(());
-        }
-        let fc = if tc == t1 {
-            f1
-        } else {
-            self.eval(sys, tc, &yc)
-        };
-        if self.try_enter(q, tc, &yc, &fc, self.band * lit(2.0)) {
-            // The time step ends at the band's edge.
-            self.dense.t1 = tc;
-            self.dense.y1 = yc;
-            self.dense.f1 = fc;
-            self.t = tc;
-            self.y = yc;
+        for (tc, entry) in found.into_iter().flatten() {
+            if !(tc > t0) {
+                continue;
+            }
+            let yc = if tc == t1 {
+                y1
+            } else {
+                let mut yc = SVector::zeros();
+                self.dense.time.interpolate_unchecked(tc, &mut yc);
+                yc
+            };
+            let fc = if tc == t1 {
+                f1
+            } else {
+                self.eval(sys, tc, &yc)
+            };
+            let entered = match entry {
+                Entry::Velocity => {
+                    self.enter_velocity(sys.velocity_exponent(), tc, &yc, &fc, self.band * lit(2.0))
+                }
+                Entry::Contact { leaving } => match sys.contact_onset() {
+                    Some(onset) => self.enter_contact(onset, tc, &yc, &fc, leaving),
+                    None => false,
+                },
+            };
+            if entered {
+                // The time step ends where the segment begins.
+                self.dense.t1 = tc;
+                self.dense.y1 = yc;
+                self.dense.f1 = fc;
+                self.t = tc;
+                self.y = yc;
+                break;
+            }
         }
         Ok(())
     }
 
-    /// One accepted step of the segment (or, if it is abandoned, a time step from its last
-    /// point). Returns `false` if the segment was abandoned before a step was reported.
+    /// One accepted step of the segment. Returns `false` if the segment was left before a
+    /// step was reported (abandoned, or finished below the resolution of `t`).
     fn segment_step<S: Dynamics<T, 2>>(
         &mut self,
         sys: &S,
@@ -372,46 +624,43 @@ where
                 sys,
                 t0: g.t0,
                 scale: g.scale,
-                p: g.p,
-                sigma: g.sigma,
+                kind: g.kind,
             };
             g.steps += 1;
             if g.steps > MAX_SEGMENT_STEPS || self.seg.step(&r, g.s_end).is_err() {
-                self.leave(t_a, y_a, true);
+                self.leave(&g, t_a, y_a, true);
                 return Ok(false);
             }
             let (s_b, z_b) = (self.seg.current().0, *self.seg.current().1);
-            let (_, dz_b) = self.seg.dense().end_derivatives();
+            let dz_b = *self.seg.dense().end_derivatives().1;
             let dtau_b = dz_b[0] * g.scale;
-            let u_b = g.sigma * s_b;
-            let v_b = velocity(u_b, g.p);
-            // dτ/ds > 0 except at u = 0; a sign change means a changed sign.
-            let monotone = z_b[0] > z_a[0] && (dtau_b > T::zero() || u_b == T::zero());
-            if !(monotone && z_b[1].is_finite() && v_b.is_finite()) {
-                self.leave(t_a, y_a, true);
+            let y_end = g.kind.state(s_b, &z_b);
+            // dτ/ds > 0 except where the scale's derivative vanishes (u = 0, w = 0); a
+            // sign change means that a (or ẋ) changed sign.
+            let monotone = z_b[0] > z_a[0] && (dtau_b > T::zero() || dz_b[0] == T::zero());
+            if !(monotone && y_end[0].is_finite() && y_end[1].is_finite()) {
+                self.leave(&g, t_a, y_a, true);
                 return Ok(false);
             }
             let mut t_b = g.t0 + g.scale * z_b[0];
             if !(t_b > t_a) {
                 // Below the resolution of t: step on in s.
                 if s_b >= g.s_end {
-                    self.leave(t_a, y_a, false);
+                    self.leave(&g, t_a, y_a, false);
                     return Ok(false);
                 }
                 continue;
             }
             self.dense.seg = self.seg.dense().clone();
-            self.dense.in_segment = true;
+            self.dense.kind = Some(g.kind);
             self.dense.t_seg = g.t0;
             self.dense.scale = g.scale;
-            self.dense.sigma = g.sigma;
-            self.dense.p = g.p;
             self.dense.s0 = s_a;
             self.dense.s1 = s_b;
             self.dense.t0 = t_a;
             self.dense.y0 = y_a;
             self.dense.f0 = f_a;
-            let mut y_b = Vector2::new(z_b[1], v_b);
+            let mut y_b = y_end;
             let mut cut = false;
             if t_b > t_limit {
                 // Cut at τ = t_limit − t₀; the segment goes on from there.
@@ -419,17 +668,23 @@ where
                 let s_c = self.dense.invert(target);
                 let mut z_c = SVector::zeros();
                 self.dense.seg.interpolate_unchecked(s_c, &mut z_c);
-                let u_c = g.sigma * s_c;
-                y_b = Vector2::new(z_c[1], velocity(u_c, g.p));
+                z_c[0] = target;
+                y_b = g.kind.state(s_c, &z_c);
                 t_b = t_limit;
                 self.dense.s1 = s_c;
-                self.seg.reset_state(s_c, Vector2::new(target, z_c[1]));
+                self.seg.reset_state(s_c, z_c);
                 cut = true;
             }
-            let f_b = if !cut && u_b != T::zero() {
-                // a = σ·ẋ'(u)/(dτ/ds) from the step's last stage.
-                let dv = lit::<T>(f64::from(g.p)) * v_b.abs() / u_b.abs();
-                Vector2::new(v_b, g.sigma * dv / dtau_b)
+            // ẍ from the step's last stage where dτ/ds ≠ 0.
+            let f_b = if !cut && dtau_b != T::zero() {
+                let a = match g.kind {
+                    Kind::Velocity { sigma, p } => {
+                        let au = (sigma * s_b).abs();
+                        lit::<T>(f64::from(p)) * y_b[1].abs() / au * sigma / dtau_b
+                    }
+                    Kind::Contact { .. } => dz_b[1] / dtau_b,
+                };
+                Vector2::new(y_b[1], a)
             } else {
                 self.eval(sys, t_b, &y_b)
             };
@@ -439,7 +694,7 @@ where
             self.t = t_b;
             self.y = y_b;
             if !cut && s_b >= g.s_end {
-                self.leave(t_b, y_b, false);
+                self.leave(&g, t_b, y_b, false);
             } else {
                 self.mode = Mode::Segment(g);
             }
@@ -451,7 +706,8 @@ where
 impl<T: Real> TurningPoints<T, super::Dopri5<T, 2>, super::Dopri5<T, 2>> {
     /// DOPRI5 in time with the tolerances `tol` and DOPRI5 in the segments with the
     /// recommended tolerances (see [Accuracy](self#accuracy)): `rtol` of `tol`'s first
-    /// component for both, absolute `100·rtol` on `θ` and `tol`'s on `x`.
+    /// component for both, absolute `100·rtol` on `θ` and `tol`'s on the second component
+    /// (`x` in velocity segments, `ẋ` in contact segments: the larger of the two).
     ///
     /// # Errors
     /// [`ParameterError`] unless `v_band` is finite and > 0, or if a tolerance is invalid.
@@ -481,6 +737,7 @@ where
         self.time.reset_state(t, y);
         self.fresh = true;
         self.cooldown = false;
+        self.cooldown_onset = false;
     }
 
     fn step<S: Dynamics<T, 2>>(&mut self, sys: &S, t_limit: T) -> Result<(), IntegrateError> {
@@ -504,7 +761,7 @@ where
                 self.dense.t1 = t;
                 self.dense.y1 = y;
                 self.dense.f1 = f;
-                self.try_enter(q, t, &y, &f, self.band);
+                self.enter_velocity(q, t, &y, &f, self.band);
             }
         }
         let r = match self.mode {
@@ -549,34 +806,24 @@ where
     }
 }
 
-/// The system in `s = σu`, state `(θ, x)` with `τ = scale·θ`.
+/// The system in `s`: state `(θ, x)` (velocity segment) or `(θ, ẋ)` (contact segment),
+/// `τ = scale·θ`.
 struct Reparam<'a, T, S> {
     sys: &'a S,
     t0: T,
     scale: T,
-    p: i32,
-    sigma: T,
+    kind: Kind<T>,
 }
 
 impl<T: Real, S: Dynamics<T, 2>> Dynamics<T, 2> for Reparam<'_, T, S> {
     #[inline(always)]
     fn rhs(&self, s: T, z: &SVector<T, 2>, dz: &mut SVector<T, 2>) {
-        let u = self.sigma * s;
-        let au = u.abs();
-        let mag = au.powi(self.p);
-        let v = u.signum() * mag;
-        // ẋ'(u) = p|u|^{p−1} = p|ẋ|/|u|: 0 at u = 0 (p ≥ 2).
-        let dv = if au > T::zero() {
-            lit::<T>(f64::from(self.p)) * mag / au
-        } else {
-            T::zero()
-        };
+        let y = self.kind.state(s, z);
         let mut f = SVector::zeros();
-        self.sys
-            .rhs(self.t0 + self.scale * z[0], &Vector2::new(z[1], v), &mut f);
-        let dtau = self.sigma * dv / f[1];
+        self.sys.rhs(self.t0 + self.scale * z[0], &y, &mut f);
+        let (dtau, factor) = self.kind.rates(s, y[1], f[1]);
         dz[0] = dtau / self.scale;
-        dz[1] = v * dtau;
+        dz[1] = factor * dtau;
     }
 }
 
@@ -592,33 +839,32 @@ pub struct TurningDense<T: Real, TD, SD> {
     f1: SVector<T, 2>,
     time: TD,
     seg: SD,
-    in_segment: bool,
+    /// The segment's kind (`None`: a time step).
+    kind: Option<Kind<T>>,
     t_seg: T,
     scale: T,
-    sigma: T,
-    p: i32,
     s0: T,
     s1: T,
 }
 
 impl<T: Real, TD: DenseOutput<T, 2>, SD: DenseOutput<T, 2>> TurningDense<T, TD, SD> {
     /// The `s ∈ [s0, s1]` where the segment's `θ(s) = target` (Brent's method on the
-    /// segment step's dense output; `τ` is monotone on the step).
+    /// segment step's dense output; `θ` is monotone on the step).
     fn invert(&self, target: T) -> T {
         let mut z = SVector::zeros();
-        let mut tau = |s: T| {
+        let mut theta = |s: T| {
             self.seg.interpolate_unchecked(s, &mut z);
             z[0] - target
         };
         let (a, b) = (self.s0, self.s1);
-        let (fa, fb) = (tau(a), tau(b));
+        let (fa, fb) = (theta(a), theta(b));
         if !(fa < T::zero()) {
             return a;
         }
         if !(fb > T::zero()) {
             return b;
         }
-        brent(tau, a, b, fa, fb, T::zero(), 200).unwrap_or(a + (b - a) * lit(0.5))
+        brent(theta, a, b, fa, fb, T::zero(), 200).unwrap_or(a + (b - a) * lit(0.5))
     }
 }
 
@@ -639,10 +885,10 @@ impl<T: Real, TD: DenseOutput<T, 2>, SD: DenseOutput<T, 2>> DenseOutput<T, 2>
 
     #[inline]
     fn interpolate_unchecked(&self, t: T, out: &mut SVector<T, 2>) {
-        if !self.in_segment {
+        let Some(kind) = self.kind else {
             self.time.interpolate_unchecked(t, out);
             return;
-        }
+        };
         if t <= self.t0 {
             *out = self.y0;
             return;
@@ -654,16 +900,35 @@ impl<T: Real, TD: DenseOutput<T, 2>, SD: DenseOutput<T, 2>> DenseOutput<T, 2>
         let s = self.invert((t - self.t_seg) / self.scale);
         let mut z = SVector::zeros();
         self.seg.interpolate_unchecked(s, &mut z);
-        let u = self.sigma * s;
-        *out = Vector2::new(z[1], velocity(u, self.p));
+        *out = kind.state(s, &z);
     }
 }
 
 /// The integer power `p = ⌈1/q⌉` of the scale `ẋ = sgn(u)|u|^p` for a declared exponent
 /// `q ∈ (0, 1)`; `None` beyond `p = 64` (a cusp too strong for the scale to be worth it).
-fn power_of<T: Real>(q: T) -> Option<i32> {
-    let inv = crate::scalar::to_f64(T::one() / q).ceil();
+fn velocity_power<T: Real>(q: T) -> Option<i32> {
+    // The margin keeps 1/q = 3 + 1 ulp (q = 1/3 rounded) at p = 3.
+    let inv = (crate::scalar::to_f64(T::one() / q) - 1e-9).ceil();
     (2.0..=64.0).contains(&inv).then_some(inv as i32)
+}
+
+/// The integer power `m` of the scale `δ = w^m` for a contact force `∝ δ^n`: the smallest
+/// `m ≤ 8` with `m·n` an integer (`m = 2` for the Hertz `n = 3/2`: `δ^{3/2} = w³`), else
+/// `⌈6/n⌉` (six continuous derivatives in `w`, enough for a fifth-order method).
+fn contact_power<T: Real>(n: T) -> Option<i32> {
+    let n = crate::scalar::to_f64(n);
+    if !(n > 0.0 && n.is_finite()) {
+        return None;
+    }
+    (1..=8)
+        .find(|&m| {
+            let mn = f64::from(m) * n;
+            (mn - mn.round()).abs() < 1e-12
+        })
+        .or_else(|| {
+            let m = (6.0 / n).ceil();
+            (1.0..=64.0).contains(&m).then_some(m as i32)
+        })
 }
 
 /// `ẋ = sgn(u)|u|^p`.
@@ -672,20 +937,40 @@ fn velocity<T: Real>(u: T, p: i32) -> T {
     u.signum() * u.abs().powi(p)
 }
 
-/// The time in `[t0, t1]` where the time step's velocity reaches `edge` (`g = ẋ − edge`
-/// changes sign: `g0`, `g1`), by Brent's method on the dense output.
-fn velocity_crossing<T: Real, D: DenseOutput<T, 2>>(
+/// The time in `[t0, t1]` where `g(y(t))` changes sign (`g0`, `g1` at the ends), by
+/// Brent's method on the time step's dense output.
+fn crossing<T: Real, D: DenseOutput<T, 2>>(
     dense: &D,
     t0: T,
     g0: T,
     t1: T,
     g1: T,
-    edge: T,
+    g: impl Fn(&SVector<T, 2>) -> T,
 ) -> T {
     let mut y = SVector::zeros();
-    let g = |t: T| {
+    let h = |t: T| {
         dense.interpolate_unchecked(t, &mut y);
-        y[1] - edge
+        g(&y)
     };
-    brent(g, t0, t1, g0, g1, T::zero(), 200).unwrap_or(t0 + (t1 - t0) * lit(0.5))
+    brent(h, t0, t1, g0, g1, T::zero(), 200).unwrap_or(t0 + (t1 - t0) * lit(0.5))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn powers_of_the_scales() {
+        assert_eq!(velocity_power(0.18667), Some(6));
+        assert_eq!(velocity_power(0.5), Some(2));
+        assert_eq!(velocity_power(1.0 / 3.0), Some(3));
+        assert_eq!(velocity_power(0.01), None);
+        assert_eq!(velocity_power(f64::NAN), None);
+        assert_eq!(contact_power(1.5), Some(2));
+        assert_eq!(contact_power(1.0), Some(1));
+        assert_eq!(contact_power(1.25), Some(4));
+        assert_eq!(contact_power(0.3), Some(20));
+        assert_eq!(contact_power(0.0), None);
+        assert_eq!(contact_power(f64::INFINITY), None);
+    }
 }

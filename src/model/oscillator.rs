@@ -139,6 +139,11 @@ impl<T: Real, L: ForceLaw<T>, E: Excitation<T>> Dynamics<T, 2> for Oscillator<T,
     fn velocity_exponent(&self) -> Option<T> {
         self.laws().velocity_exponent()
     }
+
+    /// The laws' declared contact onset (the first of them).
+    fn contact_onset(&self) -> Option<crate::force::ContactOnset<T>> {
+        self.laws().contact_onset()
+    }
 }
 
 impl<T: Real, L: ForceLaw<T>, E: Excitation<T>> Oscillator<T, L, E> {
