@@ -43,6 +43,30 @@ impl Observer<f64, 2> for Log {
     }
 }
 
+/// Upward crossings of the paper's stop (impacts).
+fn impact() -> Event<Stop<f64>> {
+    Event::new(
+        Stop {
+            position: 0,
+            velocity: 1,
+            level: PAPER.x_i,
+        },
+        Direction::Rising,
+    )
+}
+
+/// The largest difference of event times between two logs of the same events.
+fn worst_time(log: &Log, reference: &Log) -> f64 {
+    log.events
+        .iter()
+        .zip(&reference.events)
+        .map(|(a, b)| {
+            assert_eq!(a.0, b.0);
+            (a.1 - b.1).abs()
+        })
+        .fold(0.0, f64::max)
+}
+
 fn attractor_start() -> (f64, Vector2<f64>) {
     let osc = PAPER.oscillator::<f64>(OMEGA).unwrap();
     let t0 = 50.0 * PaperParameters::period(OMEGA);
@@ -117,14 +141,7 @@ fn events_inside_segments_are_located() {
     let t1 = t0 + 5.0 * PaperParameters::period(OMEGA);
     let events = (
         Event::new(Level::new(1, 0.0).unwrap(), Direction::Either),
-        Event::new(
-            Stop {
-                position: 0,
-                velocity: 1,
-                level: PAPER.x_i,
-            },
-            Direction::Rising,
-        ),
+        impact(),
     );
     let mut reference = Log::default();
     Simulation::new(osc, Dop853::new(tol(1e-12)))
@@ -143,17 +160,7 @@ fn events_inside_segments_are_located() {
     assert_eq!(log.events.len(), reference.events.len());
     assert_eq!(plain.events.len(), reference.events.len());
     assert!(reference.events.iter().filter(|e| e.0 == 0).count() >= 15);
-    let worst = |l: &Log| {
-        l.events
-            .iter()
-            .zip(&reference.events)
-            .map(|(a, b)| {
-                assert_eq!(a.0, b.0);
-                (a.1 - b.1).abs()
-            })
-            .fold(0.0, f64::max)
-    };
-    let (dt_seg, dt_plain) = (worst(&log), worst(&plain));
+    let (dt_seg, dt_plain) = (worst_time(&log, &reference), worst_time(&plain, &reference));
     // Measured: 1.6e-8 s (segments) and 1.3e-8 s (time stepping) at the worst event, an
     // impact late in the run (the attractor is chaotic).
     assert!(
@@ -398,14 +405,7 @@ fn contact_segments_on_the_attractor() {
     let (t0, y0) = attractor_start();
     let osc = PAPER.oscillator::<f64>(OMEGA).unwrap();
     let t1 = t0 + 5.0 * PaperParameters::period(OMEGA);
-    let impact = Event::new(
-        Stop {
-            position: 0,
-            velocity: 1,
-            level: PAPER.x_i,
-        },
-        Direction::Rising,
-    );
+    let impact = impact();
     let mut reference = Log::default();
     let end_ref = Simulation::new(osc, Dop853::new(tol(1e-13)))
         .with_events(impact)
@@ -430,14 +430,7 @@ fn contact_segments_on_the_attractor() {
         assert!(c.completed >= 18, "rtol {rtol}: {c:?}");
         assert_eq!(log.events.len(), reference.events.len());
         assert_eq!(plain.events.len(), reference.events.len());
-        let worst = |l: &Log| {
-            l.events
-                .iter()
-                .zip(&reference.events)
-                .map(|(a, b)| (a.1 - b.1).abs())
-                .fold(0.0, f64::max)
-        };
-        let (dt_seg, dt_plain) = (worst(&log), worst(&plain));
+        let (dt_seg, dt_plain) = (worst_time(&log, &reference), worst_time(&plain, &reference));
         // Measured: 1e-8: 1.1e-7 s (segments) / 6.7e-7 s (time); 1e-10: 9.4e-9 / 1.4e-8.
         assert!(
             dt_seg <= 3.0 * dt_plain + 1e-10,
