@@ -126,6 +126,8 @@ pub struct TurningPoints<T: Real, St: Stepper<T, 2>, Sg: Stepper<T, 2>> {
     band: T,
     onset_band: Option<T>,
     mode: Mode<T>,
+    /// The rest of a velocity segment step after `ẋ = 0`, to report next.
+    pending: Option<Pending<T>>,
     t: T,
     y: SVector<T, 2>,
     dense: TurningDense<T, St::Dense, Sg::Dense>,
@@ -236,6 +238,15 @@ struct Segment<T> {
     kind: Kind<T>,
 }
 
+/// The end of a segment step across `ẋ = 0` whose part after `ẋ = 0` is still to be
+/// reported (the step itself is accepted and its dense output kept).
+#[derive(Debug, Clone, Copy)]
+struct Pending<T> {
+    s: T,
+    z: Vector2<T>,
+    dz: Vector2<T>,
+}
+
 /// A place in a time step where a segment may begin.
 #[derive(Debug, Clone, Copy)]
 enum Entry {
@@ -280,6 +291,7 @@ where
             band: v_band,
             onset_band: None,
             mode: Mode::Time,
+            pending: None,
             t: T::zero(),
             y: SVector::zeros(),
             dense,
@@ -461,6 +473,7 @@ where
     /// Leaves a segment at `(t, y)`: the time stepper goes on from there.
     fn leave(&mut self, g: &Segment<T>, t: T, y: SVector<T, 2>, abandoned: bool) {
         self.mode = Mode::Time;
+        self.pending = None;
         self.time.reset_state(t, y);
         let n = self.seg_attempts() - g.attempts0;
         let c = &mut self.counts;
@@ -604,8 +617,9 @@ where
         Ok(())
     }
 
-    /// One accepted step of the segment. Returns `false` if the segment was left before a
-    /// step was reported (abandoned, or finished below the resolution of `t`).
+    /// One accepted step of the segment, or the part of it after `ẋ = 0` (see
+    /// [`Pending`]). Returns `false` if the segment was left before a step was reported
+    /// (abandoned, or finished below the resolution of `t`).
     fn segment_step<S: Dynamics<T, 2>>(
         &mut self,
         sys: &S,
@@ -618,88 +632,116 @@ where
         } else {
             self.eval(sys, t_a, &y_a)
         };
-        loop {
-            let (s_a, z_a) = (self.seg.current().0, *self.seg.current().1);
-            let r = Reparam {
-                sys,
-                t0: g.t0,
-                scale: g.scale,
-                kind: g.kind,
-            };
-            g.steps += 1;
-            if g.steps > MAX_SEGMENT_STEPS || self.seg.step(&r, g.s_end).is_err() {
-                self.leave(&g, t_a, y_a, true);
-                return Ok(false);
-            }
-            let (s_b, z_b) = (self.seg.current().0, *self.seg.current().1);
-            let dz_b = *self.seg.dense().end_derivatives().1;
-            let dtau_b = dz_b[0] * g.scale;
-            let y_end = g.kind.state(s_b, &z_b);
-            // dτ/ds > 0 except where the scale's derivative vanishes (u = 0, w = 0); a
-            // sign change means that a (or ẋ) changed sign.
-            let monotone = z_b[0] > z_a[0] && (dtau_b > T::zero() || dz_b[0] == T::zero());
-            if !(monotone && y_end[0].is_finite() && y_end[1].is_finite()) {
-                self.leave(&g, t_a, y_a, true);
-                return Ok(false);
-            }
-            let mut t_b = g.t0 + g.scale * z_b[0];
-            if !(t_b > t_a) {
-                // Below the resolution of t: step on in s.
-                if s_b >= g.s_end {
-                    self.leave(&g, t_a, y_a, false);
+        let (s_a, mut s_b, mut z_b, mut dz_b) = match self.pending.take() {
+            // The rest of the step already taken, from ẋ = 0 on.
+            Some(p) => (T::zero(), p.s, p.z, p.dz),
+            None => loop {
+                let (s_a, z_a) = (self.seg.current().0, *self.seg.current().1);
+                let r = Reparam {
+                    sys,
+                    t0: g.t0,
+                    scale: g.scale,
+                    kind: g.kind,
+                };
+                g.steps += 1;
+                if g.steps > MAX_SEGMENT_STEPS || self.seg.step(&r, g.s_end).is_err() {
+                    self.leave(&g, t_a, y_a, true);
                     return Ok(false);
                 }
-                continue;
-            }
-            self.dense.seg = self.seg.dense().clone();
-            self.dense.kind = Some(g.kind);
-            self.dense.t_seg = g.t0;
-            self.dense.scale = g.scale;
-            self.dense.s0 = s_a;
-            self.dense.s1 = s_b;
-            self.dense.t0 = t_a;
-            self.dense.y0 = y_a;
-            self.dense.f0 = f_a;
-            let mut y_b = y_end;
-            let mut cut = false;
-            if t_b > t_limit {
-                // Cut at τ = t_limit − t₀; the segment goes on from there.
-                let target = (t_limit - g.t0) / g.scale;
-                let s_c = self.dense.invert(target);
-                let mut z_c = SVector::zeros();
-                self.dense.seg.interpolate_unchecked(s_c, &mut z_c);
-                z_c[0] = target;
-                y_b = g.kind.state(s_c, &z_c);
-                t_b = t_limit;
-                self.dense.s1 = s_c;
-                self.seg.reset_state(s_c, z_c);
-                cut = true;
-            }
-            // ẍ from the step's last stage where dτ/ds ≠ 0.
-            let f_b = if !cut && dtau_b != T::zero() {
-                let a = match g.kind {
-                    Kind::Velocity { sigma, p } => {
-                        let au = (sigma * s_b).abs();
-                        lit::<T>(f64::from(p)) * y_b[1].abs() / au * sigma / dtau_b
+                let (s_b, z_b) = (self.seg.current().0, *self.seg.current().1);
+                let dz_b = *self.seg.dense().end_derivatives().1;
+                let y_end = g.kind.state(s_b, &z_b);
+                // dτ/ds > 0 except where the scale's derivative vanishes (u = 0, w = 0);
+                // a sign change means that a (or ẋ) changed sign. θ may stand still in
+                // floating point next to u = 0 (it grows like |u|^p there).
+                let monotone = z_b[0] >= z_a[0] && dz_b[0] >= T::zero();
+                if !(monotone && y_end[0].is_finite() && y_end[1].is_finite()) {
+                    self.leave(&g, t_a, y_a, true);
+                    return Ok(false);
+                }
+                if !(g.t0 + g.scale * z_b[0] > t_a) {
+                    // Below the resolution of t: step on in s.
+                    if s_b >= g.s_end {
+                        self.leave(&g, t_a, y_a, false);
+                        return Ok(false);
                     }
-                    Kind::Contact { .. } => dz_b[1] / dtau_b,
-                };
-                Vector2::new(y_b[1], a)
-            } else {
-                self.eval(sys, t_b, &y_b)
-            };
-            self.dense.t1 = t_b;
-            self.dense.y1 = y_b;
-            self.dense.f1 = f_b;
-            self.t = t_b;
-            self.y = y_b;
-            if !cut && s_b >= g.s_end {
-                self.leave(&g, t_b, y_b, false);
-            } else {
-                self.mode = Mode::Segment(g);
+                    continue;
+                }
+                self.dense.seg = self.seg.dense().clone();
+                break (s_a, s_b, z_b, dz_b);
+            },
+        };
+        self.dense.kind = Some(g.kind);
+        self.dense.t_seg = g.t0;
+        self.dense.scale = g.scale;
+        self.dense.s0 = s_a;
+        self.dense.t0 = t_a;
+        self.dense.y0 = y_a;
+        self.dense.f0 = f_a;
+        // A velocity step across ẋ = 0 is reported in two parts, so that no reported step
+        // has ẋ changing sign inside it: observers that look for an interior extremum of x
+        // (inverting τ(s) at every trial point) find it at the end of the first part.
+        if let Kind::Velocity { .. } = g.kind
+            && s_a < T::zero()
+            && s_b > T::zero()
+        {
+            let mut z0 = SVector::zeros();
+            self.dense.seg.interpolate_unchecked(T::zero(), &mut z0);
+            let t0 = g.t0 + g.scale * z0[0];
+            if t0 > t_a && t0 < g.t0 + g.scale * z_b[0] {
+                self.pending = Some(Pending {
+                    s: s_b,
+                    z: z_b,
+                    dz: dz_b,
+                });
+                (s_b, z_b) = (T::zero(), z0);
+                // dτ/ds = 0 at u = 0: ẍ comes from an evaluation below.
+                dz_b = SVector::zeros();
             }
-            return Ok(true);
         }
+        let dtau_b = dz_b[0] * g.scale;
+        let mut t_b = g.t0 + g.scale * z_b[0];
+        let mut y_b = g.kind.state(s_b, &z_b);
+        self.dense.s1 = s_b;
+        let mut cut = false;
+        if t_b > t_limit {
+            // Cut at τ = t_limit − t₀; the segment goes on from there.
+            let target = (t_limit - g.t0) / g.scale;
+            let s_c = self.dense.invert(target);
+            let mut z_c = SVector::zeros();
+            self.dense.seg.interpolate_unchecked(s_c, &mut z_c);
+            z_c[0] = target;
+            y_b = g.kind.state(s_c, &z_c);
+            t_b = t_limit;
+            self.dense.s1 = s_c;
+            self.seg.reset_state(s_c, z_c);
+            self.pending = None;
+            cut = true;
+        }
+        // ẍ from the step's last stage where dτ/ds ≠ 0.
+        let f_b = if !cut && dtau_b != T::zero() {
+            let a = match g.kind {
+                Kind::Velocity { sigma, p } => {
+                    let au = (sigma * s_b).abs();
+                    lit::<T>(f64::from(p)) * y_b[1].abs() / au * sigma / dtau_b
+                }
+                Kind::Contact { .. } => dz_b[1] / dtau_b,
+            };
+            Vector2::new(y_b[1], a)
+        } else {
+            self.eval(sys, t_b, &y_b)
+        };
+        self.dense.t1 = t_b;
+        self.dense.y1 = y_b;
+        self.dense.f1 = f_b;
+        self.t = t_b;
+        self.y = y_b;
+        if !cut && self.pending.is_none() && s_b >= g.s_end {
+            self.leave(&g, t_b, y_b, false);
+        } else {
+            self.mode = Mode::Segment(g);
+        }
+        Ok(true)
     }
 }
 
@@ -734,6 +776,7 @@ where
         self.t = t;
         self.y = y;
         self.mode = Mode::Time;
+        self.pending = None;
         self.time.reset_state(t, y);
         self.fresh = true;
         self.cooldown = false;
