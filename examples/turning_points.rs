@@ -11,14 +11,14 @@
 //!
 //! | rtol | RHS/period time → segments | attempts/period | attempts/segment | RMS err x time → segments | CPU |
 //! |---|---|---|---|---|---|
-//! | 1e-6 | 1014 → 752 (−26 %) | 169 → 123 | 7.8 | 4.6e-6 → 3.2e-6 | −19 % |
-//! | 1e-8 | 1928 → 1482 (−23 %) | 321 → 245 | 17.2 | 7.1e-8 → 5.9e-8 | −18 % |
-//! | 1e-10 | 3933 → 3130 (−20 %) | 655 → 520 | 35.3 | 2.6e-9 → 5.1e-10 | −15 % |
+//! | 1e-6 | 1014 → 756 (−25 %) | 169 → 123 | 7.8 | 4.6e-6 → 3.2e-6 | −15 % |
+//! | 1e-8 | 1928 → 1486 (−23 %) | 321 → 245 | 17.2 | 7.1e-8 → 5.9e-8 | −15 % |
+//! | 1e-10 | 3933 → 3134 (−20 %) | 655 → 520 | 35.3 | 2.6e-9 → 5.1e-10 | −12 % |
 //!
 //! Four segments per period (two turning points in contact, two friction reversals in free
 //! flight), none abandoned. On the chaotic attractor errors grow from period to period, so
 //! the second table measures on the stable period-2 orbit at ω = 19 rad/s: time stepping
-//! needs 1.02–1.47× (median 1.29×) the evaluations to reach the segments' error at rtol
+//! needs 1.02–1.47× (median 1.28×) the evaluations to reach the segments' error at rtol
 //! 1e-6…1e-12. With θ to rtol (`--theta-atol 1`) the gain is 0.85–1.13×, with 1000·rtol
 //! 0.94–1.35×.
 //!

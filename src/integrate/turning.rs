@@ -60,7 +60,7 @@
 //! accepted steps per period there). On the attractor it costs 9 % more evaluations than
 //! the velocity segments alone at about the same error; on the stable period-2 orbit the
 //! work–precision gain over time stepping is 0.95–1.69× (median 1.33×) against 1.02–1.47×
-//! (median 1.29×) without it. It is off by default.
+//! (median 1.28×) without it. It is off by default.
 //!
 //! # When a segment is not used, or is left
 //! - The system declares no exponent, or its `f₀ ≠ ẋ` (not a one-degree-of-freedom system in
