@@ -139,6 +139,35 @@ fn lanes_reproduce_the_scalar_paper_model_to_the_bit() {
     assert!(impacts > 200, "{impacts}");
 }
 
+/// The tail compaction: with the queue empty and at most half the lanes busy, the busy
+/// lanes move to a vector of half the width (16 → 8 → 4 → 2 here, as trajectories of 3 to
+/// 9 periods end one after another). Each trajectory is still the scalar one to the bit
+/// with exact math, and the same as on two lanes with vector math.
+#[test]
+fn tail_compaction_keeps_every_trajectory() {
+    let omegas = [17.0, 18.0, 19.0, 20.465, 22.0, 25.0, 15.7];
+    let jobs: Vec<Trajectory> = omegas
+        .iter()
+        .enumerate()
+        .map(|(k, &w)| {
+            Trajectory::periods(Member::paper(w).unwrap(), rest(), 3.0 + k as f64).unwrap()
+        })
+        .collect();
+    let tol = tol(1e-8);
+    let wide = lanes::<F64x16>(&jobs, tol, LaneMath::Exact);
+    for (job, (rec, stats, y)) in jobs.iter().zip(&wide) {
+        let (srec, sstats, sy) = scalar(job, tol, true);
+        assert_eq!(*stats, sstats, "ω = {}", job.member.omega());
+        assert_eq!(*y, sy);
+        assert_eq!(rec.sections(), srec.sections());
+        assert_eq!(rec.events, srec.events);
+    }
+    assert_eq!(
+        summary(&lanes::<F64x16>(&jobs, tol, LaneMath::Vector)),
+        summary(&lanes::<F64x2>(&jobs, tol, LaneMath::Vector))
+    );
+}
+
 /// The largest distance between the section points of two runs relative to the points'
 /// scale per component, over the last `n` sections.
 fn section_distance(a: &Record, b: &Record, n: usize) -> f64 {

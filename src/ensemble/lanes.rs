@@ -47,6 +47,9 @@ pub trait Lanes:
 {
     /// The number of lanes `L`.
     const LANES: usize;
+    /// The type with half the lanes (itself for two lanes): the ensemble moves its last
+    /// trajectories there when at most half the lanes are busy.
+    type Half: Lanes;
     /// Every lane `x`.
     fn splat(x: f64) -> Self;
     /// Lanes `src[0..L]` (`src` must hold at least `L` values; missing ones read as 0).
@@ -84,7 +87,7 @@ pub trait Lanes:
 }
 
 macro_rules! lanes_type {
-    ($name:ident, $n:expr, $align:literal, $doc:literal) => {
+    ($name:ident, $n:expr, $align:literal, $half:ident, $doc:literal) => {
         #[doc = $doc]
         ///
         /// A plain array of `f64` whose operations are lane-wise loops: the compiler turns
@@ -211,6 +214,7 @@ macro_rules! lanes_type {
         }
         impl Lanes for $name {
             const LANES: usize = $n;
+            type Half = $half;
             #[inline(always)]
             fn splat(x: f64) -> Self {
                 Self([x; $n])
@@ -297,23 +301,26 @@ macro_rules! lanes_type {
     };
 }
 
-lanes_type!(F64x2, 2, 16, "Two lanes (one SSE2 register).");
+lanes_type!(F64x2, 2, 16, F64x2, "Two lanes (one SSE2 register).");
 lanes_type!(
     F64x4,
     4,
     32,
+    F64x2,
     "Four lanes: the default width (one AVX register, two SSE2 registers)."
 );
 lanes_type!(
     F64x8,
     8,
     64,
+    F64x4,
     "Eight lanes (one AVX-512 register, two AVX or four SSE2 registers)."
 );
 lanes_type!(
     F64x16,
     16,
     64,
+    F64x8,
     "Sixteen lanes (two AVX-512, four AVX or eight SSE2 registers): more independent \
      work per instruction stream, which hides the latency of the polynomial chains in \
      `sin`, `exp` and `ln`."
