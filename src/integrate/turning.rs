@@ -84,7 +84,7 @@
 
 use nalgebra::{SVector, Vector2};
 
-use super::{DenseOutput, IntegrateError, Stats, Stepper};
+use super::{DenseOutput, HermiteDense, IntegrateError, Stats, Stepper};
 use crate::error::ParameterError;
 use crate::force::ContactOnset;
 use crate::roots::brent;
@@ -271,12 +271,7 @@ where
     pub fn new(time: St, segment: Sg, v_band: T) -> Result<Self, ParameterError> {
         positive("v_band", v_band)?;
         let dense = TurningDense {
-            t0: T::zero(),
-            t1: T::zero(),
-            y0: SVector::zeros(),
-            y1: SVector::zeros(),
-            f0: SVector::zeros(),
-            f1: SVector::zeros(),
+            ends: HermiteDense::zeros(),
             time: time.dense().clone(),
             seg: segment.dense().clone(),
             kind: None,
@@ -498,10 +493,11 @@ where
     fn entries<S: Dynamics<T, 2>>(
         &self,
         sys: &S,
+        onset: Option<(T, ContactOnset<T>)>,
         t0: T,
         y0: &SVector<T, 2>,
     ) -> [Option<(T, Entry)>; 2] {
-        let (t1, y1) = (self.dense.t1, self.dense.y1);
+        let (t1, y1) = (self.dense.ends.span().1, *self.dense.ends.endpoints().1);
         let d = &self.dense.time;
         let mut out = [None, None];
         let (v0, v1) = (y0[1], y1[1]);
@@ -520,9 +516,7 @@ where
                 out[0] = Some((tc, Entry::Velocity));
             }
         }
-        if let (Some(band), Some(onset), false) =
-            (self.onset_band, sys.contact_onset(), self.cooldown_onset)
-        {
+        if let (Some((band, onset)), false) = (onset, self.cooldown_onset) {
             let (d0, d1) = (onset.penetration(y0[0]), onset.penetration(y1[0]));
             if d0 < T::zero() && d1 >= T::zero() {
                 let tc = if d1 == T::zero() {
@@ -555,24 +549,23 @@ where
         let (f0, f1) = (*f0, *f1);
         self.dense.time = d.clone();
         self.dense.kind = None;
-        self.dense.t0 = t0;
-        self.dense.y0 = y0;
-        self.dense.f0 = f0;
-        self.dense.t1 = t1;
-        self.dense.y1 = y1;
-        self.dense.f1 = f1;
+        self.dense.ends = HermiteDense::new(t0, t1, y0, y1, f0, f1);
         self.t = t1;
         self.y = y1;
         if y1[1].abs() >= self.band {
             self.cooldown = false;
         }
-        if let (Some(band), Some(onset)) = (self.onset_band, sys.contact_onset()) {
+        // The contact band and the declared onset, read once per step.
+        let onset = self
+            .onset_band
+            .and_then(|band| sys.contact_onset().map(|o| (band, o)));
+        if let Some((band, onset)) = onset {
             let d1 = onset.penetration(y1[0]);
             if d1 < T::zero() || d1 > band {
                 self.cooldown_onset = false;
             }
         }
-        let mut found = self.entries(sys, t0, &y0);
+        let mut found = self.entries(sys, onset, t0, &y0);
         // Earliest first.
         if let [Some(a), Some(b)] = found
             && b.0 < a.0
@@ -599,16 +592,14 @@ where
                 Entry::Velocity => {
                     self.enter_velocity(sys.velocity_exponent(), tc, &yc, &fc, self.band * lit(2.0))
                 }
-                Entry::Contact { leaving } => match sys.contact_onset() {
-                    Some(onset) => self.enter_contact(onset, tc, &yc, &fc, leaving),
+                Entry::Contact { leaving } => match onset {
+                    Some((_, onset)) => self.enter_contact(onset, tc, &yc, &fc, leaving),
                     None => false,
                 },
             };
             if entered {
                 // The time step ends where the segment begins.
-                self.dense.t1 = tc;
-                self.dense.y1 = yc;
-                self.dense.f1 = fc;
+                self.dense.ends = HermiteDense::new(t0, tc, y0, yc, f0, fc);
                 self.t = tc;
                 self.y = yc;
                 break;
@@ -627,8 +618,9 @@ where
         mut g: Segment<T>,
     ) -> Result<bool, IntegrateError> {
         let (t_a, y_a) = (self.t, self.y);
-        let f_a = if self.dense.t1 == t_a && self.dense.y1 == y_a {
-            self.dense.f1
+        let ends = &self.dense.ends;
+        let f_a = if ends.span().1 == t_a && *ends.endpoints().1 == y_a {
+            *ends.end_derivatives().1
         } else {
             self.eval(sys, t_a, &y_a)
         };
@@ -675,9 +667,6 @@ where
         self.dense.t_seg = g.t0;
         self.dense.scale = g.scale;
         self.dense.s0 = s_a;
-        self.dense.t0 = t_a;
-        self.dense.y0 = y_a;
-        self.dense.f0 = f_a;
         // A velocity step across ẋ = 0 is reported in two parts, so that no reported step
         // has ẋ changing sign inside it: observers that look for an interior extremum of x
         // (inverting τ(s) at every trial point) find it at the end of the first part.
@@ -731,9 +720,7 @@ where
         } else {
             self.eval(sys, t_b, &y_b)
         };
-        self.dense.t1 = t_b;
-        self.dense.y1 = y_b;
-        self.dense.f1 = f_b;
+        self.dense.ends = HermiteDense::new(t_a, t_b, y_a, y_b, f_a, f_b);
         self.t = t_b;
         self.y = y_b;
         if !cut && self.pending.is_none() && s_b >= g.s_end {
@@ -801,9 +788,8 @@ where
                 let probe = Vector2::new(y[0], self.band);
                 let mechanical = y[1] != T::zero() || self.eval(sys, t, &probe)[0] == probe[1];
                 let q = if mechanical { q } else { None };
-                self.dense.t1 = t;
-                self.dense.y1 = y;
-                self.dense.f1 = f;
+                // The current point as a step of zero length: its f is reused.
+                self.dense.ends = HermiteDense::new(t, t, y, y, f, f);
                 self.enter_velocity(q, t, &y, &f, self.band);
             }
         }
@@ -874,12 +860,8 @@ impl<T: Real, S: Dynamics<T, 2>> Dynamics<T, 2> for Reparam<'_, T, S> {
 /// `τ(s)` inverted.
 #[derive(Debug, Clone)]
 pub struct TurningDense<T: Real, TD, SD> {
-    t0: T,
-    t1: T,
-    y0: SVector<T, 2>,
-    y1: SVector<T, 2>,
-    f0: SVector<T, 2>,
-    f1: SVector<T, 2>,
+    /// The reported step's ends: span, states and derivatives.
+    ends: HermiteDense<T, 2>,
     time: TD,
     seg: SD,
     /// The segment's kind (`None`: a time step).
@@ -915,15 +897,15 @@ impl<T: Real, TD: DenseOutput<T, 2>, SD: DenseOutput<T, 2>> DenseOutput<T, 2>
     for TurningDense<T, TD, SD>
 {
     fn span(&self) -> (T, T) {
-        (self.t0, self.t1)
+        self.ends.span()
     }
 
     fn endpoints(&self) -> (&SVector<T, 2>, &SVector<T, 2>) {
-        (&self.y0, &self.y1)
+        self.ends.endpoints()
     }
 
     fn end_derivatives(&self) -> (&SVector<T, 2>, &SVector<T, 2>) {
-        (&self.f0, &self.f1)
+        self.ends.end_derivatives()
     }
 
     #[inline]
@@ -932,12 +914,13 @@ impl<T: Real, TD: DenseOutput<T, 2>, SD: DenseOutput<T, 2>> DenseOutput<T, 2>
             self.time.interpolate_unchecked(t, out);
             return;
         };
-        if t <= self.t0 {
-            *out = self.y0;
+        let (t0, t1) = self.ends.span();
+        if t <= t0 {
+            *out = *self.ends.endpoints().0;
             return;
         }
-        if t >= self.t1 {
-            *out = self.y1;
+        if t >= t1 {
+            *out = *self.ends.endpoints().1;
             return;
         }
         let s = self.invert((t - self.t_seg) / self.scale);
