@@ -44,6 +44,7 @@ use nalgebra::Vector2;
 use nonsmooth::drive::{Control, Observer, Simulation, StepView};
 use nonsmooth::integrate::{DenseOutput, Dop853, Dopri5, Stepper, Tolerances, TurningPoints};
 use nonsmooth::model::paper::PAPER;
+use nonsmooth::sample::Stroboscopic;
 
 const OMEGA: f64 = 20.465;
 
@@ -78,22 +79,6 @@ impl Config {
 
 fn time_tolerances(rtol: f64) -> nonsmooth::Result<Tolerances<f64, 2>> {
     Ok(Tolerances::per_component(rtol, [rtol * 1e-4, rtol * 1e-2])?)
-}
-
-/// Section points (steps land on `t = 2πk/ω`).
-struct Sections {
-    period: f64,
-    points: Vec<Vector2<f64>>,
-}
-
-impl Observer<f64, 2> for Sections {
-    fn on_step<D: DenseOutput<f64, 2>>(&mut self, s: &StepView<'_, f64, 2, D>) -> Control {
-        let k = (s.t1 / self.period).round();
-        if k >= 1.0 && s.t1 == k * self.period {
-            self.points.push(s.y1);
-        }
-        Control::Continue
-    }
 }
 
 /// Accepted steps by phase: free flight, contact (`x ≥ x_I` at an end), and the band
@@ -180,12 +165,12 @@ fn sections<St: Stepper<f64, 2>>(
     let period = TAU / omega;
     let mut sim =
         Simulation::new(PAPER.oscillator::<f64>(omega)?, st).landing_grid(Some((0.0, period)))?;
-    let mut obs = Sections {
-        period,
-        points: vec![],
-    };
-    let out = sim.run(t0, y0, t0 + f64::from(periods) * period, &mut obs)?;
-    Ok((obs.points, out.stats.rhs_evals))
+    // Steps land on the sections, so the sampler records the step ends there.
+    let mut strobe =
+        Stroboscopic::<f64, 2>::periodic(0.0, period, t0 + 0.5 * period, periods as usize)?;
+    let out = sim.run(t0, y0, t0 + f64::from(periods) * period, &mut strobe)?;
+    let points = strobe.points().iter().map(|p| p.y).collect();
+    Ok((points, out.stats.rhs_evals))
 }
 
 /// The stable period-2 orbit at ω = 19 rad/s, where errors do not grow from period to
