@@ -45,6 +45,16 @@ pub trait Dynamics<T: Real, const N: usize> {
         None
     }
 
+    /// The shortest time over which the system's explicit dependence on `t` can turn
+    /// around near `t`, if it must bound the step. The driver takes no step longer than
+    /// this. A system whose error estimate sees its forcing need not declare it (the
+    /// default, `None`); one whose state can stay constant while its forcing changes — a
+    /// constrained mode, a sticking contact — must, or a long step hides a change of mode
+    /// (see the event contract in [`event`](crate::event)).
+    fn time_scale(&self, _t: T) -> Option<T> {
+        None
+    }
+
     /// For a one-degree-of-freedom system with state `(x, ẋ)` and `f = (ẋ, ẍ)`: the
     /// exponent `q ∈ (0, 1)` of a term `∝ sgn(ẋ)|ẋ|^q` in `ẍ`, if it has one (see
     /// [`ForceLaw::velocity_exponent`](crate::ForceLaw::velocity_exponent)). A
@@ -74,6 +84,10 @@ impl<T: Real, const N: usize, D: Dynamics<T, N> + ?Sized> Dynamics<T, N> for &D 
     #[inline(always)]
     fn time_derivative(&self, t: T, y: &SVector<T, N>) -> Option<SVector<T, N>> {
         (**self).time_derivative(t, y)
+    }
+    #[inline(always)]
+    fn time_scale(&self, t: T) -> Option<T> {
+        (**self).time_scale(t)
     }
     #[inline(always)]
     fn velocity_exponent(&self) -> Option<T> {

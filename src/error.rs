@@ -63,6 +63,10 @@ pub enum Error {
     /// Event handling failed (e.g. an accumulation of events).
     #[error(transparent)]
     Event(#[from] crate::event::EventError),
+    /// A run through modes (sticking, stick–slip) was started inconsistently or left its
+    /// constraint.
+    #[error(transparent)]
+    Mode(#[from] crate::drive::modes::ModeError),
     /// A sampler or sweep was misconfigured or failed.
     #[error(transparent)]
     Sweep(#[from] crate::sweep::SweepError),

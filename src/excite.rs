@@ -31,10 +31,18 @@ pub trait Excitation<T: Real> {
     /// The force at time `t`.
     fn force(&self, t: T) -> T;
 
-    /// `df/dt` at `t` (default: central difference).
+    /// `df/dt` at `t` (default: a central difference whose step is set by the
+    /// [`time_scale`](Excitation::time_scale), not by `|t|`, so it stays accurate late in a
+    /// long run).
     fn force_rate(&self, t: T) -> T {
-        let h = crate::scalar::epsilon::<T>().powf(lit(1.0 / 3.0)) * t.abs().max(T::one());
-        (self.force(t + h) - self.force(t - h)) / (lit::<T>(2.0) * h)
+        central_difference(|s| self.force(s), t, self.time_scale(t))
+    }
+
+    /// `d²f/dt²` at `t` (default: a central difference of
+    /// [`force_rate`](Excitation::force_rate), as there). Used where an excitation is the
+    /// position of a surface that a body rides on (the surface's acceleration).
+    fn force_acceleration(&self, t: T) -> T {
+        central_difference(|s| self.force_rate(s), t, self.time_scale(t))
     }
 
     /// The forcing phase `φ(t)` in radians, if the forcing is periodic in a phase.
@@ -51,6 +59,32 @@ pub trait Excitation<T: Real> {
     fn angular_frequency(&self, _t: T) -> Option<T> {
         None
     }
+
+    /// The shortest time over which `f` can turn around near `t`, if it varies in time:
+    /// no step of a run is longer than this while the excitation drives a quantity that
+    /// the error estimate cannot see (a sticking or release condition, a moving surface;
+    /// see the event contract in [`event`](crate::event)). Default: a sixteenth of the
+    /// period `2π/|ω(t)|` when [`angular_frequency`](Excitation::angular_frequency) is
+    /// declared, else `None` (constant in time, or nothing declared: override it for an
+    /// excitation of your own that varies in time).
+    fn time_scale(&self, t: T) -> Option<T> {
+        self.angular_frequency(t).and_then(|w| {
+            let h = T::two_pi() / (lit::<T>(16.0) * w.abs());
+            (h.is_finite() && h > T::zero()).then_some(h)
+        })
+    }
+}
+
+/// The central difference `(f(t₊) − f(t₋))/(t₊ − t₋)` at `t± = t ± h`, `h = ε^{1/3}·s`, where
+/// `s` is the excitation's own time unit `16·scale/2π = 1/ω` when it declares one, else one
+/// second, and at least `ε^{1/3}·|t|` so that `t ± h` stay distinct: the step does not
+/// grow with `|t|` (the difference is taken between the representable neighbours used).
+fn central_difference<T: Real>(f: impl Fn(T) -> T, t: T, scale: Option<T>) -> T {
+    let cbrt_eps = crate::scalar::epsilon::<T>().powf(lit(1.0 / 3.0));
+    let unit = scale.map_or(T::one(), |h| lit::<T>(16.0) * h / T::two_pi());
+    let h = cbrt_eps * unit.max(cbrt_eps * t.abs());
+    let (up, down) = (t + h, t - h);
+    (f(up) - f(down)) / (up - down)
 }
 
 impl<T: Real, E: Excitation<T> + ?Sized> Excitation<T> for &E {
@@ -71,6 +105,12 @@ impl<T: Real, E: Excitation<T> + ?Sized> Excitation<T> for &E {
     fn angular_frequency(&self, t: T) -> Option<T> {
         (**self).angular_frequency(t)
     }
+    fn force_acceleration(&self, t: T) -> T {
+        (**self).force_acceleration(t)
+    }
+    fn time_scale(&self, t: T) -> Option<T> {
+        (**self).time_scale(t)
+    }
 }
 
 /// No forcing.
@@ -81,6 +121,9 @@ impl<T: Real> Excitation<T> for () {
     }
     #[inline(always)]
     fn force_rate(&self, _t: T) -> T {
+        T::zero()
+    }
+    fn force_acceleration(&self, _t: T) -> T {
         T::zero()
     }
 }
@@ -123,6 +166,9 @@ impl<T: Real> Excitation<T> for Constant<T> {
     }
     #[inline(always)]
     fn force_rate(&self, _t: T) -> T {
+        T::zero()
+    }
+    fn force_acceleration(&self, _t: T) -> T {
         T::zero()
     }
 }
@@ -214,6 +260,9 @@ impl<T: Real> Excitation<T> for Harmonic<T> {
     fn force_rate(&self, t: T) -> T {
         self.amplitude * self.omega * fastmath::cos(self.omega * t + self.phase0)
     }
+    fn force_acceleration(&self, t: T) -> T {
+        -self.amplitude * self.omega * self.omega * fastmath::sin(self.omega * t + self.phase0)
+    }
     fn phase(&self, t: T) -> Option<T> {
         Some(self.omega * t + self.phase0)
     }
@@ -297,6 +346,9 @@ impl<T: Real> Excitation<T> for UnbalancedRotor<T> {
     #[inline(always)]
     fn force_rate(&self, t: T) -> T {
         self.amp * self.omega * fastmath::cos(self.omega * t)
+    }
+    fn force_acceleration(&self, t: T) -> T {
+        -self.amp * self.omega * self.omega * fastmath::sin(self.omega * t)
     }
     fn phase(&self, t: T) -> Option<T> {
         Some(self.omega * t)

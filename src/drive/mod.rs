@@ -29,7 +29,7 @@ pub mod modes;
 pub mod stick_slip;
 pub mod sticking;
 
-pub use modes::{ModeRun, ModeSystem, Segment, run_modes};
+pub use modes::{ModeError, ModeRun, ModeSystem, Segment, run_modes};
 pub use stick_slip::{Coulomb, SlipMode, StickSlip};
 pub use sticking::{Constrained, ContactMode, ModeLog, RigidContact, run_with_sticking};
 
@@ -169,6 +169,12 @@ pub trait Observer<T: Real, const N: usize> {
         Control::Continue
     }
 
+    /// Called by [`run_modes`] before each segment of a run through modes, with the
+    /// segment's start time and its mode's name
+    /// ([`ModeSystem::mode_name`](modes::ModeSystem::mode_name)): every step and event
+    /// until the next call belongs to that mode.
+    fn on_mode(&mut self, _t: T, _mode: &'static str) {}
+
     /// Called once at the end of a successful run.
     fn on_finish(&mut self, _outcome: &Outcome<T, N>) {}
 }
@@ -191,6 +197,9 @@ impl<T: Real, const N: usize, O: Observer<T, N> + ?Sized> Observer<T, N> for &mu
     }
     fn on_event(&mut self, event: &EventRecord<T, N>) -> Control {
         (**self).on_event(event)
+    }
+    fn on_mode(&mut self, t: T, mode: &'static str) {
+        (**self).on_mode(t, mode)
     }
     fn on_finish(&mut self, outcome: &Outcome<T, N>) {
         (**self).on_finish(outcome)
@@ -222,6 +231,9 @@ macro_rules! observer_tuple {
                 $(if self.$idx.on_event(event) == Control::Stop { c = Control::Stop; })+
                 c
             }
+            fn on_mode(&mut self, t: T, mode: &'static str) {
+                $(self.$idx.on_mode(t, mode);)+
+            }
             fn on_finish(&mut self, outcome: &Outcome<T, N>) {
                 $(self.$idx.on_finish(outcome);)+
             }
@@ -236,6 +248,11 @@ impl<T: Real, const N: usize, O: Observer<T, N>> Observer<T, N> for Option<O> {
     }
     fn check_span(&self, t0: T, t_end: T) -> Result<()> {
         self.as_ref().map_or(Ok(()), |o| o.check_span(t0, t_end))
+    }
+    fn on_mode(&mut self, t: T, mode: &'static str) {
+        if let Some(o) = self {
+            o.on_mode(t, mode)
+        }
     }
     fn on_start(&mut self, t0: T, y0: &SVector<T, N>) {
         if let Some(o) = self {
@@ -451,13 +468,30 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
         self.check_work(t0, t_end)
     }
 
+    /// The longest step the events and the system allow near `t`, if they bound it (see
+    /// [`EventFunction::time_scale`](crate::event::EventFunction::time_scale) and
+    /// [`Dynamics::time_scale`]).
+    #[inline(always)]
+    fn time_scale(&self, t: T) -> Option<T> {
+        match (self.events.max_step(t), self.system.time_scale(t)) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        }
+    }
+
     /// Fails at once when the run provably needs more steps than the cap: its span over the
     /// largest step it may take (the stepper's `h_max` or fixed step, the landing grid's
-    /// spacing).
+    /// spacing, the time scale of the events and the system).
     fn check_work(&self, t0: T, t_end: T) -> Result<()> {
         let mut h = self.stepper.max_step();
         if let Some((_, dt)) = self.grid {
             h = Some(h.map_or(dt, |h| h.min(dt)));
+        }
+        // The time scale bounds every step; the larger of its values at the two ends bounds
+        // it over the run when it changes monotonically (a ramp).
+        if let (Some(a), Some(b)) = (self.time_scale(t0), self.time_scale(t_end)) {
+            let s = a.max(b);
+            h = Some(h.map_or(s, |h| h.min(s)));
         }
         let Some(h) = h else { return Ok(()) };
         let span = to_f64(t_end - t0);
@@ -495,8 +529,9 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
                 .into());
             }
             let limit = landing_limit(t_now, t_end, self.grid);
-            // Events with a time scale (moving surfaces) bound the step.
-            let limit = match self.events.max_step(t_now) {
+            // The time scales of the events (moving surfaces, mode conditions) and of the
+            // system (constrained modes) bound the step.
+            let limit = match self.time_scale(t_now) {
                 Some(h) => limit.min(t_now + h),
                 None => limit,
             };
@@ -697,6 +732,27 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
             }
             let terminal = self.events.is_terminal(i);
             if self.events.resets(i) {
+                // An impact moves into the surface. A located crossing where the rate does
+                // not (the far end of a bracket past the top of a graze of zero normal
+                // velocity: the arrival of a chattering sequence) is no impact: the body
+                // stays on the surface, reported as sticking, not as an event.
+                let mut fc = SVector::zeros();
+                self.system.rhs(tc, &yc, &mut fc);
+                self.stepper.stats_mut().rhs_evals += 1;
+                let into = if c.rising { T::one() } else { -T::one() };
+                if let Some(r) = self.events.rate(i, tc, &yc, &fc) {
+                    if !(into * r > T::zero()) {
+                        self.stepper.stats_mut().events -= 1;
+                        self.stepper.reset_state(tc, yc);
+                        return Err(EventError::Sticking {
+                            index: i,
+                            t: to_f64(tc),
+                            depth: to_f64(self.events.value(i, tc, &yc).abs()),
+                            state: yc.iter().map(|&v| to_f64(v)).collect(),
+                        }
+                        .into());
+                    }
+                }
                 let mut ya = yc;
                 self.events.apply_reset(i, tc, &mut ya);
                 let rec = EventRecord {

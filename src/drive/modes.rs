@@ -42,12 +42,76 @@
 use std::fmt::Debug;
 
 use nalgebra::SVector;
+use thiserror::Error;
 
 use super::{Observer, Outcome};
 use crate::Real;
-use crate::error::Result;
+use crate::error::{ParameterError, Result};
 use crate::event::EventError;
-use crate::scalar::to_f64;
+use crate::scalar::{lit, to_f64};
+
+/// Errors of runs through modes.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum ModeError {
+    /// The start mode contradicts the start state: e.g. stuck while the force needed to
+    /// hold the contact exceeds the static limit, slipping forward while the slip velocity
+    /// is negative, or starting inside a rigid surface.
+    #[error(
+        "start mode {mode} contradicts the state at t = {t}: {quantity} = {value}, must be {requirement}"
+    )]
+    InconsistentStart {
+        /// The start mode.
+        mode: &'static str,
+        /// The start time.
+        t: f64,
+        /// The quantity that contradicts the mode.
+        quantity: &'static str,
+        /// Its value.
+        value: f64,
+        /// What the mode requires of it.
+        requirement: String,
+    },
+    /// A constrained mode left its constraint by more than the documented tolerance (the
+    /// integration drifted, e.g. a stuck body sinking into a rigid surface).
+    #[error(
+        "the constraint of mode {mode} is violated at t = {t}: {quantity} = {value} exceeds the tolerance {tolerance}"
+    )]
+    ConstraintDrift {
+        /// The mode.
+        mode: &'static str,
+        /// Time (a step end or a dense sample).
+        t: f64,
+        /// The constraint quantity (penetration, slip velocity).
+        quantity: &'static str,
+        /// Its value.
+        value: f64,
+        /// The tolerance.
+        tolerance: f64,
+    },
+}
+
+/// `dg/dt` along the flow `ẏ = dy` at `(t, y)` by a central difference
+/// `(g(t+h, y+h·dy) − g(t−h, y−h·dy))/2h`, `h = ε^{1/3}·s` with `s` the time unit
+/// `16·scale/2π` of a declared time scale (else one second). For the rates of mode
+/// conditions (a release, a static limit) whose exact derivative needs the derivative of
+/// the acceleration: the rate only has to show the sign of `ġ` at step ends, so that an
+/// excursion of `g` past zero inside a step (a release and a re-stick between two step
+/// ends) is found by the driver's grazing search.
+pub(crate) fn rate_along_flow<T: Real, const M: usize>(
+    g: impl Fn(T, &SVector<T, M>) -> T,
+    t: T,
+    y: &SVector<T, M>,
+    dy: &SVector<T, M>,
+    scale: Option<T>,
+) -> T {
+    let cbrt_eps = crate::scalar::epsilon::<T>().powf(lit(1.0 / 3.0));
+    let unit = scale.map_or(T::one(), |h| lit::<T>(16.0) * h / T::two_pi());
+    let h = cbrt_eps * unit.max(cbrt_eps * t.abs());
+    let (up, down) = (t + h, t - h);
+    let (hu, hd) = (up - t, t - down);
+    (g(up, &(y + dy * hu)) - g(down, &(y - dy * hd))) / (hu + hd)
+}
 
 /// How one segment of a [`ModeSystem`] ended.
 #[derive(Debug, Clone, PartialEq)]
@@ -63,6 +127,12 @@ pub struct Segment<T: Real, const M: usize, Mode> {
 pub trait ModeSystem<T: Real, const M: usize> {
     /// The discrete mode (e.g. free/stuck, slip direction/stick).
     type Mode: Copy + PartialEq + Debug;
+
+    /// The mode's name, passed to the observer's [`on_mode`](Observer::on_mode) before each
+    /// segment. Default: `"mode"`.
+    fn mode_name(&self, _mode: Self::Mode) -> &'static str {
+        "mode"
+    }
 
     /// Runs `mode` from `(t, y)` towards `t_end`, streaming to `observer`, until `t_end` or
     /// a mode change.
@@ -93,8 +163,10 @@ pub struct ModeRun<T: Real, const M: usize, Mode> {
 /// `max_segments` segments.
 ///
 /// # Errors
-/// The segments' errors; [`EventError::Zeno`] if `max_segments` segments do not reach
-/// `t_end` (mode changes accumulating), with the state to continue from.
+/// [`ParameterError`] if `max_segments` is zero; the segments' errors (a start mode that
+/// contradicts the start state is [`ModeError::InconsistentStart`]); [`EventError::Zeno`]
+/// if `max_segments` segments do not reach `t_end` (mode changes accumulating), with the
+/// state to continue from.
 pub fn run_modes<T, const M: usize, Sys, O>(
     system: &mut Sys,
     mode: Sys::Mode,
@@ -109,9 +181,13 @@ where
     Sys: ModeSystem<T, M>,
     O: Observer<T, M>,
 {
+    if max_segments == 0 {
+        return Err(ParameterError::new("max_segments", 0.0, "> 0").into());
+    }
     let (mut mode, mut t, mut y) = (mode, t0, y0);
     let mut transitions = Vec::new();
     for _ in 0..max_segments {
+        observer.on_mode(t, system.mode_name(mode));
         let segment = system.segment(mode, t, y, t_end, observer)?;
         match segment.next {
             None => {

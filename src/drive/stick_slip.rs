@@ -50,13 +50,13 @@
 
 use nalgebra::SVector;
 
-use super::modes::{ModeSystem, Segment};
+use super::modes::{ModeError, ModeSystem, Segment, rate_along_flow};
 use super::{Observer, Simulation, Termination};
 use crate::error::{ParameterError, Result};
 use crate::event::{Direction, Event, EventFunction};
 use crate::excite::Excitation;
 use crate::integrate::Stepper;
-use crate::model::{Coordinate, Elements, Loads, Mechanical};
+use crate::model::{Coordinate, Elements, Loads, Mechanical, shorter};
 use crate::validate::{finite, non_negative};
 use crate::{Dynamics, Real};
 
@@ -126,6 +126,22 @@ pub enum SlipMode {
     Stick,
 }
 
+impl SlipMode {
+    /// The mode's name (`"forward"`, `"backward"`, `"stick"`), as observers see it in
+    /// [`Observer::on_mode`].
+    pub fn name(self) -> &'static str {
+        match self {
+            SlipMode::Forward => "forward",
+            SlipMode::Backward => "backward",
+            SlipMode::Stick => "stick",
+        }
+    }
+}
+
+/// The largest `|v_r|` a start in [`SlipMode::Stick`] may have, relative to
+/// `max(1, |u|, |w·q̇|)` (the stick mode damps what is left).
+pub const STICK_RATE_TOLERANCE: f64 = 1e-8;
+
 /// The mass-metric quantities of the friction direction.
 #[derive(Debug, Clone, Copy)]
 struct Metric<T: Real, const N: usize> {
@@ -179,6 +195,18 @@ where
     Ld: Loads<T, N>,
     U: Excitation<T>,
 {
+    /// Stuck, the state moves with the surface while the force needed to hold it changes
+    /// with the loads: the loads' and the surface velocity's time scales bound the step.
+    fn time_scale(&self, t: T) -> Option<T> {
+        match self.slip_force {
+            Some(_) => None,
+            None => shorter(
+                self.model.forcing_time_scale(t),
+                self.friction.surface_velocity.time_scale(t),
+            ),
+        }
+    }
+
     fn rhs(&self, t: T, y: &SVector<T, M>, dy: &mut SVector<T, M>) {
         let (a, force) = match self.slip_force {
             Some(f) => (self.model.acceleration(t, y), f),
@@ -210,6 +238,24 @@ where
             Some(_) => self.0.friction.slip_velocity(t, y),
             None => self.0.multiplier(t, y).1.abs() - self.0.friction.static_limit,
         }
+    }
+    /// Slipping, `v̇_r = w·q̈ − u̇(t)` exactly; stuck, along the flow by a central
+    /// difference, so that a release and a re-stick between two step ends is found by the
+    /// driver's grazing search.
+    fn rate(&self, t: T, y: &SVector<T, M>, dy: &SVector<T, M>) -> Option<T> {
+        let f = &self.0.friction;
+        Some(match self.0.slip_force {
+            Some(_) => f.coordinate.rate(&dy.as_slice()[N..]) - f.surface_velocity.force_rate(t),
+            None => rate_along_flow(|s, z| self.value(s, z), t, y, dy, self.time_scale(t)),
+        })
+    }
+    /// Both conditions depend on time through the surface velocity; the static limit also
+    /// through the loads.
+    fn time_scale(&self, t: T) -> Option<T> {
+        shorter(
+            Dynamics::time_scale(&self.0, t),
+            self.0.friction.surface_velocity.time_scale(t),
+        )
     }
 }
 
@@ -282,16 +328,99 @@ where
         }
     }
 
-    /// The mode at `v_r = 0`.
+    /// The mode at `v_r = 0`: stick while the force needed to hold it is below the static
+    /// limit, or at the limit and not growing past it; else slip in direction `−sgn λ`.
     fn mode_on_surface(&self, t: T, y: &SVector<T, M>) -> SlipMode {
-        let lambda = self.rhs(None).multiplier(t, y).1;
-        if lambda.abs() <= self.friction.static_limit {
+        let rhs = self.rhs(None);
+        let lambda = rhs.multiplier(t, y).1;
+        let holds = lambda.abs() < self.friction.static_limit
+            || (lambda.abs() == self.friction.static_limit && {
+                let mut dy = SVector::zeros();
+                rhs.rhs(t, y, &mut dy);
+                ModeEnd(rhs).rate(t, y, &dy).is_some_and(|r| r <= T::zero())
+            });
+        if holds {
             SlipMode::Stick
         } else if lambda > T::zero() {
             SlipMode::Backward
         } else {
             SlipMode::Forward
         }
+    }
+
+    /// [`ModeError::InconsistentStart`] unless `mode` can start at `(t, y)`: slipping in
+    /// the sign of `v_r` (or at `v_r = 0` accelerating that way), stuck with `|v_r|` within
+    /// [`STICK_RATE_TOLERANCE`] of the surface speed and `|λ| ≤ F_s`.
+    fn check_start(&self, mode: SlipMode, t: T, y: &SVector<T, M>) -> Result<()> {
+        let v = self.friction.slip_velocity(t, y);
+        let err = |quantity, value: T, requirement: String| -> Result<()> {
+            Err(ModeError::InconsistentStart {
+                mode: mode.name(),
+                t: crate::scalar::to_f64(t),
+                quantity,
+                value: crate::scalar::to_f64(value),
+                requirement,
+            }
+            .into())
+        };
+        match mode {
+            SlipMode::Forward | SlipMode::Backward => {
+                let sign = if mode == SlipMode::Forward {
+                    T::one()
+                } else {
+                    -T::one()
+                };
+                if sign * v < T::zero() {
+                    return err(
+                        "slip velocity",
+                        v,
+                        format!("of the sign of {}", mode.name()),
+                    );
+                }
+                if v == T::zero() {
+                    // On the surface: the slip must move the way it is named.
+                    let rhs = self.rhs(Some(-sign * self.friction.kinetic));
+                    let mut dy = SVector::zeros();
+                    rhs.rhs(t, y, &mut dy);
+                    let a = ModeEnd(rhs).rate(t, y, &dy).unwrap_or(T::zero());
+                    if sign * a < T::zero() {
+                        return err(
+                            "slip acceleration at zero slip velocity",
+                            a,
+                            format!("of the sign of {}", mode.name()),
+                        );
+                    }
+                }
+            }
+            SlipMode::Stick => {
+                let scale = self
+                    .friction
+                    .surface_velocity
+                    .force(t)
+                    .abs()
+                    .max(self.friction.coordinate.rate(&y.as_slice()[N..]).abs());
+                let tol = crate::scalar::lit::<T>(STICK_RATE_TOLERANCE) * scale.max(T::one());
+                if v.abs() > tol {
+                    return err(
+                        "slip velocity",
+                        v,
+                        format!("within {STICK_RATE_TOLERANCE:e}·max(1, |u|, |w·q̇|) of 0"),
+                    );
+                }
+                let lambda = self.rhs(None).multiplier(t, y).1;
+                if lambda.abs() > self.friction.static_limit {
+                    return err(
+                        "force needed to hold the contact",
+                        lambda,
+                        format!(
+                            "within the static limit ±{}",
+                            crate::scalar::to_f64(self.friction.static_limit)
+                        ),
+                    );
+                }
+            }
+        }
+        Ok(())
     }
 
     /// Sets `v_r = 0` exactly, changing the velocities along `M⁻¹w` only.
@@ -315,6 +444,10 @@ where
 {
     type Mode = SlipMode;
 
+    fn mode_name(&self, mode: SlipMode) -> &'static str {
+        mode.name()
+    }
+
     fn segment<O: Observer<T, M>>(
         &mut self,
         mode: SlipMode,
@@ -323,6 +456,22 @@ where
         t_end: T,
         observer: &mut O,
     ) -> Result<Segment<T, M, SlipMode>> {
+        self.check_start(mode, t, &y)?;
+        if mode == SlipMode::Stick && self.mode_on_surface(t, &y) != SlipMode::Stick {
+            // At the static limit with the force growing past it: slip at once.
+            let mut y = y;
+            self.project(t, &mut y);
+            let next = self.mode_on_surface(t, &y);
+            return Ok(Segment {
+                outcome: super::Outcome {
+                    t,
+                    y,
+                    termination: Termination::TerminalEvent(0),
+                    stats: Default::default(),
+                },
+                next: Some(next),
+            });
+        }
         let (slip_force, direction) = match mode {
             SlipMode::Forward => (Some(-self.friction.kinetic), Direction::Falling),
             SlipMode::Backward => (Some(self.friction.kinetic), Direction::Rising),

@@ -24,13 +24,13 @@
 
 use nalgebra::SVector;
 
-use super::modes::{ModeSystem, Segment, run_modes};
+use super::modes::{ModeError, ModeSystem, Segment, rate_along_flow, run_modes};
 use super::{Observer, Outcome, Simulation, Termination};
 use crate::error::Result;
 use crate::event::{Direction, Event, EventError, EventFunction, Gap, NewtonImpact};
 use crate::excite::Excitation;
 use crate::integrate::Stepper;
-use crate::model::{Elements, Loads, Mechanical};
+use crate::model::{Elements, Loads, Mechanical, shorter};
 use crate::scalar::lit;
 use crate::{Dynamics, Real};
 
@@ -84,10 +84,14 @@ where
         }
     }
 
-    /// `s̈(t)` by a central difference of `ṡ`.
-    fn surface_acceleration(&self, t: T) -> T {
-        let h = crate::scalar::epsilon::<T>().powf(lit(1.0 / 3.0)) * t.abs().max(T::one());
-        (self.gap.surface(t + h).1 - self.gap.surface(t - h).1) / (lit::<T>(2.0) * h)
+    /// The shortest time scale of the model's loads and the surface's motion near `t`: the
+    /// longest step of the sticking mode, whose state moves with the surface while the
+    /// release condition changes with the loads.
+    pub fn time_scale(&self, t: T) -> Option<T> {
+        shorter(
+            self.model.forcing_time_scale(t),
+            EventFunction::<T, M>::time_scale(self.gap, t),
+        )
     }
 
     /// The free acceleration `M⁻¹f` and the constraint multiplier `λ` at `(t, y)`.
@@ -101,7 +105,7 @@ where
         let ed = self.gap.coordinate().rate(qd) - sd;
         let two = lit::<T>(2.0);
         let target =
-            self.surface_acceleration(t) - two * self.alpha * ed - self.alpha * self.alpha * e;
+            self.gap.surface_acceleration(t) - two * self.alpha * ed - self.alpha * self.alpha * e;
         let lambda = (target - w.dot(&a)) / self.w_m_w;
         (a, lambda)
     }
@@ -134,6 +138,9 @@ where
             dy[N + k] = a[k] + lambda * self.m_w[k];
         }
     }
+    fn time_scale(&self, t: T) -> Option<T> {
+        Constrained::time_scale(self, t)
+    }
 }
 
 /// The release condition `−σλ` of the sticking mode (positive while the constraint force is
@@ -153,6 +160,21 @@ where
 {
     fn value(&self, t: T, y: &SVector<T, M>) -> T {
         -self.0.gap.sign() * self.0.multiplier(t, y).1
+    }
+    /// Along the flow by a central difference: it shows a release and a re-catch between
+    /// two step ends to the driver's grazing search.
+    fn rate(&self, t: T, y: &SVector<T, M>, dy: &SVector<T, M>) -> Option<T> {
+        Some(rate_along_flow(
+            |s, z| self.value(s, z),
+            t,
+            y,
+            dy,
+            self.0.time_scale(t),
+        ))
+    }
+    /// The loads' and the surface's: the release depends on time through both.
+    fn time_scale(&self, t: T) -> Option<T> {
+        self.0.time_scale(t)
     }
 }
 
@@ -174,6 +196,69 @@ pub enum ContactMode {
     Stuck,
 }
 
+impl ContactMode {
+    /// The mode's name (`"free"`, `"stuck"`), as observers see it in
+    /// [`Observer::on_mode`].
+    pub fn name(self) -> &'static str {
+        match self {
+            ContactMode::Free => "free",
+            ContactMode::Stuck => "stuck",
+        }
+    }
+}
+
+/// The largest penetration `g` into the rigid surface a [`RigidContact`] run accepts, at a
+/// start, at any step end and at [`DRIFT_SAMPLES`] interior points of each sticking step,
+/// unless set with [`RigidContact::with_drift_tolerance`] (in the gap's units).
+pub const DRIFT_TOLERANCE: f64 = 1e-8;
+
+/// Interior points of each sticking step at which the penetration is checked.
+pub const DRIFT_SAMPLES: usize = 4;
+
+/// Forwards everything to the caller's observer and watches the penetration of a sticking
+/// step at its end and at [`DRIFT_SAMPLES`] interior points; stops the run at the first
+/// violation (kept in `violation`).
+struct DriftWatch<'o, 'g, T: Real, const N: usize, const M: usize, S, O> {
+    gap: &'g Gap<T, N, S>,
+    tolerance: T,
+    violation: Option<(T, T)>,
+    inner: &'o mut O,
+}
+
+impl<T, const N: usize, const M: usize, S, O> Observer<T, M> for DriftWatch<'_, '_, T, N, M, S, O>
+where
+    T: Real,
+    S: Excitation<T>,
+    O: Observer<T, M>,
+{
+    fn on_start(&mut self, t0: T, y0: &SVector<T, M>) {
+        self.inner.on_start(t0, y0)
+    }
+    fn on_step<D: crate::integrate::DenseOutput<T, M>>(
+        &mut self,
+        step: &super::StepView<'_, T, M, D>,
+    ) -> super::Control {
+        let mut y = step.y1;
+        for k in 1..=DRIFT_SAMPLES + 1 {
+            let t = if k == DRIFT_SAMPLES + 1 {
+                step.t1
+            } else {
+                step.t0 + (step.t1 - step.t0) * lit::<T>(k as f64 / (DRIFT_SAMPLES + 1) as f64)
+            };
+            step.state_at(t, &mut y);
+            let g = self.gap.penetration(t, &y.as_slice()[..N]);
+            if !(g.abs() <= self.tolerance) {
+                self.violation = Some((t, g));
+                return super::Control::Stop;
+            }
+        }
+        self.inner.on_step(step)
+    }
+    fn on_event(&mut self, event: &super::EventRecord<T, M>) -> super::Control {
+        self.inner.on_event(event)
+    }
+}
+
 /// Rigid contact on a [`Gap`] as a [`ModeSystem`]: free flight with Newton impacts ↔
 /// sticking to the surface (see the [module docs](self)).
 pub struct RigidContact<'a, T, const N: usize, const M: usize, El, Ld, S, St>
@@ -186,6 +271,7 @@ where
     constrained: Constrained<'a, T, N, M, El, Ld, S>,
     free: FreeFlight<T, N, M, El, Ld, S, St>,
     stuck: Sticking<'a, T, N, M, El, Ld, S, St>,
+    tolerance: T,
 }
 
 /// The free mode's simulation: the model with its impact event.
@@ -224,6 +310,60 @@ where
                 .with_events(Event::new(gap.clone(), Direction::Rising).with_reset(impact.clone())),
             stuck: Simulation::new(constrained, stepper())
                 .with_events(Event::new(Release(constrained), Direction::Falling).terminal()),
+            tolerance: lit(DRIFT_TOLERANCE),
+        }
+    }
+
+    /// Sets the largest penetration accepted at a start and in the sticking mode (default
+    /// [`DRIFT_TOLERANCE`]).
+    ///
+    /// # Errors
+    /// [`ParameterError`](crate::ParameterError) unless `tolerance` is finite and `> 0`.
+    pub fn with_drift_tolerance(mut self, tolerance: T) -> Result<Self> {
+        self.tolerance = crate::validate::positive("drift tolerance", tolerance)?;
+        Ok(self)
+    }
+
+    /// [`ModeError::InconsistentStart`] unless `mode` can start at `(t, y)`: outside the
+    /// surface (or on it to the drift tolerance) in free flight; on it, with the surface's
+    /// velocity and a compressive constraint force, when stuck.
+    fn check_start(&self, mode: ContactMode, t: T, y: &SVector<T, M>) -> Result<()> {
+        let gap = self.constrained.gap;
+        let (q, qd) = y.as_slice().split_at(N);
+        let g = gap.penetration(t, q);
+        let err = |quantity, value: T, requirement: String| -> Result<()> {
+            Err(ModeError::InconsistentStart {
+                mode: mode.name(),
+                t: crate::scalar::to_f64(t),
+                quantity,
+                value: crate::scalar::to_f64(value),
+                requirement,
+            }
+            .into())
+        };
+        let tol = crate::scalar::to_f64(self.tolerance);
+        match mode {
+            ContactMode::Free if !(g <= self.tolerance) => err(
+                "penetration",
+                g,
+                format!("at most the drift tolerance {tol:e}"),
+            ),
+            ContactMode::Stuck if !(g.abs() <= self.tolerance) => err(
+                "penetration",
+                g,
+                format!("within the drift tolerance {tol:e} of 0"),
+            ),
+            ContactMode::Stuck if !(gap.penetration_rate(t, qd).abs() <= self.tolerance) => err(
+                "penetration rate",
+                gap.penetration_rate(t, qd),
+                format!("within {tol:e} of 0"),
+            ),
+            ContactMode::Stuck if !self.compressive(t, y) => err(
+                "constraint force (compressive > 0)",
+                -gap.sign() * self.constrained.multiplier(t, y).1,
+                "> 0".into(),
+            ),
+            _ => Ok(()),
         }
     }
 
@@ -244,6 +384,10 @@ where
 {
     type Mode = ContactMode;
 
+    fn mode_name(&self, mode: ContactMode) -> &'static str {
+        mode.name()
+    }
+
     fn segment<O: Observer<T, M>>(
         &mut self,
         mode: ContactMode,
@@ -252,6 +396,7 @@ where
         t_end: T,
         observer: &mut O,
     ) -> Result<Segment<T, M, ContactMode>> {
+        self.check_start(mode, t, &y)?;
         match mode {
             ContactMode::Free => match self.free.run(t, y, t_end, observer) {
                 // Free flight until t_end, an accumulation or a catch.
@@ -283,7 +428,23 @@ where
                 Err(e) => Err(e),
             },
             ContactMode::Stuck => {
-                let outcome = self.stuck.run(t, y, t_end, observer)?;
+                let mut watch = DriftWatch {
+                    gap: self.constrained.gap,
+                    tolerance: self.tolerance,
+                    violation: None,
+                    inner: observer,
+                };
+                let outcome = self.stuck.run(t, y, t_end, &mut watch)?;
+                if let Some((t, g)) = watch.violation {
+                    return Err(ModeError::ConstraintDrift {
+                        mode: ContactMode::Stuck.name(),
+                        t: crate::scalar::to_f64(t),
+                        quantity: "penetration",
+                        value: crate::scalar::to_f64(g),
+                        tolerance: crate::scalar::to_f64(self.tolerance),
+                    }
+                    .into());
+                }
                 let next = match outcome.termination {
                     Termination::TerminalEvent(_) => Some(ContactMode::Free),
                     _ => None,

@@ -335,6 +335,13 @@ impl<T: Real, const N: usize, S: crate::excite::Excitation<T>> Gap<T, N, S> {
         (self.motion.force(t), self.motion.force_rate(t))
     }
 
+    /// The surface's acceleration `s̈(t)` (the motion's
+    /// [`force_acceleration`](crate::excite::Excitation::force_acceleration)).
+    #[inline(always)]
+    pub fn surface_acceleration(&self, t: T) -> T {
+        self.motion.force_acceleration(t)
+    }
+
     /// The penetration `g(t, q)` from the positions `q`.
     #[inline(always)]
     pub fn penetration(&self, t: T, q: &[T]) -> T {
@@ -366,12 +373,10 @@ impl<T: Real, const N: usize, const M: usize, S: crate::excite::Excitation<T>> E
         }
         Some(self.penetration_rate(t, &y.as_slice()[N..]))
     }
-    /// `2π/(16ω)` for a surface moving with angular frequency `ω`: sixteen steps per
-    /// surface period at least.
+    /// The motion's [`time_scale`](crate::excite::Excitation::time_scale) (`2π/(16ω)` for a
+    /// harmonic surface: sixteen steps per surface period at least).
     fn time_scale(&self, t: T) -> Option<T> {
-        self.motion
-            .angular_frequency(t)
-            .map(|w| T::two_pi() / (lit::<T>(16.0) * w))
+        self.motion.time_scale(t)
     }
     fn check(&self) -> Result<(), EventError> {
         if M != 2 * N {

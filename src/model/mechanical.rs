@@ -449,6 +449,19 @@ pub trait Loads<T: Real, const N: usize> {
     fn phase(&self, _t: T) -> Option<T> {
         None
     }
+    /// The shortest [`time_scale`](Excitation::time_scale) of the loads near `t`, if any
+    /// load declares one.
+    fn time_scale(&self, _t: T) -> Option<T> {
+        None
+    }
+}
+
+/// The smaller of two optional time scales.
+pub(crate) fn shorter<T: Real>(a: Option<T>, b: Option<T>) -> Option<T> {
+    match (a, b) {
+        (Some(a), Some(b)) => Some(a.min(b)),
+        (a, b) => a.or(b),
+    }
 }
 
 impl<T: Real, const N: usize> Loads<T, N> for () {
@@ -472,6 +485,9 @@ impl<T: Real, const N: usize, E: Excitation<T>> Loads<T, N> for Load<T, N, E> {
     fn phase(&self, t: T) -> Option<T> {
         self.excitation.phase(t)
     }
+    fn time_scale(&self, t: T) -> Option<T> {
+        self.excitation.time_scale(t)
+    }
 }
 
 impl<T: Real, const N: usize, E: Loads<T, N>, const K: usize> Loads<T, N> for [E; K] {
@@ -490,6 +506,9 @@ impl<T: Real, const N: usize, E: Loads<T, N>, const K: usize> Loads<T, N> for [E
     fn phase(&self, t: T) -> Option<T> {
         self.iter().find_map(|e| e.phase(t))
     }
+    fn time_scale(&self, t: T) -> Option<T> {
+        self.iter().fold(None, |m, e| shorter(m, e.time_scale(t)))
+    }
 }
 
 macro_rules! load_tuple {
@@ -505,6 +524,11 @@ macro_rules! load_tuple {
             }
             fn phase(&self, t: T) -> Option<T> {
                 None $(.or_else(|| self.$idx.phase(t)))+
+            }
+            fn time_scale(&self, t: T) -> Option<T> {
+                let m = None;
+                $(let m = shorter(m, self.$idx.time_scale(t));)+
+                m
             }
         }
     };
@@ -787,6 +811,13 @@ impl<T: Real, const N: usize, const M: usize, El: Elements<T, N>, Ld: Loads<T, N
     pub fn acceleration(&self, t: T, y: &SVector<T, M>) -> SVector<T, N> {
         let (q, qd) = y.as_slice().split_at(N);
         self.inv_mass * self.generalized_force(t, q, qd)
+    }
+
+    /// The shortest [`time_scale`](Excitation::time_scale) of the loads near `t`, if any
+    /// declares one: the bound on the step of a mode in which the state can stay constant
+    /// while the loads change (sticking, stick–slip).
+    pub fn forcing_time_scale(&self, t: T) -> Option<T> {
+        self.loads.time_scale(t)
     }
 
     /// `(M⁻¹w, wᵀM⁻¹w)` for a direction `w` (a coordinate's weights): the accelerations a

@@ -17,5 +17,6 @@ mod mechanical;
 mod oscillator;
 
 pub use crate::systems::paper;
+pub(crate) use mechanical::shorter;
 pub use mechanical::{Coordinate, Element, Elements, Load, Loads, Mechanical, ModelError};
 pub use oscillator::Oscillator;
