@@ -4,6 +4,7 @@
 
 use nalgebra::Vector2;
 use nonsmooth::event::{EventFunction, Level, ResetMap, Restitution};
+use nonsmooth::sample::{Regime, detect_period, try_detect_period};
 
 /// Defect 1: `Level::value`/`rate` and `Restitution::apply` with a component index beyond
 /// the state panicked ("Matrix index out of bounds") when called directly.
@@ -30,4 +31,27 @@ fn level_and_restitution_out_of_range_do_not_panic() {
     let inside = Restitution::new(1, 0.5).unwrap();
     ResetMap::<f64, 2>::apply(&inside, 0.0, &mut z);
     assert_eq!(z, Vector2::new(0.5, 1.0));
+}
+
+/// Defect 2: period detection accepted a negative or −∞ tolerance (every sequence "not
+/// periodic"); `+∞` called every sequence period 1.
+#[test]
+fn period_detection_rejects_invalid_tolerances() {
+    let scale = Vector2::new(1.0, 1.0);
+    let p2: Vec<_> = (0..20)
+        .map(|i| Vector2::new(if i % 2 == 0 { 1.0 } else { -1.0 }, 0.0))
+        .collect();
+    for tol in [-1e-6, f64::NEG_INFINITY, f64::INFINITY, f64::NAN] {
+        let e = try_detect_period(&p2, &scale, tol, 8).unwrap_err();
+        assert_eq!(e.name, "tol");
+        assert!(e.value == tol || (tol.is_nan() && e.value.is_nan()), "{e}");
+        assert!(e.to_string().contains("`tol`"), "{e}");
+        // The infallible form finds no period with such a tolerance.
+        assert_eq!(detect_period(&p2, &scale, tol, 8), Regime::NotPeriodic);
+    }
+    assert_eq!(
+        try_detect_period(&p2, &scale, 0.0, 8).unwrap(),
+        Regime::Periodic(2)
+    );
+    assert_eq!(detect_period(&p2, &scale, 1e-9, 8), Regime::Periodic(2));
 }
