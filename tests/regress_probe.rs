@@ -4,6 +4,7 @@
 
 use nalgebra::Vector2;
 use nonsmooth::event::{EventFunction, Level, ResetMap, Restitution};
+use nonsmooth::excite::{Excitation, Harmonic, RampedRotor, UnbalancedRotor};
 use nonsmooth::sample::{Regime, detect_period, try_detect_period};
 
 /// Defect 1: `Level::value`/`rate` and `Restitution::apply` with a component index beyond
@@ -54,4 +55,64 @@ fn period_detection_rejects_invalid_tolerances() {
         Regime::Periodic(2)
     );
     assert_eq!(detect_period(&p2, &scale, 1e-9, 8), Regime::Periodic(2));
+}
+
+/// Defect 3: `Harmonic` with ω ≈ 1e306 and `RampedRotor`/`UnbalancedRotor` with extreme
+/// parameters gave NaN from `force`/`force_rate` (sin of an overflowed phase, `inf·0`).
+#[test]
+fn excitations_are_finite_for_finite_time() {
+    let times = [
+        0.0,
+        1e-300,
+        0.37,
+        1000.0,
+        -1000.0,
+        1e15,
+        1e200,
+        -1e300,
+        f64::MAX,
+    ];
+    let finite = |name: &str, e: &dyn Excitation<f64>| {
+        for &t in &times {
+            let (f, r) = (e.force(t), e.force_rate(t));
+            assert!(
+                f.is_finite() && r.is_finite(),
+                "{name} at t = {t:e}: {f}, {r}"
+            );
+        }
+    };
+    for (amplitude, omega) in [(1.0, 1e306), (0.0, 1e306), (1e-300, 1e300), (2.0, 7.0)] {
+        let h = Harmonic::new(amplitude, omega, 0.3).unwrap();
+        finite(&format!("Harmonic({amplitude:e}, {omega:e})"), &h);
+        assert!(h.force(1000.0).abs() <= amplitude);
+    }
+    // The force rate's amplitude A·ω must be finite.
+    assert!(Harmonic::new(1e10, 1e306, 0.0).is_err());
+    for (m0e, omega) in [(0.0, 1e306), (1e-300, 1e100), (0.01805, 20.0)] {
+        let r = UnbalancedRotor::new(m0e, omega).unwrap();
+        finite(&format!("UnbalancedRotor({m0e:e}, {omega:e})"), &r);
+    }
+    let mut ramps = 0;
+    for m0e in [0.0, 1e-300, 1e-10, 0.01805, 1e10] {
+        for omega0 in [1e-300, 1e-3, 14.0, 1e100, 1e300] {
+            for rate in [-1e300, -8.0905e-3, 0.0, 8.0905e-3, 1.0, 1e300] {
+                if let Ok(r) = RampedRotor::new(m0e, omega0, rate) {
+                    finite(&format!("RampedRotor({m0e:e}, {omega0:e}, {rate:e})"), &r);
+                    ramps += 1;
+                }
+            }
+        }
+    }
+    assert!(ramps > 60, "{ramps}");
+    // Ordinary parameters: unchanged (the paper's ramp against its closed form).
+    let r = RampedRotor::new(0.01805, 14.0, 8.0905e-3).unwrap();
+    let t: f64 = 12.3;
+    let (w, phi) = (14.0 + 8.0905e-3 * t, (14.0 + 0.5 * 8.0905e-3 * t) * t);
+    let exact = 0.01805 * (w * w * phi.sin() - 8.0905e-3 * phi.cos());
+    assert!((r.force(t) - exact).abs() < 1e-12 * exact.abs().max(1.0));
+    // The force at t = 0 is −m0e·rate: it must be finite.
+    assert!(RampedRotor::new(1e300, 1e-20, 1e10).is_err());
+    // f32: the phase overflows f32 long before f64.
+    let h = Harmonic::<f32>::new(1.0, 1e30, 0.0).unwrap();
+    assert!(h.force(1e9).is_finite() && h.force_rate(1e9).is_finite());
 }
