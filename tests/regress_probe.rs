@@ -3,8 +3,10 @@
 //! documented no-ops instead of panics, and invalid settings are rejected by name.
 
 use nalgebra::Vector2;
+use nonsmooth::ForceLaw;
 use nonsmooth::event::{EventFunction, Level, ResetMap, Restitution};
 use nonsmooth::excite::{Excitation, Harmonic, RampedRotor, UnbalancedRotor};
+use nonsmooth::force::{DryFriction, Regularization};
 use nonsmooth::sample::{Regime, detect_period, try_detect_period};
 
 /// Defect 1: `Level::value`/`rate` and `Restitution::apply` with a component index beyond
@@ -115,4 +117,72 @@ fn excitations_are_finite_for_finite_time() {
     // f32: the phase overflows f32 long before f64.
     let h = Harmonic::<f32>::new(1.0, 1e30, 0.0).unwrap();
     assert!(h.force(1e9).is_finite() && h.force_rate(1e9).is_finite());
+}
+
+/// Defect 4: `DryFriction` at (x, v) = (1e300, 1e-121) gave a NaN partial (`T·ε²/s^{3/2}`
+/// with `s^{3/2}` underflowing to 0), and `v²` overflow gave a zero or NaN force.
+#[test]
+fn dry_friction_partials_are_finite() {
+    let speeds = [
+        0.0,
+        1e-121,
+        -1e-121,
+        5e-324,
+        1e-300,
+        1e-6,
+        -1.0,
+        1e150,
+        -1e200,
+        1e300,
+        f64::MAX,
+        -f64::MAX,
+    ];
+    let mut laws = 0;
+    for t in [0.0_f64, 1e-300, 0.63133, 1e10, 1e300] {
+        for eps in [1.5e-154_f64, 1e-150, 1e-6, 1.0, 1e100, 1e154] {
+            for reg in [Regularization::Sqrt, Regularization::Tanh] {
+                let Ok(f) = DryFriction::new(t, eps, reg) else {
+                    // Only a slope T/ε at v = 0 beyond the range is rejected.
+                    assert!(!(t / eps).is_finite(), "T = {t:e}, ε = {eps:e}");
+                    continue;
+                };
+                laws += 1;
+                for &v in &speeds {
+                    let force = f.force(1e300, v);
+                    let (dx, dv) = f.partials(1e300, v);
+                    assert!(
+                        force.is_finite() && dx.is_finite() && dv.is_finite(),
+                        "{f:?} at v = {v:e}: {force}, ({dx}, {dv})"
+                    );
+                    assert!(
+                        force.abs() <= t * (1.0 + 4.0 * f64::EPSILON),
+                        "{f:?} at v = {v:e}: {force}"
+                    );
+                    assert!(
+                        (0.0..=t / eps * (1.0 + 1e-15)).contains(&dv),
+                        "{f:?} at v = {v:e}: {dv}"
+                    );
+                    // Far outside the layer the force is ±T.
+                    if v.abs() >= 1e150 && v.abs() > 1e20 * eps {
+                        assert!(
+                            (force - t * v.signum()).abs() <= 4.0 * f64::EPSILON * t,
+                            "{f:?} at v = {v:e}: {force}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+    assert!(laws > 40, "{laws}");
+    // The probe's point, with a regularization scale whose ε² is near the underflow limit.
+    let f = DryFriction::sqrt(1.0, 1e-150).unwrap();
+    let (_, dv) = f.partials(1e300, 1e-121);
+    let want = (1e-150_f64 / 1e-121).powi(2) / 1e-121; // ε²/v³ = 1e63
+
+    assert!((dv / want - 1.0).abs() < 1e-12, "{dv:e} vs {want:e}");
+    // The paper's law is unchanged.
+    let paper = DryFriction::sqrt(0.63133, 1e-6).unwrap();
+    let (v, e2): (f64, f64) = (3e-6, 1e-6 * 1e-6);
+    let s = v * v + e2;
+    assert_eq!(paper.partials(0.0, v).1, 0.63133 * e2 / (s * s.sqrt()));
 }
