@@ -7,6 +7,7 @@ use nonsmooth::ForceLaw;
 use nonsmooth::event::{EventFunction, Level, ResetMap, Restitution};
 use nonsmooth::excite::{Excitation, Harmonic, RampedRotor, UnbalancedRotor};
 use nonsmooth::force::{DryFriction, Regularization};
+use nonsmooth::identify::{Parameter, ParameterSpace, Transform};
 use nonsmooth::sample::{Regime, detect_period, try_detect_period};
 
 /// Defect 1: `Level::value`/`rate` and `Restitution::apply` with a component index beyond
@@ -185,4 +186,105 @@ fn dry_friction_partials_are_finite() {
     let (v, e2): (f64, f64) = (3e-6, 1e-6 * 1e-6);
     let s = v * v + e2;
     assert_eq!(paper.partials(0.0, v).1, 0.63133 * e2 / (s * s.sqrt()));
+}
+
+/// Defect 5: `ParameterSpace` round trips failed at ±f64::MAX (NaN, infinite `u`, a sign
+/// flip for a bound at −MAX) and at subnormal values (a `Log` parameter came back as the
+/// smallest normal number; a subnormal value between −1 and 1 came back as 0).
+#[test]
+fn parameter_space_round_trips_at_the_ends_of_the_range() {
+    let m = f64::MAX;
+    let base = [
+        m,
+        -m,
+        0.0,
+        1.0,
+        -1.0,
+        5e-324,
+        -5e-324,
+        1e-310,
+        -1e-310,
+        f64::MIN_POSITIVE,
+        1e300,
+        -1e300,
+        1e-300,
+        3.7,
+        m / 3.0,
+        -m / 7.0,
+    ];
+    let values: Vec<f64> = base
+        .iter()
+        .copied()
+        .chain(base.iter().map(|x| x * 0.999))
+        .collect();
+    let mut checked = 0;
+    for &x0 in &values {
+        for &b in &values {
+            for p in [
+                Parameter::new("x", x0),
+                Parameter::positive("x", x0),
+                Parameter::new("x", x0).with_lower(b),
+                Parameter::new("x", x0).with_upper(b),
+                Parameter::new("x", x0).with_bounds(-b, b),
+                Parameter::new("x", x0).with_bounds(b, m),
+                Parameter::new("x", x0).with_bounds(-m, b),
+                Parameter::positive("x", x0).with_lower(b),
+                Parameter::positive("x", x0).with_upper(b),
+                Parameter::positive("x", x0).with_bounds(5e-324, b),
+            ] {
+                let Ok(space) = ParameterSpace::new([p.clone()]) else {
+                    continue;
+                };
+                let (lo, hi) = p.bounds();
+                for &x in &values {
+                    let Ok(u) = space.to_unconstrained(&[x]) else {
+                        continue; // outside the bounds, or not positive under Log
+                    };
+                    assert!(u[0].is_finite(), "{p:?}: {x:e} -> {}", u[0]);
+                    let back = space
+                        .to_physical(&u)
+                        .unwrap_or_else(|e| panic!("{p:?}: {x:e} -> {:e}: {e}", u[0]))
+                        .values()[0];
+                    assert!(
+                        back >= lo.unwrap_or(-m) && back <= hi.unwrap_or(m),
+                        "{p:?}: {x:e} -> {back:e}"
+                    );
+                    let ok = if p.transform() == Transform::Log {
+                        // A few ulps of ln x, ln(bounds) and the map's scale (≲ 3000).
+                        (back / x - 1.0).abs() <= 4e-12 || (back - x).abs() <= 2e-323
+                    } else {
+                        let scale = [Some(x), lo, hi, Some(p.initial())]
+                            .into_iter()
+                            .flatten()
+                            .fold(0.0_f64, |a, v| a.max(v.abs()));
+                        (back - x).abs() <= 16.0 * f64::EPSILON * scale
+                            || (back - x).abs() <= 2e-323
+                    };
+                    assert!(ok, "{p:?}: {x:e} -> {:e} -> {back:e}", u[0]);
+                    checked += 1;
+                }
+            }
+        }
+    }
+    assert!(checked > 20_000, "{checked}");
+    // Exact or nearly so where the representation allows it: a value near the middle of
+    // bounds at ±MAX, subnormal values near the middle of the bounds and under Log.
+    let one = ParameterSpace::new([Parameter::new("x", 0.0).with_bounds(-m, m)]).unwrap();
+    let back = one
+        .to_physical(&one.to_unconstrained(&[1.0]).unwrap())
+        .unwrap()
+        .values()[0];
+    assert!((back - 1.0).abs() <= f64::EPSILON, "{back}"); // was 0
+    for (p, x) in [
+        (Parameter::new("x", 0.0).with_bounds(-1.0, 1.0), 1e-310),
+        (Parameter::positive("x", 1.0), 1e-310),
+        (Parameter::positive("x", 1.0), 5e-324),
+    ] {
+        let space = ParameterSpace::new([p.clone()]).unwrap();
+        let back = space
+            .to_physical(&space.to_unconstrained(&[x]).unwrap())
+            .unwrap()
+            .values()[0];
+        assert_eq!(back, x, "{p:?}");
+    }
 }
