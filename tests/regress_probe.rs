@@ -288,3 +288,24 @@ fn parameter_space_round_trips_at_the_ends_of_the_range() {
         assert_eq!(back, x, "{p:?}");
     }
 }
+
+/// Defect 6: a deserialized `HertzContact` whose cached `(n3 − 1)/2` disagrees with `n3`
+/// must not keep the cached value (it is rebuilt through the constructors).
+#[cfg(feature = "serde")]
+#[test]
+fn deserialized_hertz_contact_recomputes_its_cached_exponent() {
+    use nonsmooth::force::HertzContact;
+    let h = HertzContact::new(-2.086e-3, 2.3983e8)
+        .unwrap()
+        .with_damping(0.8485, 1.5, 0.18667)
+        .unwrap()
+        .with_rate_regularization(1e-8)
+        .unwrap();
+    for bad in [3.0, -0.25, 1e300] {
+        let mut v = serde_json::to_value(h).unwrap();
+        v["half_n3_minus_1"] = serde_json::json!(bad);
+        let back: HertzContact<f64> = serde_json::from_value(v).unwrap();
+        assert_eq!(back, h);
+        assert_eq!(back.force(0.0, 0.1), h.force(0.0, 0.1));
+    }
+}
