@@ -2,12 +2,15 @@
 //! Finite input never gives NaN or an infinity, out-of-range arguments are errors or
 //! documented no-ops instead of panics, and invalid settings are rejected by name.
 
-use nalgebra::Vector2;
+use nalgebra::{Matrix2, SVector, Vector2};
 use nonsmooth::ForceLaw;
+use nonsmooth::drive::Simulation;
 use nonsmooth::event::{EventFunction, Level, ResetMap, Restitution};
 use nonsmooth::excite::{Excitation, Harmonic, RampedRotor, UnbalancedRotor};
-use nonsmooth::force::{DryFriction, Regularization};
+use nonsmooth::force::{DryFriction, LinearSpring, Regularization, ViscousDamper};
 use nonsmooth::identify::{Parameter, ParameterSpace, Transform};
+use nonsmooth::integrate::{Dopri5, Rosenbrock23, Tolerances};
+use nonsmooth::model::{Element, Load, Mechanical, ModelError};
 use nonsmooth::sample::{Regime, detect_period, try_detect_period};
 
 /// Defect 1: `Level::value`/`rate` and `Restitution::apply` with a component index beyond
@@ -308,4 +311,92 @@ fn deserialized_hertz_contact_recomputes_its_cached_exponent() {
         assert_eq!(back, h);
         assert_eq!(back.force(0.0, 0.1), h.force(0.0, 0.1));
     }
+}
+
+/// Defect 7: mass matrices whose inverse overflowed were accepted (NaN/∞ stored), a tiny
+/// well-conditioned one was called "singular", N = 0 ran into "step size too small", and a
+/// chain of 400 masses overflowed the stack (now a compile error beyond `MAX_DOFS`, see
+/// the `compile_fail` examples on `Mechanical`).
+#[test]
+fn mass_matrices_at_extreme_scales() {
+    // A lumped mass whose inverse overflows.
+    let e = Mechanical::<f64, 2, 4>::with_masses([5e-324, 1.0]).unwrap_err();
+    assert_eq!((e.name, e.value), ("mass", 5e-324), "{e}");
+    // Tiny and huge well-conditioned matrices: accepted, with the right finite inverse.
+    for s in [1e-170, 1e-300, 1e300] {
+        let mass = Matrix2::new(2.0, 0.5, 0.5, 1.0) * s;
+        let model = Mechanical::<f64, 2, 4>::with_mass_matrix(mass)
+            .unwrap_or_else(|e| panic!("scale {s:e}: {e}"));
+        let inv = model.inverse_mass_matrix();
+        assert!(inv.iter().all(|v| v.is_finite()), "scale {s:e}: {inv}");
+        let want = Matrix2::new(1.0, -0.5, -0.5, 2.0) / (1.75 * s);
+        for (a, b) in inv.iter().zip(want.iter()) {
+            assert!(
+                (a - b).abs() <= 1e-14 * b.abs(),
+                "scale {s:e}: {inv} vs {want}"
+            );
+        }
+        let diag =
+            Mechanical::<f64, 2, 4>::with_mass_matrix(Matrix2::from_diagonal(&Vector2::new(s, s)))
+                .unwrap();
+        let inv = diag.inverse_mass_matrix()[(1, 1)];
+        assert!(
+            (inv * s - 1.0).abs() <= 4.0 * f64::EPSILON,
+            "scale {s:e}: {inv:e}"
+        );
+    }
+    // A positive-definite matrix whose inverse is beyond the range: an error naming it.
+    let tiny = Matrix2::from_diagonal(&Vector2::new(1e-310, 1.0));
+    match Mechanical::<f64, 2, 4>::with_mass_matrix(tiny) {
+        Err(e @ ModelError::MassInverseOverflow { smallest_mass }) => {
+            assert_eq!(smallest_mass, 1e-310);
+            assert!(e.to_string().contains("1e-310"), "{e}");
+        }
+        other => panic!("{other:?}"),
+    }
+    // The ordinary case is unchanged to the bit.
+    let m = Matrix2::new(2.0, 0.3, 0.3, 1.5);
+    let model = Mechanical::<f64, 2, 4>::with_mass_matrix(m).unwrap();
+    assert_eq!(*model.inverse_mass_matrix(), m.try_inverse().unwrap());
+    assert_eq!(Mechanical::<f64, 2, 4>::MAX_DOFS, 64);
+}
+
+/// Defect 7, size limit: a chain of `MAX_DOFS` masses is built and run with an implicit
+/// stepper (Jacobians of 128×128) on a spawned thread's 2 MiB stack.
+#[test]
+fn largest_mechanical_system_runs_on_a_two_mib_stack() {
+    fn chain() {
+        const N: usize = 64;
+        type Spring = Element<f64, N, (LinearSpring<f64>, ViscousDamper<f64>)>;
+        let elements: [Spring; N] = std::array::from_fn(|i| {
+            let law = (
+                LinearSpring::new(10.0).unwrap(),
+                ViscousDamper::new(0.1).unwrap(),
+            );
+            if i == 0 {
+                Element::on_dof(0, law).unwrap()
+            } else {
+                Element::between(i, i - 1, law).unwrap()
+            }
+        });
+        let model = Mechanical::<f64, N, { 2 * N }>::with_masses([1.0; N])
+            .unwrap()
+            .with_elements(elements)
+            .with_loads(Load::on_dof(N - 1, Harmonic::new(1.0, 1.0, 0.0).unwrap()).unwrap());
+        let y0 = SVector::<f64, { 2 * N }>::zeros();
+        let tol = Tolerances::new(1e-6, 1e-8).unwrap();
+        let explicit = Simulation::new(&model, Dopri5::new(tol))
+            .run(0.0, y0, 1.0, &mut ())
+            .unwrap();
+        let implicit = Simulation::new(&model, Rosenbrock23::new(tol))
+            .run(0.0, y0, 1.0, &mut ())
+            .unwrap();
+        assert!((explicit.y - implicit.y).amax() < 1e-4);
+    }
+    std::thread::Builder::new()
+        .stack_size(2 << 20)
+        .spawn(chain)
+        .unwrap()
+        .join()
+        .unwrap();
 }
