@@ -3,15 +3,17 @@
 //! documented no-ops instead of panics, and invalid settings are rejected by name.
 
 use nalgebra::{Matrix2, SVector, Vector2};
-use nonsmooth::ForceLaw;
 use nonsmooth::drive::Simulation;
 use nonsmooth::event::{EventFunction, Level, ResetMap, Restitution};
 use nonsmooth::excite::{Excitation, Harmonic, RampedRotor, UnbalancedRotor};
 use nonsmooth::force::{DryFriction, LinearSpring, Regularization, ViscousDamper};
 use nonsmooth::identify::{Parameter, ParameterSpace, Transform};
 use nonsmooth::integrate::{Dopri5, Rosenbrock23, Tolerances};
+use nonsmooth::lyapunov::tangent_tolerances;
 use nonsmooth::model::{Element, Load, Mechanical, ModelError};
+use nonsmooth::orbit::{ContinuationSettings, Extremum, Grazing, OrbitError, Shooting, follow};
 use nonsmooth::sample::{Regime, detect_period, try_detect_period};
+use nonsmooth::{Error, ForceLaw};
 
 /// Defect 1: `Level::value`/`rate` and `Restitution::apply` with a component index beyond
 /// the state panicked ("Matrix index out of bounds") when called directly.
@@ -399,4 +401,74 @@ fn largest_mechanical_system_runs_on_a_two_mib_stack() {
         .unwrap()
         .join()
         .unwrap();
+}
+
+/// Defect 8: `orbit::follow` with a NaN grazing level reported grazing bifurcations (the
+/// sign test of a NaN margin); the level must be finite and the component in range.
+#[test]
+fn continuation_rejects_a_nan_grazing_level() {
+    type Model = Mechanical<
+        f64,
+        1,
+        2,
+        Element<f64, 1, (LinearSpring<f64>, ViscousDamper<f64>)>,
+        Load<f64, 1, Harmonic<f64>>,
+    >;
+    let model = |w: f64| -> nonsmooth::Result<Model> {
+        Ok(Mechanical::<f64, 1, 2>::with_masses([1.0])?
+            .with_elements(Element::on_dof(
+                0,
+                (LinearSpring::new(1.0)?, ViscousDamper::new(0.1)?),
+            )?)
+            .with_loads(Load::on_dof(0, Harmonic::cosine(0.5, w)?)?))
+    };
+    let tol = Tolerances::new(1e-10, 1e-12).unwrap();
+    let build = |w: f64| -> nonsmooth::Result<_> {
+        Ok(Shooting::new(
+            model(w)?,
+            (),
+            tangent_tolerances::<f64, 2, 2, 6>(&tol, 1e-10, 1e-12)?,
+        ))
+    };
+    let period = |w: f64| std::f64::consts::TAU / w;
+    let settings = |g: Grazing| {
+        ContinuationSettings::new(0.5, 0.8, 0.05)
+            .unwrap()
+            .with_grazing(g)
+    };
+    for (component, level) in [(0, f64::NAN), (0, f64::INFINITY), (2, 0.0)] {
+        let g = Grazing {
+            component,
+            level,
+            extremum: Extremum::Min,
+        };
+        for s in [
+            settings(g),
+            ContinuationSettings::new(0.5, 0.8, 0.05)
+                .unwrap()
+                .with_contact_changes(g),
+        ] {
+            match follow(build, period, 0.0, 0.5, SVector::zeros(), &s) {
+                Err(Error::Orbit(OrbitError::InvalidSetting { what, value, .. })) => {
+                    assert!(what.contains("grazing"), "{what}");
+                    assert!(value.is_nan() == level.is_nan() || value == component as f64);
+                }
+                other => panic!("component {component}, level {level}: {other:?}"),
+            }
+        }
+    }
+    // A finite level far below the motion: no grazing on the branch.
+    let far = Grazing {
+        component: 0,
+        level: -100.0,
+        extremum: Extremum::Min,
+    };
+    let branch = follow(build, period, 0.0, 0.5, SVector::zeros(), &settings(far)).unwrap();
+    assert!(branch.bifurcations.is_empty(), "{:?}", branch.bifurcations);
+    assert!(
+        branch
+            .points
+            .iter()
+            .all(|q| q.grazing_margin.unwrap() > 0.0)
+    );
 }
