@@ -10,6 +10,24 @@ use crate::fastmath;
 use crate::scalar::lit;
 use crate::validate::{finite, non_negative, positive};
 
+/// `x` clamped to the finite range: `±∞ → ±MAX` (NaN stays NaN; a type without a largest
+/// value is returned unchanged).
+///
+/// The excitations evaluate a phase `ω·t` that overflows for finite but extreme `ω` and `t`;
+/// there the floating-point phase is spaced far more than `2π` apart and carries no angle, so
+/// any phase is as good as the exact one, and the saturated one keeps `sin`/`cos` finite.
+#[inline(always)]
+fn saturate<T: Real>(x: T) -> T {
+    if x.is_finite() {
+        return x;
+    }
+    match T::max_value() {
+        Some(max) if x > T::zero() => max,
+        Some(max) if x < T::zero() => -max,
+        _ => x,
+    }
+}
+
 /// A time-dependent force `f(t)`.
 ///
 /// Implement [`force`](Excitation::force); override [`force_rate`](Excitation::force_rate)
@@ -179,6 +197,9 @@ impl<T: Real> Excitation<T> for Constant<T> {
 ///
 /// # Model
 /// $$f(t) = F_0 \sin(\omega t + \varphi_0), \qquad \varphi(t) = \omega t + \varphi_0 .$$
+/// Where `ωt + φ0` overflows, [`force`](Excitation::force) and
+/// [`force_rate`](Excitation::force_rate) take the phase as `±MAX` (the floating-point
+/// phase there carries no angle): for finite `t` both are finite.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Harmonic<T> {
@@ -196,12 +217,23 @@ impl<T: Real> Harmonic<T> {
     /// `amplitude·sin(omega·t + phase0)`.
     ///
     /// # Errors
-    /// [`ParameterError`] unless all are finite and `omega > 0`.
+    /// [`ParameterError`] unless all are finite and `omega > 0`, with the amplitude of the
+    /// force rate `amplitude·ω` finite.
     pub fn new(amplitude: T, omega: T, phase0: T) -> Result<Self, ParameterError> {
+        let amplitude = finite("amplitude", amplitude)?;
+        let omega = positive("omega", omega)?;
+        let phase0 = finite("phase0", phase0)?;
+        if !(amplitude * omega).is_finite() {
+            return Err(ParameterError::new(
+                "omega",
+                crate::scalar::to_f64(omega),
+                "small enough that amplitude·ω is finite",
+            ));
+        }
         Ok(Self {
-            amplitude: finite("amplitude", amplitude)?,
-            omega: positive("omega", omega)?,
-            phase0: finite("phase0", phase0)?,
+            amplitude,
+            omega,
+            phase0,
         })
     }
 
@@ -254,11 +286,11 @@ impl<T: Real> Harmonic<T> {
 impl<T: Real> Excitation<T> for Harmonic<T> {
     #[inline(always)]
     fn force(&self, t: T) -> T {
-        self.amplitude * fastmath::sin(self.omega * t + self.phase0)
+        self.amplitude * fastmath::sin(saturate(self.omega * t + self.phase0))
     }
     #[inline(always)]
     fn force_rate(&self, t: T) -> T {
-        self.amplitude * self.omega * fastmath::cos(self.omega * t + self.phase0)
+        self.amplitude * self.omega * fastmath::cos(saturate(self.omega * t + self.phase0))
     }
     fn force_acceleration(&self, t: T) -> T {
         -self.amplitude * self.omega * self.omega * fastmath::sin(self.omega * t + self.phase0)
@@ -281,6 +313,8 @@ impl<T: Real> Excitation<T> for Harmonic<T> {
 ///
 /// # Model
 /// $$f(t) = m_0 e\,\omega^2 \sin\omega t .$$
+/// Where `ωt` overflows, the phase is taken as `±MAX` (as for [`Harmonic`]): for finite `t`
+/// the force and its rate are finite.
 /// # References
 /// The paper's eq. (1), right-hand side; `m0·e = 0.01805 kg·m`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -341,11 +375,11 @@ impl<T: Real> UnbalancedRotor<T> {
 impl<T: Real> Excitation<T> for UnbalancedRotor<T> {
     #[inline(always)]
     fn force(&self, t: T) -> T {
-        self.amp * fastmath::sin(self.omega * t)
+        self.amp * fastmath::sin(saturate(self.omega * t))
     }
     #[inline(always)]
     fn force_rate(&self, t: T) -> T {
-        self.amp * self.omega * fastmath::cos(self.omega * t)
+        self.amp * self.omega * fastmath::cos(saturate(self.omega * t))
     }
     fn force_acceleration(&self, t: T) -> T {
         -self.amp * self.omega * self.omega * fastmath::sin(self.omega * t)
@@ -373,6 +407,10 @@ impl<T: Real> Excitation<T> for UnbalancedRotor<T> {
 /// $$f(t) = m_0 e\,\bigl(\dot\varphi^2 \sin\varphi - \ddot\varphi\cos\varphi\bigr).$$
 /// For `r = 0` it is [`UnbalancedRotor`]. Stroboscopic sections are at `φ = 2πi`, found
 /// from the quadratic for `t` (no accumulated time).
+///
+/// For finite `t` the force and its rate are finite: where the ramp takes `ω(t)`, `φ(t)` or
+/// the force beyond the floating-point range (far outside any simulated horizon), every
+/// intermediate saturates at `±MAX` and the phase is taken as `±MAX`, as for [`Harmonic`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct RampedRotor<T> {
@@ -391,20 +429,59 @@ impl<T: Real> RampedRotor<T> {
     ///
     /// # Errors
     /// [`ParameterError`] unless `m0e ≥ 0`, `omega0 > 0` and `rate` are finite and the
-    /// force and its rate at `t = 0` are finite.
+    /// force and its rate at `t = 0` (`−m0e·rate`, `m0e·ω0³`) and `m0e·ω0·rate` are finite.
     pub fn new(m0e: T, omega0: T, rate: T) -> Result<Self, ParameterError> {
         let m0e = non_negative("m0e", m0e)?;
         let omega0 = positive("omega0", omega0)?;
         let rate = finite("rate", rate)?;
-        // The force and its rate at t = 0 (m0e·ω0³, m0e·ω0·r) must be finite.
-        if !(m0e * omega0 * omega0 * omega0).is_finite() || !(m0e * omega0 * rate).is_finite() {
+        // The rate at t = 0 is m0e·ω0³; the force at t = 0 is −m0e·r.
+        if !(m0e * omega0 * omega0 * omega0).is_finite() {
             return Err(ParameterError::new(
                 "omega0",
                 crate::scalar::to_f64(omega0),
-                "small enough that m0e·ω0³ and m0e·ω0·rate are finite",
+                "small enough that m0e·ω0³ is finite",
+            ));
+        }
+        if !(m0e * rate).is_finite() || !(m0e * omega0 * rate).is_finite() {
+            return Err(ParameterError::new(
+                "rate",
+                crate::scalar::to_f64(rate),
+                "small enough that m0e·rate and m0e·ω0·rate are finite",
             ));
         }
         Ok(Self { m0e, omega0, rate })
+    }
+
+    /// [`force`](Excitation::force) where its direct evaluation is not finite: every
+    /// intermediate saturated at `±MAX` (finite operands, so never NaN), the unbalance
+    /// multiplied in first so that a small `m0e` keeps a large `ω²` in range.
+    #[cold]
+    fn saturated_force(&self, t: T) -> T {
+        let (w, s, c) = self.saturated_state(t);
+        let m = self.m0e;
+        let centrifugal = saturate(saturate(saturate(m * w) * w) * s);
+        let tangential = saturate(saturate(m * self.rate) * c);
+        saturate(centrifugal - tangential)
+    }
+
+    /// [`force_rate`](Excitation::force_rate) where its direct evaluation is not finite,
+    /// as [`saturated_force`](Self::saturated_force): `m0e·(w³·cos φ + 3·r·w·sin φ)`.
+    #[cold]
+    fn saturated_force_rate(&self, t: T) -> T {
+        let (w, s, c) = self.saturated_state(t);
+        let m = self.m0e;
+        let cubic = saturate(saturate(saturate(saturate(m * w) * w) * w) * c);
+        let mixed = saturate(saturate(saturate(saturate(m * self.rate) * w) * s) * lit(3.0));
+        saturate(cubic + mixed)
+    }
+
+    /// `(ω(t), sin φ(t), cos φ(t))` with `ω` and `φ` saturated at `±MAX`.
+    fn saturated_state(&self, t: T) -> (T, T, T) {
+        let w = saturate(self.omega0 + saturate(self.rate * t));
+        let half_rate_t = saturate(lit::<T>(0.5) * self.rate * t);
+        let phi = saturate(saturate(self.omega0 + half_rate_t) * t);
+        let (s, c) = fastmath::sin_cos(phi);
+        (w, s, c)
     }
 
     /// `ω(t) = ω0 + r·t`.
@@ -419,14 +496,24 @@ impl<T: Real> Excitation<T> for RampedRotor<T> {
         let w = self.omega0 + self.rate * t;
         let phi = (self.omega0 + lit::<T>(0.5) * self.rate * t) * t;
         let (s, c) = fastmath::sin_cos(phi);
-        self.m0e * (w * w * s - self.rate * c)
+        let f = self.m0e * (w * w * s - self.rate * c);
+        if f.is_finite() {
+            f
+        } else {
+            self.saturated_force(t)
+        }
     }
     fn force_rate(&self, t: T) -> T {
         let w = self.omega0 + self.rate * t;
         let phi = (self.omega0 + lit::<T>(0.5) * self.rate * t) * t;
         let (s, c) = fastmath::sin_cos(phi);
         let r = self.rate;
-        self.m0e * (lit::<T>(2.0) * w * r * s + w * w * w * c + r * w * s)
+        let rate = self.m0e * (lit::<T>(2.0) * w * r * s + w * w * w * c + r * w * s);
+        if rate.is_finite() {
+            rate
+        } else {
+            self.saturated_force_rate(t)
+        }
     }
     fn phase(&self, t: T) -> Option<T> {
         Some((self.omega0 + lit::<T>(0.5) * self.rate * t) * t)

@@ -189,7 +189,9 @@ pub fn check_index(index: usize, n: usize) -> Result<(), EventError> {
 /// The hyperplane `g = y[index] − level` (e.g. the stop `x = x_I`), with rate `ẏ[index]`.
 ///
 /// Deserialization (feature `serde`) applies the constructor's check of the level (the index
-/// is checked against the state when a run starts).
+/// is checked against the state when a run starts). Called directly on a state without
+/// component `index`, [`value`](EventFunction::value) is NaN (which the driver reports) and
+/// [`rate`](EventFunction::rate) is `None`; neither panics.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Level<T> {
@@ -228,11 +230,15 @@ impl<T: Real> Level<T> {
 impl<T: Real, const N: usize> EventFunction<T, N> for Level<T> {
     #[inline(always)]
     fn value(&self, _t: T, y: &SVector<T, N>) -> T {
-        y[self.index] - self.level
+        // An index outside the state gives NaN (reported by the driver), never a panic.
+        match y.get(self.index) {
+            Some(&x) => x - self.level,
+            None => T::zero() / T::zero(),
+        }
     }
     #[inline(always)]
     fn rate(&self, _t: T, _y: &SVector<T, N>, dy: &SVector<T, N>) -> Option<T> {
-        Some(dy[self.index])
+        dy.get(self.index).copied()
     }
     fn check(&self) -> Result<(), EventError> {
         check_index(self.index, N)
@@ -425,7 +431,9 @@ impl<T: Real, const N: usize> ResetMap<T, N> for () {
 /// Newton's restitution law `ẏ[velocity]⁺ = −r·ẏ[velocity]⁻`.
 ///
 /// Deserialization (feature `serde`) applies the constructor's check of `r` (the index is
-/// checked against the state when a run starts).
+/// checked against the state when a run starts). Applied directly to a state without
+/// component `velocity`, [`apply`](ResetMap::apply) leaves the state unchanged (no panic);
+/// [`check`](ResetMap::check) reports such an index.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Restitution<T> {
@@ -454,7 +462,10 @@ impl<T: Real> Restitution<T> {
 impl<T: Real, const N: usize> ResetMap<T, N> for Restitution<T> {
     #[inline(always)]
     fn apply(&self, _t: T, y: &mut SVector<T, N>) {
-        y[self.velocity] = -self.r * y[self.velocity];
+        // An index outside the state leaves it unchanged (`check` reports it), never a panic.
+        if let Some(v) = y.get_mut(self.velocity) {
+            *v = -self.r * *v;
+        }
     }
     fn check(&self) -> Result<(), EventError> {
         check_index(self.velocity, N)

@@ -60,14 +60,20 @@ impl<T: Real> DryFriction<T> {
     /// Friction with an explicit regularization.
     ///
     /// # Errors
-    /// [`ParameterError`] if `t < 0`, `eps ≤ 0`, either is not finite, or `eps² `
-    /// underflows (`eps < 1.5·10⁻¹⁵⁴` for `f64`: the force at `v = 0` would be `0/0`).
+    /// [`ParameterError`] if `t < 0`, `eps ≤ 0`, either is not finite, `eps²`
+    /// underflows (`eps < 1.5·10⁻¹⁵⁴` for `f64`: the force at `v = 0` would be `0/0`) or
+    /// overflows, or the slope at `v = 0`, `T/eps`, is not finite.
     pub fn new(t: T, eps: T, reg: Regularization) -> Result<Self, ParameterError> {
-        Ok(Self {
-            t: non_negative("T", t)?,
-            eps: normal_square("eps", positive("eps", eps)?)?,
-            reg,
-        })
+        let t = non_negative("T", t)?;
+        let eps = normal_square("eps", positive("eps", eps)?)?;
+        if !(t / eps).is_finite() {
+            return Err(ParameterError::new(
+                "eps",
+                crate::scalar::to_f64(eps),
+                "large enough that the slope T/eps at v = 0 is finite",
+            ));
+        }
+        Ok(Self { t, eps, reg })
     }
 
     /// The friction magnitude `T`.
@@ -90,7 +96,16 @@ impl<T: Real> ForceLaw<T> for DryFriction<T> {
     #[inline(always)]
     fn force(&self, _x: T, v: T) -> T {
         match self.reg {
-            Regularization::Sqrt => self.t * v / (v * v + self.eps * self.eps).sqrt(),
+            Regularization::Sqrt => {
+                let s = v * v + self.eps * self.eps;
+                let f = self.t * v / s.sqrt();
+                if s.is_finite() && f.is_finite() {
+                    f
+                } else {
+                    // `v²` or `T·v` overflowed: `v/hypot(v, ε)` is in [−1, 1].
+                    self.t * (v / v.hypot(self.eps))
+                }
+            }
             Regularization::Tanh => self.t * (v / self.eps).tanh(),
         }
     }
@@ -101,7 +116,20 @@ impl<T: Real> ForceLaw<T> for DryFriction<T> {
             Regularization::Sqrt => {
                 let e2 = self.eps * self.eps;
                 let s = v * v + e2;
-                self.t * e2 / (s * s.sqrt())
+                let num = self.t * e2;
+                let den = s * s.sqrt();
+                let dv = num / den;
+                // `T·ε²/s^{3/2}` directly while its parts are normal numbers; otherwise
+                // (`s^{3/2}` overflowing or underflowing, `T·ε²` subnormal or 0) the same
+                // value as `(T/ε)·(ε/r)³` with `r = hypot(v, ε) ≥ ε`: at most `T/ε`, which
+                // the constructor keeps finite.
+                let min = crate::scalar::lit::<T>(f64::MIN_POSITIVE);
+                if num > min && den > min && den.is_finite() && dv.is_finite() {
+                    dv
+                } else {
+                    let q = self.eps / v.hypot(self.eps);
+                    self.t / self.eps * (q * q * q)
+                }
             }
             Regularization::Tanh => {
                 let th = (v / self.eps).tanh();

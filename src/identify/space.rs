@@ -104,15 +104,29 @@ impl Parameter {
 /// How `z = T(x)` is mapped to the unconstrained coordinate `u`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum BoundMap {
+    /// `z = mid + half·sin u` (`= lo + (hi − lo)(1 + sin u)/2`), with `mid = lo/2 + hi/2`
+    /// and `half = hi/2 − lo/2` (finite for bounds up to ±f64::MAX; values near the middle
+    /// keep their own resolution, e.g. subnormal ones between −1 and 1).
+    Both {
+        lo: f64,
+        hi: f64,
+        mid: f64,
+        half: f64,
+    },
+    /// `z = k·(lo + s(√(1 + (u/s)²) − 1))`, with the bound and the scale stored divided by
+    /// `k` (1, or 8 for bounds or scales so large that `|z − bound|` or `u` would overflow).
+    Lower { lo: f64, s: f64, k: f64 },
+    /// `z = k·(hi − s(√(1 + (u/s)²) − 1))`, as [`Lower`](BoundMap::Lower).
+    Upper { hi: f64, s: f64, k: f64 },
     /// `z = u`.
     Free,
-    /// `z = lo + (hi − lo)(1 + sin u)/2`.
-    Both { lo: f64, hi: f64 },
-    /// `z = lo + s(√(1 + (u/s)²) − 1)`.
-    Lower { lo: f64, s: f64 },
-    /// `z = hi − s(√(1 + (u/s)²) − 1)`.
-    Upper { hi: f64, s: f64 },
 }
+
+/// `ln f64::MAX` plus 10⁻¹² (about ten units in its last place).
+const LN_MAX_WITH_ROUNDING: f64 = 709.782_712_893_385;
+
+/// The factor that one-sided maps divide `z` by when the unscaled map would overflow.
+const WIDE: f64 = 8.0;
 
 #[derive(Debug, Clone, PartialEq)]
 struct Mapping {
@@ -131,44 +145,91 @@ impl Mapping {
     fn x_of_z(&self, z: f64) -> f64 {
         match self.transform {
             Transform::Identity => z,
-            Transform::Log => z.exp(),
+            Transform::Log => {
+                let x = z.exp();
+                // ln f64::MAX rounded up by the bound maps (by a few units in the last place
+                // of z ≈ 709.78) is f64::MAX, not an overflow.
+                if x == f64::INFINITY && z <= LN_MAX_WITH_ROUNDING {
+                    f64::MAX
+                } else {
+                    x
+                }
+            }
         }
     }
 
     fn z_of_u(&self, u: f64) -> f64 {
         match self.bounds {
             BoundMap::Free => u,
-            BoundMap::Both { lo, hi } => {
-                let w = 0.5 * (1.0 + u.sin());
-                let span = hi - lo;
-                // Clamp: rounding must never leave [lo, hi].
-                if span.is_finite() {
-                    (lo + span * w).clamp(lo, hi)
+            BoundMap::Both { lo, hi, mid, half } => {
+                let sin = u.sin();
+                // The bounds themselves exactly; clamp: rounding must never leave [lo, hi].
+                if sin >= 1.0 {
+                    hi
+                } else if sin <= -1.0 {
+                    lo
+                } else if half >= f64::MIN_POSITIVE {
+                    (mid + half * sin).clamp(lo, hi)
                 } else {
-                    // hi − lo overflows (bounds near ±f64::MAX): the convex combination.
-                    (lo * (1.0 - w) + hi * w).clamp(lo, hi)
+                    // Bounds a few subnormal steps apart: `half` would round.
+                    (lo + (hi - lo) * (0.5 * (1.0 + sin))).clamp(lo, hi)
                 }
             }
-            BoundMap::Lower { lo, s } => lo + sqrt_one_plus_minus_one(u, s),
-            BoundMap::Upper { hi, s } => hi - sqrt_one_plus_minus_one(u, s),
+            // With k = 1 these are `lo + …` and `hi − …` (multiplying by 1 is exact).
+            BoundMap::Lower { lo, s, k } => scaled_sum(k, lo, sqrt_one_plus_minus_one(u, s)),
+            BoundMap::Upper { hi, s, k } => scaled_sum(k, hi, -sqrt_one_plus_minus_one(u, s)),
         }
     }
 
     fn u_of_z(&self, z: f64) -> f64 {
         match self.bounds {
             BoundMap::Free => z,
-            BoundMap::Both { lo, hi } => {
-                let span = hi - lo;
-                let r = if span.is_finite() {
-                    2.0 * (z - lo) / span - 1.0
+            BoundMap::Both { lo, hi, mid, half } => {
+                if z >= hi {
+                    std::f64::consts::FRAC_PI_2
+                } else if z <= lo {
+                    -std::f64::consts::FRAC_PI_2
+                } else if half >= f64::MIN_POSITIVE {
+                    ((z - mid) / half).clamp(-1.0, 1.0).asin()
                 } else {
-                    2.0 * (0.5 * z - 0.5 * lo) / (0.5 * hi - 0.5 * lo) - 1.0
-                };
-                r.clamp(-1.0, 1.0).asin()
+                    (2.0 * (z - lo) / (hi - lo) - 1.0).clamp(-1.0, 1.0).asin()
+                }
             }
-            BoundMap::Lower { lo, s } => inverse_sqrt_map(z - lo, s),
-            BoundMap::Upper { hi, s } => inverse_sqrt_map(hi - z, s),
+            BoundMap::Lower { lo, s, k } => inverse_sqrt_map(z / k - lo, s),
+            BoundMap::Upper { hi, s, k } => inverse_sqrt_map(hi - z / k, s),
         }
+    }
+}
+
+/// `k·(a + b)`; where that overflows by no more than the rounding of the maps (relative
+/// 10⁻¹², the image of a value at ±f64::MAX), ±f64::MAX.
+fn scaled_sum(k: f64, a: f64, b: f64) -> f64 {
+    let z = k * (a + b);
+    if z.is_infinite() && (0.5 * a + 0.5 * b).abs() <= 0.5 * f64::MAX / k * (1.0 + 1e-12) {
+        f64::MAX.copysign(z)
+    } else {
+        z
+    }
+}
+
+/// The one-sided map for bound `b` with the domain reaching `far` (`±f64::MAX`): the bound
+/// and the scale divided by `k`, and `k` — 1 where every `z` of the domain has a finite `u`
+/// (`|far − b|`, the scale and `u` at `far` finite), [`WIDE`] otherwise (bounds or a start
+/// within about `10²⁹²` of `∓f64::MAX`), where the same map in `z/8` keeps them finite.
+fn one_sided(z0: f64, b: f64, far: f64) -> (f64, f64, f64) {
+    let scaled = |k: f64| {
+        let (z0, b) = (z0 / k, b / k);
+        let d = (z0 - b).abs();
+        let s = if d > 0.0 { d } else { z0.abs().max(1.0 / k) };
+        (b, s)
+    };
+    let (b1, s1) = scaled(1.0);
+    let reach = (far - b1).abs();
+    if s1.is_finite() && reach.is_finite() && inverse_sqrt_map(reach, s1) < f64::INFINITY {
+        (b1, s1, 1.0)
+    } else {
+        let (bk, sk) = scaled(WIDE);
+        (bk, sk, WIDE)
     }
 }
 
@@ -181,16 +242,11 @@ fn sqrt_one_plus_minus_one(u: f64, s: f64) -> f64 {
 }
 
 /// The inverse of [`sqrt_one_plus_minus_one`] on `d = |z − bound| ≥ 0`:
-/// `s·√(r² − 1)` with `r = d/s + 1` is `√d·√(d + 2s)`, finite for every finite `d`. Where
-/// `d` itself overflows (a bound and a value near ±f64::MAX of opposite signs) the exact
-/// `u` is beyond the range and saturates at `f64::MAX`.
+/// `s·√(r² − 1)` with `r = d/s + 1` is `√d·√(d + 2s)`. Infinite where `d` or `u` overflows,
+/// which [`one_sided`] rules out for the values of a parameter's domain.
 fn inverse_sqrt_map(d: f64, s: f64) -> f64 {
-    if d.is_finite() {
-        let d = d.max(0.0);
-        d.sqrt() * (d + 2.0 * s).sqrt()
-    } else {
-        f64::MAX
-    }
+    let d = d.max(0.0);
+    d.sqrt() * (d + 2.0 * s).sqrt()
 }
 
 /// Physical parameter values by name, as handed to the objective.
@@ -399,15 +455,22 @@ impl ParameterSpace {
             None
         };
         let zh = hi.is_finite().then(|| t.z_of_x(hi));
-        let scale = |b: f64| {
-            let d = (z0 - b).abs();
-            if d > 0.0 { d } else { z0.abs().max(1.0) }
-        };
         let bounds = match (zl, zh) {
             (None, None) => BoundMap::Free,
-            (Some(lo), Some(hi)) => BoundMap::Both { lo, hi },
-            (Some(lo), None) => BoundMap::Lower { lo, s: scale(lo) },
-            (None, Some(hi)) => BoundMap::Upper { hi, s: scale(hi) },
+            (Some(lo), Some(hi)) => BoundMap::Both {
+                lo,
+                hi,
+                mid: 0.5 * lo + 0.5 * hi,
+                half: 0.5 * hi - 0.5 * lo,
+            },
+            (Some(lo), None) => {
+                let (lo, s, k) = one_sided(z0, lo, f64::MAX);
+                BoundMap::Lower { lo, s, k }
+            }
+            (None, Some(hi)) => {
+                let (hi, s, k) = one_sided(z0, hi, -f64::MAX);
+                BoundMap::Upper { hi, s, k }
+            }
         };
         Ok(Mapping {
             transform: p.transform,
@@ -492,12 +555,19 @@ impl ParameterSpace {
     }
 
     /// Maps the optimizer's vector `u` to physical values, always within the bounds (the
-    /// result is clamped to them against rounding; a `Log` value that underflows becomes
-    /// the smallest positive normal `f64`).
+    /// result is clamped to them against rounding; a `Log` value that underflows to 0
+    /// becomes the smallest positive `f64`, 5e-324).
+    ///
+    /// `to_physical(to_unconstrained(x))` gives `x` back to a few units in the last place
+    /// of the coordinate the bounds are applied in: of `ln x` under [`Transform::Log`]
+    /// (relative error below 10⁻¹³, subnormal values included), of `max(|x|, |bound|)` with
+    /// one bound, of the bounds' half-span measured from their middle with both, for every
+    /// finite `x` in the bounds (±f64::MAX included).
     ///
     /// # Errors
     /// [`IdentifyError::DimensionMismatch`]; [`IdentifyError::NonFiniteValue`] if a value
-    /// is not finite (NaN in `u`, or `exp` overflow under [`Transform::Log`]).
+    /// is not finite (NaN in `u`, `exp` overflow under [`Transform::Log`], or a `u` beyond
+    /// the one that maps to ±f64::MAX).
     pub fn to_physical(&self, u: &[f64]) -> Result<ParamValues, IdentifyError> {
         self.check_len(u.len())?;
         let mut values = Vec::with_capacity(u.len());
@@ -509,7 +579,8 @@ impl ParameterSpace {
                     value: x,
                 });
             }
-            // exp(ln b) may round past the bound b, and exp may underflow to 0: clamp.
+            // exp(ln b) may round past the bound b, and exp may underflow to 0: clamp
+            // (exp's subnormal results are kept: they are the values asked for).
             if let Some(lo) = p.lower {
                 x = x.max(lo);
             }
@@ -517,7 +588,7 @@ impl ParameterSpace {
                 x = x.min(hi);
             }
             if p.transform == Transform::Log {
-                x = x.max(f64::MIN_POSITIVE);
+                x = x.max(f64::from_bits(1));
             }
             values.push(x);
         }

@@ -34,6 +34,15 @@ pub enum ModelError {
         /// What failed.
         reason: &'static str,
     },
+    /// The mass matrix is positive definite but its inverse is not finite in the scalar
+    /// type (masses too small, e.g. below about `5.6·10⁻³⁰⁹` for `f64`).
+    #[error(
+        "the inverse of the mass matrix overflows (smallest diagonal mass {smallest_mass:e}): rescale the units"
+    )]
+    MassInverseOverflow {
+        /// The smallest diagonal entry of the mass matrix.
+        smallest_mass: f64,
+    },
     /// A matrix entry is not finite.
     #[error("matrix `{name}` has a non-finite entry at ({row}, {col})")]
     NonFiniteMatrix {
@@ -565,6 +574,22 @@ load_tuple!(A 0, B 1, C 2, D 3, E 4, F 5, G 6, H 7);
 /// run-time panic. The 1-DOF [`Oscillator`](crate::model::Oscillator) is the same model for
 /// `N = 1` with scalar arithmetic (the two give bit-identical right-hand sides, tested).
 ///
+/// # Size limit
+/// `1 ≤ N ≤ 64` ([`MAX_DOFS`](Self::MAX_DOFS)), checked at compile time like `M = 2N`.
+/// The matrices are `nalgebra` static matrices stored inline: the model holds six `N×N`
+/// blocks and a run with an implicit stepper several `2N×2N` Jacobians, all on the stack.
+/// With 64 degrees of freedom a run with [`Rosenbrock23`](crate::integrate::Rosenbrock23)
+/// fits the 2 MiB stack of a spawned thread (a test, a rayon worker); a chain of 100 masses
+/// does not, and 400 masses overflow even the 8 MiB main thread.
+/// ```compile_fail
+/// # use nonsmooth::model::Mechanical;
+/// let none = Mechanical::<f64, 0, 0>::with_masses([]); // no degrees of freedom
+/// ```
+/// ```compile_fail
+/// # use nonsmooth::model::Mechanical;
+/// let chain = Mechanical::<f64, 400, 800>::with_masses([1.0; 400]); // beyond MAX_DOFS
+/// ```
+///
 /// # Examples
 /// A primary mass on a spring, forced, with a secondary mass attached to it hitting a Hertz
 /// stop 1 mm above its rest position:
@@ -603,19 +628,43 @@ pub struct Mechanical<T: Real, const N: usize, const M: usize, El = (), Ld = ()>
     loads: Ld,
 }
 
+/// The largest number of degrees of freedom of a [`Mechanical`] system (see its size limit).
+const MAX_DOFS: usize = 64;
+
+impl<T: Real, const N: usize, const M: usize, El, Ld> Mechanical<T, N, M, El, Ld> {
+    /// The largest number of degrees of freedom `N` (64): the constructors do not compile
+    /// for larger `N`, nor for `N = 0` (see the type's size limit).
+    pub const MAX_DOFS: usize = MAX_DOFS;
+}
+
 impl<T: Real, const N: usize, const M: usize> Mechanical<T, N, M, (), ()> {
     /// A system of `N` lumped masses (diagonal mass matrix), no elements, no loads.
     ///
     /// # Errors
-    /// [`ParameterError`] unless every mass is finite and > 0.
+    /// [`ParameterError`] unless every mass is finite and > 0 with a finite inverse
+    /// (`mass ≥ 5.6·10⁻³⁰⁹` for `f64`).
     pub fn with_masses(masses: [T; N]) -> Result<Self, ParameterError> {
         const { assert!(M == 2 * N, "the state dimension M must be 2N") };
+        const {
+            assert!(
+                N >= 1 && N <= MAX_DOFS,
+                "Mechanical needs 1 ≤ N ≤ 64 degrees of freedom (its matrices are on the stack)"
+            )
+        };
         let mut mass = SMatrix::zeros();
         let mut inv_mass = SMatrix::zeros();
         for (i, &m) in masses.iter().enumerate() {
             let m = crate::validate::positive("mass", m)?;
+            let inv = T::one() / m;
+            if !inv.is_finite() {
+                return Err(ParameterError::new(
+                    "mass",
+                    to_f64(m),
+                    "large enough that 1/mass is finite",
+                ));
+            }
             mass[(i, i)] = m;
-            inv_mass[(i, i)] = T::one() / m;
+            inv_mass[(i, i)] = inv;
         }
         Ok(Self {
             mass,
@@ -631,11 +680,23 @@ impl<T: Real, const N: usize, const M: usize> Mechanical<T, N, M, (), ()> {
 
     /// A system with a full symmetric positive-definite mass matrix.
     ///
+    /// The factorization and the inverse are computed for the matrix divided by the power
+    /// of two nearest below its largest entry (exactly, so the result is that of the matrix
+    /// itself), and scaled back: a well-conditioned matrix of any magnitude is accepted as
+    /// long as its inverse is finite.
+    ///
     /// # Errors
     /// [`ModelError`] if an entry is not finite, the matrix is not symmetric (to 8 ulps of
-    /// its largest entry) or not positive definite (Cholesky fails).
+    /// its largest entry) or not positive definite (Cholesky fails), and
+    /// [`ModelError::MassInverseOverflow`] if its inverse is not finite.
     pub fn with_mass_matrix(mass: SMatrix<T, N, N>) -> Result<Self, ModelError> {
         const { assert!(M == 2 * N, "the state dimension M must be 2N") };
+        const {
+            assert!(
+                N >= 1 && N <= MAX_DOFS,
+                "Mechanical needs 1 ≤ N ≤ 64 degrees of freedom (its matrices are on the stack)"
+            )
+        };
         check_finite("mass", &mass)?;
         let scale = mass.amax();
         for i in 0..N {
@@ -649,14 +710,26 @@ impl<T: Real, const N: usize, const M: usize> Mechanical<T, N, M, (), ()> {
                 }
             }
         }
-        if mass.cholesky().is_none() {
+        // Dividing by a power of two is exact: the factorization and the inverse of the
+        // unit-scale matrix are those of `mass`, without the overflow or underflow of the
+        // products (a determinant of 10⁶⁰⁰ or 10⁻³⁴⁰) at extreme magnitudes.
+        let s = power_of_two_below(scale);
+        let unit = mass.map(|m| m / s);
+        if unit.cholesky().is_none() {
             return Err(ModelError::MassMatrix {
                 reason: "Cholesky factorization failed",
             });
         }
-        let inv_mass = mass
+        let inv_mass = unit
             .try_inverse()
-            .ok_or(ModelError::MassMatrix { reason: "singular" })?;
+            .ok_or(ModelError::MassMatrix { reason: "singular" })?
+            .map(|m| m / s);
+        if inv_mass.iter().any(|m| !m.is_finite()) {
+            let smallest = (0..N).fold(f64::INFINITY, |a, i| a.min(to_f64(mass[(i, i)])));
+            return Err(ModelError::MassInverseOverflow {
+                smallest_mass: smallest,
+            });
+        }
         let diagonal = (0..N).all(|i| (0..N).all(|j| i == j || mass[(i, j)] == T::zero()));
         Ok(Self {
             mass,
@@ -669,6 +742,17 @@ impl<T: Real, const N: usize, const M: usize> Mechanical<T, N, M, (), ()> {
             loads: (),
         })
     }
+}
+
+/// The largest power of two `≤ x` for a positive normal `x` (1 for 0, the smallest normal
+/// `f64` for smaller `x`), in `T`.
+fn power_of_two_below<T: Real>(x: T) -> T {
+    let f = to_f64(x);
+    if f == 0.0 {
+        return T::one();
+    }
+    let f = f.max(f64::MIN_POSITIVE);
+    lit(f64::from_bits(f.to_bits() & 0x7ff0_0000_0000_0000))
 }
 
 fn check_finite<T: Real, const N: usize>(

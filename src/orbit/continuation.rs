@@ -196,7 +196,9 @@ impl ContinuationSettings {
         Ok(self)
     }
 
-    /// Also locates grazing of the orbit with a contact level.
+    /// Also locates grazing of the orbit with a contact level. [`follow`] rejects a level
+    /// that is not finite and a component outside the state
+    /// ([`OrbitError::InvalidSetting`]).
     #[must_use]
     pub fn with_grazing(mut self, grazing: Grazing) -> Self {
         self.grazing = Some(grazing);
@@ -211,7 +213,8 @@ impl ContinuationSettings {
     /// following that one extremum (the one nearest in time to where the count of extrema
     /// beyond the level changed) onto the level. Extrema born beyond the level are not
     /// crossings and are not reported; a local maximum rising out of a contact (a contact
-    /// splitting in two) is not tested.
+    /// splitting in two) is not tested. [`follow`] checks the level and the component as
+    /// for [`with_grazing`](Self::with_grazing).
     #[must_use]
     pub fn with_contact_changes(mut self, grazing: Grazing) -> Self {
         self.contacts = Some(grazing);
@@ -610,7 +613,10 @@ where
             if which == GRAZE && self.grazing.is_none() {
                 continue;
             }
-            if a.tests[which].signum() == b.tests[which].signum() {
+            // A test that is not finite at either end (NaN multipliers, an extremum that
+            // could not be evaluated) has no sign change to locate.
+            let (ta, tb) = (a.tests[which], b.tests[which]);
+            if !(ta.is_finite() && tb.is_finite()) || ta.signum() == tb.signum() {
                 continue;
             }
             let at = self.locate(a, b, ds, which, settings.locate_tolerance)?;
@@ -772,8 +778,9 @@ where
 /// tolerances); see the [module docs](self).
 ///
 /// # Errors
-/// The errors of the first orbit's [`Shooting::find`]; invalid scales (wrong count). A
-/// corrector that fails down to the smallest step ends the branch
+/// The errors of the first orbit's [`Shooting::find`]; invalid scales (wrong count);
+/// [`OrbitError::InvalidSetting`] for a [`Grazing`] test whose level is not finite or whose
+/// component is not `< N`. A corrector that fails down to the smallest step ends the branch
 /// ([`BranchEnd::StepTooSmall`]) rather than failing.
 pub fn follow<S, E, const N: usize, const M: usize, B, P>(
     build: B,
@@ -789,6 +796,18 @@ where
     S: Dynamics<f64, N> + Clone,
     E: EventSet<f64, N> + Clone,
 {
+    for g in [settings.grazing, settings.contacts].into_iter().flatten() {
+        if !g.level.is_finite() {
+            return Err(invalid("the grazing level", "finite", g.level));
+        }
+        if g.component >= N {
+            return Err(invalid(
+                "the grazing component",
+                "< N (the state dimension)",
+                g.component as f64,
+            ));
+        }
+    }
     let first = build(p0)?.find(t0, period(p0), guess)?;
     let (sy, sp) = match &settings.scales {
         Some((s, sp)) => {

@@ -13,13 +13,14 @@
 //! from `record_from` on (to skip transients) and keeps at most `capacity` records (bounded
 //! memory; the count of dropped records is kept).
 //!
-//! [`detect_period`] finds the period of a recorded sequence of section points.
+//! [`detect_period`] finds the period of a recorded sequence of section points
+//! ([`try_detect_period`] rejects an invalid tolerance).
 
 mod period;
 mod samplers;
 mod surface;
 
-pub use period::{Regime, detect_period};
+pub use period::{Regime, detect_period, try_detect_period};
 pub use samplers::{
     Impact, ImpactSequence, PeriodRecord, PeriodSummary, Periodic, PhaseClock, Section,
     SectionClock, SectionPoint, Stroboscopic, Trajectory,

@@ -3,6 +3,7 @@
 use nalgebra::SVector;
 
 use crate::Real;
+use crate::error::ParameterError;
 
 /// The regime read from a sequence of section points.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -27,13 +28,30 @@ impl Regime {
 /// The smallest `p ≤ max_period` with `‖(P_{i+p} − P_i) ⊘ scale‖_∞ ≤ tol` for every
 /// recorded `i` (component-wise scaling by `scale`), or [`Regime::NotPeriodic`].
 ///
-/// Needs at least `2·p` points to accept a period `p`.
+/// Needs at least `2·p` points to accept a period `p`. A tolerance that is not finite and
+/// `≥ 0` (negative, infinite or NaN) finds no period: [`Regime::NotPeriodic`]. Use
+/// [`try_detect_period`] to have such a tolerance rejected.
 pub fn detect_period<T: Real, const N: usize>(
     points: &[SVector<T, N>],
     scale: &SVector<T, N>,
     tol: T,
     max_period: usize,
 ) -> Regime {
+    try_detect_period(points, scale, tol, max_period).unwrap_or(Regime::NotPeriodic)
+}
+
+/// [`detect_period`] with the tolerance checked first.
+///
+/// # Errors
+/// [`ParameterError`] naming `tol` unless it is finite and `≥ 0` (a negative or `−∞`
+/// tolerance would call every sequence not periodic, `+∞` every sequence period 1).
+pub fn try_detect_period<T: Real, const N: usize>(
+    points: &[SVector<T, N>],
+    scale: &SVector<T, N>,
+    tol: T,
+    max_period: usize,
+) -> Result<Regime, ParameterError> {
+    let tol = crate::validate::non_negative("tol", tol)?;
     for p in 1..=max_period {
         if points.len() < 2 * p {
             break;
@@ -49,10 +67,10 @@ pub fn detect_period<T: Real, const N: usize>(
             })
         });
         if ok {
-            return Regime::Periodic(p);
+            return Ok(Regime::Periodic(p));
         }
     }
-    Regime::NotPeriodic
+    Ok(Regime::NotPeriodic)
 }
 
 #[cfg(test)]
