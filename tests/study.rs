@@ -542,3 +542,193 @@ q = { lo = 0.1, hi = 1.0, step = 0.01 }
         "system.parameters.x_i",
     );
 }
+
+/// A small, quick map (no Lyapunov exponent, no entropy index).
+const TINY: &str = r#"
+name = "tiny"
+[system]
+model = "paper"
+[grid]
+x = { parameter = "omega", start = 18.0, end = 24.0, points = 5 }
+[periods]
+transient = 10
+record = 10
+"#;
+
+/// Runs the command-line tool with `args`, killing it after `secs` seconds (a hang fails
+/// the test instead of stalling the suite); returns its status and output.
+fn run_cli(args: &[&std::ffi::OsStr], secs: u64) -> (bool, String, String) {
+    use std::io::Read;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_nonsmooth"))
+        .args(args)
+        .env_remove("SLURM_ARRAY_TASK_ID")
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(secs);
+    let status = loop {
+        if let Some(st) = child.try_wait().unwrap() {
+            break st;
+        }
+        if std::time::Instant::now() > deadline {
+            child.kill().unwrap();
+            child.wait().unwrap();
+            panic!("nonsmooth {args:?} did not finish within {secs} s");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    };
+    let (mut out, mut err) = (String::new(), String::new());
+    child
+        .stdout
+        .take()
+        .unwrap()
+        .read_to_string(&mut out)
+        .unwrap();
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut err)
+        .unwrap();
+    (status.success(), out, err)
+}
+
+fn os(s: &str) -> &std::ffi::OsStr {
+    std::ffi::OsStr::new(s)
+}
+
+fn shard_manifests(dir: &Path) -> usize {
+    fs::read_dir(dir).map_or(0, |rd| {
+        rd.filter(|e| {
+            e.as_ref()
+                .is_ok_and(|e| e.file_name().to_string_lossy().ends_with(".json"))
+        })
+        .count()
+    })
+}
+
+/// Issue 27: `transient = 4000000000` passed `study check`, and `study run` exited 0 with
+/// every point failed on the 10⁹-section limit of a run. Work beyond a limit is an error of
+/// the spec, naming the field and the limit, in `check` and in `run` before any point runs.
+#[test]
+fn work_beyond_a_limit_is_rejected_before_any_point_runs() {
+    let limit_error = |text: &str, field: &str, limit: &str| match Study::from_toml(text) {
+        Err(StudyError::InvalidSpec { field: f, message }) => {
+            assert_eq!(f, field, "{message}");
+            assert!(message.contains(limit), "{f} {message}: no limit {limit}");
+        }
+        other => panic!("expected an error naming {field}, got {other:?}"),
+    };
+    limit_error(
+        &TINY.replace("transient = 10", "transient = 4000000000"),
+        "periods.transient",
+        "999999999",
+    );
+    limit_error(
+        &TINY
+            .replace("transient = 10", "transient = 999999990")
+            .replace(
+                "[periods]",
+                "[integration]\nmax_steps = 2000000000\n[periods]",
+            ),
+        "periods",
+        "999999999",
+    );
+    // Fewer steps than periods: steps land on every period, so every point would stop.
+    limit_error(
+        &TINY.replace("[periods]", "[integration]\nmax_steps = 19\n[periods]"),
+        "integration.max_steps",
+        "20",
+    );
+    limit_error(
+        &TINY.replace(
+            "[periods]",
+            "[record]\nlyapunov = { periods = 100000001 }\n[periods]",
+        ),
+        "record.lyapunov.periods",
+        "100000000",
+    );
+    limit_error(
+        &TINY.replace(
+            "[periods]",
+            "[record]\nq = { lo = 0.0, hi = 1.0, step = 1e-9 }\n[periods]",
+        ),
+        "record.q.step",
+        "16777216",
+    );
+    // At the limits the spec is valid.
+    let at = TINY
+        .replace("transient = 10", "transient = 999999989")
+        .replace(
+            "[periods]",
+            "[integration]\nmax_steps = 999999999\n[periods]",
+        );
+    assert!(Study::from_toml(&at).is_ok());
+
+    // The command line: `check` and `run` fail naming the field; `run` writes nothing.
+    let d = scratch("limits");
+    let spec = d.join("big.toml");
+    fs::write(
+        &spec,
+        TINY.replace("transient = 10", "transient = 4000000000"),
+    )
+    .unwrap();
+    let (ok, _, err) = run_cli(&[os("study"), os("check"), spec.as_os_str()], 60);
+    assert!(!ok && err.contains("periods.transient"), "{err}");
+    let out = d.join("out");
+    let (ok, _, err) = run_cli(
+        &[
+            os("study"),
+            os("run"),
+            spec.as_os_str(),
+            os("--out"),
+            out.as_os_str(),
+            os("--quiet"),
+        ],
+        60,
+    );
+    assert!(!ok && err.contains("periods.transient"), "{err}");
+    assert_eq!(shard_manifests(&out), 0, "no point may run");
+}
+
+/// A `study run` whose every point failed exits non-zero (the shard files are written, with
+/// the reasons in their status column); so does the merge of such a study.
+#[test]
+fn a_run_or_merge_where_every_point_failed_exits_non_zero() {
+    let d = scratch("all-failed");
+    let spec = d.join("capped.toml");
+    // 20 steps for 20 periods: valid, but every point needs more.
+    fs::write(
+        &spec,
+        TINY.replace("[periods]", "[integration]\nmax_steps = 20\n[periods]"),
+    )
+    .unwrap();
+    let out = d.join("out");
+    let (ok, _, err) = run_cli(
+        &[
+            os("study"),
+            os("run"),
+            spec.as_os_str(),
+            os("--out"),
+            out.as_os_str(),
+            os("--quiet"),
+        ],
+        120,
+    );
+    assert!(!ok, "{err}");
+    assert!(
+        err.contains("every point of shard 1/1 failed (5 of 5)"),
+        "{err}"
+    );
+    assert_eq!(shard_manifests(&out), 1, "the shard files are written");
+    let (_, recs) = read_shards(&out).unwrap();
+    assert!(recs.iter().all(|r| !r.is_ok()));
+    let (ok, _, err) = run_cli(&[os("study"), os("merge"), out.as_os_str()], 120);
+    assert!(!ok, "{err}");
+    assert!(
+        err.contains("every point of the study failed (5 of 5"),
+        "{err}"
+    );
+    assert!(out.join("merged.csv").exists());
+}

@@ -102,8 +102,8 @@ pub use merge::Merged;
 pub use plan::{PlanSettings, sbatch_script};
 pub use shard::{SHARD_FORMAT, Shard, ShardManifest, check_output_dir, read_shards, write_shard};
 pub use spec::{
-    AttractorSpec, Axis, GridSpec, InitialSpec, IntegrationSpec, LyapunovSpec, MAX_POINTS,
-    PeriodsSpec, QSpec, RecordSpec, Study, StudySpec, SystemSpec,
+    AttractorSpec, Axis, GridSpec, InitialSpec, IntegrationSpec, LyapunovSpec, MAX_PERIODS,
+    MAX_POINTS, PeriodsSpec, QSpec, RecordSpec, Study, StudySpec, SystemSpec,
 };
 
 use thiserror::Error;

@@ -147,6 +147,18 @@ pub struct ShardManifest {
     pub sections_fnv: String,
 }
 
+impl ShardManifest {
+    /// Reads a manifest file (e.g. the one [`write_shard`] returns).
+    ///
+    /// # Errors
+    /// [`StudyError::Io`] naming the file if it cannot be read; [`StudyError::Corrupt`] if
+    /// it is not a manifest.
+    pub fn read(path: &Path) -> Result<Self, StudyError> {
+        let text = fs::read_to_string(path).map_err(|e| io(path, e))?;
+        serde_json::from_str(&text).map_err(|e| corrupt(path, format!("unreadable manifest: {e}")))
+    }
+}
+
 /// A float in the shortest form that reads back to the same bits.
 pub(crate) fn fmt_f64(v: f64) -> String {
     let a = v.abs();
