@@ -732,3 +732,65 @@ fn a_run_or_merge_where_every_point_failed_exits_non_zero() {
     );
     assert!(out.join("merged.csv").exists());
 }
+
+/// Issue 27: an `x0` axis from −1e308 to 1e308 gave the axis values NaN, inf, inf (the
+/// linspace overflowed), the spec was accepted, the NaN point ran (from the rest state) and
+/// was recorded `ok`, and `study merge` hung (plotters' tick loop on a range that is not
+/// finite). The values are now −1e308, 0, 1e308, and the merge draws an axis whose range
+/// overflows over its grid index.
+#[test]
+fn an_axis_across_the_f64_range_has_finite_values_and_merges() {
+    let text = r#"
+name = "huge"
+[system]
+model = "duffing_ueda"
+[grid]
+x = { parameter = "x0", start = -1e308, end = 1e308, points = 3 }
+y = { parameter = "v0", start = -1e308, end = 1e308, points = 3 }
+[periods]
+transient = 20
+record = 10
+"#;
+    let study = Study::from_toml(text).unwrap();
+    let xs: Vec<f64> = (0..3).map(|i| study.values(i).0).collect();
+    assert_eq!(xs, [-1e308, 0.0, 1e308]);
+    for i in 0..study.points() {
+        let (x, y) = study.values(i);
+        assert!(x.is_finite() && y.is_finite(), "point {i}: {x}, {y}");
+    }
+    let d = scratch("huge-axis");
+    let spec = d.join("huge.toml");
+    fs::write(&spec, text).unwrap();
+    let out = d.join("out");
+    let (ok, _, err) = run_cli(
+        &[
+            os("study"),
+            os("run"),
+            spec.as_os_str(),
+            os("--out"),
+            out.as_os_str(),
+            os("--quiet"),
+        ],
+        120,
+    );
+    assert!(ok, "{err}");
+    let (_, recs) = read_shards(&out).unwrap();
+    // The origin runs; a start at x0 = ±1e308 does not (its force overflows).
+    assert!(recs[4].is_ok(), "{}", recs[4].status);
+    for i in [0, 2, 3, 5, 6, 8] {
+        assert!(!recs[i].is_ok(), "point {i}");
+    }
+    let (ok, _, err) = run_cli(&[os("study"), os("merge"), out.as_os_str()], 120);
+    assert!(ok, "{err}");
+    let table = fs::read_to_string(out.join("merged.csv")).unwrap();
+    for line in table.lines().skip(1) {
+        let xy: Vec<f64> = line
+            .split(',')
+            .skip(3)
+            .take(2)
+            .map(|v| v.parse().unwrap())
+            .collect();
+        assert!(xy.iter().all(|v| v.is_finite()), "{line}");
+    }
+    assert!(out.join("merged.png").exists());
+}

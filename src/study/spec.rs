@@ -112,12 +112,20 @@ pub struct Axis {
 }
 
 impl Axis {
-    /// The `k`-th value.
+    /// The `k`-th value (finite for finite `start` and `end`).
     pub fn value(&self, k: usize) -> f64 {
         if self.points <= 1 {
-            self.start
+            return self.start;
+        }
+        let s = k as f64 / (self.points - 1) as f64;
+        let span = self.end - self.start;
+        if span.is_finite() {
+            // The form of every existing study: its values stay the same bits.
+            self.start + span * s
         } else {
-            self.start + (self.end - self.start) * (k as f64 / (self.points - 1) as f64)
+            // `start < 0 < end` here: two terms of opposite sign, each at most the larger
+            // of |start|, |end|, cannot overflow.
+            self.start * (1.0 - s) + self.end * s
         }
     }
 
@@ -530,6 +538,16 @@ impl StudySpec {
         for (field, a) in &axes {
             for k in 0..a.points {
                 let v = a.value(k);
+                if !v.is_finite() {
+                    return Err(invalid(
+                        field.to_string(),
+                        format!(
+                            "value {k} of {} ({} from {} to {} in {} points) is {v}: every \
+                             axis value must be finite",
+                            a.parameter, a.parameter, a.start, a.end, a.points
+                        ),
+                    ));
+                }
                 let mut p = set.clone();
                 let mut y0 = self.initial.state;
                 for (_, b) in &axes {
@@ -712,6 +730,26 @@ mod tests {
         assert_eq!(a.value(0), 17.5);
         assert_eq!(a.value(60), 25.0);
         assert_eq!(a.value(30), 21.25);
+    }
+
+    #[test]
+    fn an_axis_across_the_f64_range_has_finite_values() {
+        let a = Axis {
+            parameter: "x0".into(),
+            start: -1e308,
+            end: 1e308,
+            points: 3,
+        };
+        assert_eq!([a.value(0), a.value(1), a.value(2)], [-1e308, 0.0, 1e308]);
+        let b = Axis {
+            parameter: "x0".into(),
+            start: -f64::MAX,
+            end: f64::MAX,
+            points: 7,
+        };
+        assert!((0..7).all(|k| b.value(k).is_finite()));
+        assert!((0..6).all(|k| b.value(k) < b.value(k + 1)));
+        assert_eq!((b.value(0), b.value(6)), (-f64::MAX, f64::MAX));
     }
 
     #[test]
