@@ -794,3 +794,44 @@ record = 10
     }
     assert!(out.join("merged.png").exists());
 }
+
+/// Issue 27: a manifest that claims one point more than its shard has gave "5 points,
+/// shard 1/3 of 15 points has 5". Each count is now checked on its own, and the message
+/// says which is claimed and which was found.
+#[test]
+fn a_manifest_with_a_wrong_count_says_which() {
+    let study = Study::from_toml(TINY).unwrap();
+    let d = scratch("claims");
+    run_in_shards(&study, &d, 2);
+    let j = d.join("shard-00001-of-00002.json");
+    let orig = fs::read_to_string(&j).unwrap();
+    let tamper = |key: &str, delta: i64| {
+        let mut v: serde_json::Value = serde_json::from_str(&orig).unwrap();
+        let n = v[key].as_i64().unwrap();
+        v[key] = (n + delta).into();
+        fs::write(&j, serde_json::to_string_pretty(&v).unwrap()).unwrap();
+        match Merged::from_dir(&d) {
+            Err(StudyError::Corrupt(m)) => m,
+            other => panic!("{key}: {other:?}"),
+        }
+    };
+    // Shard 1 of 2 of 5 points holds points 0, 2, 4.
+    let m = tamper("points", 1);
+    assert!(
+        m.contains("the manifest claims 4 points, shard 1/2 of a study of 5 points has 3"),
+        "{m}"
+    );
+    let m = tamper("total_points", 1);
+    assert!(
+        m.contains("the manifest claims a study of 6 points, its spec has 5"),
+        "{m}"
+    );
+    let m = tamper("failed_points", 2);
+    assert!(
+        m.contains("the manifest claims 2 failed points, its points file"),
+        "{m}"
+    );
+    assert!(m.ends_with("holds 0"), "{m}");
+    fs::write(&j, &orig).unwrap();
+    assert!(Merged::from_dir(&d).is_ok());
+}

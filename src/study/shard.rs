@@ -572,15 +572,48 @@ pub fn read_shards(dir: &Path) -> Result<(Study, Vec<PointRecord>), StudyError> 
     let mut slots: Vec<Option<PointRecord>> = vec![None; total];
     for (i, (p, m)) in &by_index {
         let shard = Shard::new(*i, n)?;
-        let recs = read_shard(dir, m, p)?;
         let expected: Vec<usize> = shard_indices(total, shard).collect();
-        if recs.len() != expected.len() || recs.len() != m.points {
+        // The manifest's counts against the spec, then the points file against both: each
+        // message says which count is claimed and which was found.
+        if m.total_points != total {
             return Err(corrupt(
                 p,
                 format!(
-                    "{} points, shard {shard} of {total} points has {}",
-                    recs.len(),
+                    "the manifest claims a study of {} points, its spec has {total}",
+                    m.total_points
+                ),
+            ));
+        }
+        if m.points != expected.len() {
+            return Err(corrupt(
+                p,
+                format!(
+                    "the manifest claims {} points, shard {shard} of a study of {total} points \
+                     has {}",
+                    m.points,
                     expected.len()
+                ),
+            ));
+        }
+        let recs = read_shard(dir, m, p)?;
+        if recs.len() != m.points {
+            return Err(corrupt(
+                p,
+                format!(
+                    "the manifest claims {} points, its points file {} holds {}",
+                    m.points,
+                    m.points_file,
+                    recs.len()
+                ),
+            ));
+        }
+        let failed = recs.iter().filter(|r| !r.is_ok()).count();
+        if failed != m.failed_points {
+            return Err(corrupt(
+                p,
+                format!(
+                    "the manifest claims {} failed points, its points file {} holds {failed}",
+                    m.failed_points, m.points_file
                 ),
             ));
         }
