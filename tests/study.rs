@@ -835,3 +835,171 @@ fn a_manifest_with_a_wrong_count_says_which() {
     fs::write(&j, &orig).unwrap();
     assert!(Merged::from_dir(&d).is_ok());
 }
+
+/// Issue 27 (security): `study plan --partition` was copied into the sbatch script
+/// unchecked, so a newline put a command on its own line. Every value written into the
+/// script is checked: `#SBATCH` values must be plain tokens, the shell's words are
+/// single-quoted and hold no control characters. Each hostile value is rejected, or the
+/// script — run by bash with `exec` replaced by a function that records its arguments —
+/// executes nothing of it and passes it through unchanged.
+#[test]
+fn plan_rejects_or_quotes_every_hostile_value() {
+    let study = Study::from_toml(MAP).unwrap();
+    let d = scratch("plan-hostile");
+    let pwned = d.join("pwned");
+    let p = pwned.display().to_string();
+    let payloads = [
+        format!("x\ntouch {p}"),
+        format!("x\r\ntouch {p}"),
+        format!("x'; touch {p}; '"),
+        format!("x\"; touch {p}; \""),
+        format!("$(touch {p})"),
+        format!("`touch {p}`"),
+        format!("x; touch {p}"),
+        format!("x && touch {p} #"),
+        format!("${{IFS}}touch${{IFS}}{p}"),
+    ];
+    let base = || PlanSettings::new(3, "/data/out", "/opt/nonsmooth");
+    let spec_path = PathBuf::from("/data/map.toml");
+    // The values of `#SBATCH` lines: every payload is rejected, naming the setting.
+    for v in &payloads {
+        for (field, settings) in [
+            ("--partition", base().partition(Some(v.clone()))),
+            ("--time", base().time(v.clone())),
+            ("--out", PlanSettings::new(3, v.clone(), "/opt/nonsmooth")),
+        ] {
+            match sbatch_script(&study, &spec_path, &settings) {
+                Err(e) => assert!(e.to_string().contains(field), "{field}: {e}"),
+                Ok(s) => panic!("{field} = {v:?} accepted:\n{s}"),
+            }
+        }
+    }
+    for bad in ["gpu normal", "gpu%x", "", "a/b"] {
+        assert!(
+            sbatch_script(&study, &spec_path, &base().partition(Some(bad.into()))).is_err(),
+            "{bad:?}"
+        );
+    }
+    assert!(
+        sbatch_script(
+            &study,
+            &spec_path,
+            &base().partition(Some("gpu,long-1.x_2".into()))
+        )
+        .is_ok()
+    );
+    // The study's name (the job name) is checked by the spec.
+    for v in &payloads {
+        let text = MAP.replace("name = \"map\"", &format!("name = {v:?}"));
+        assert!(Study::from_toml(&text).is_err(), "name {v:?}");
+    }
+    // The program and spec paths are shell words: control characters and a leading '-'
+    // are rejected, everything else is quoted and reaches the program unchanged.
+    let script_file = d.join("job.sh");
+    let args_file = d.join("args");
+    for v in &payloads {
+        for field in ["program", "spec path"] {
+            let (settings, spec) = if field == "program" {
+                (
+                    PlanSettings::new(3, "/data/out", v.clone()),
+                    spec_path.clone(),
+                )
+            } else {
+                (base(), PathBuf::from(v))
+            };
+            let script = match sbatch_script(&study, &spec, &settings) {
+                Err(e) => {
+                    assert!(v.contains(['\n', '\r']), "{field} = {v:?}: {e}");
+                    assert!(e.to_string().contains(field), "{e}");
+                    continue;
+                }
+                Ok(s) => s,
+            };
+            // Only two lines execute: `set` and the `exec` of the program.
+            let code: Vec<&str> = script
+                .lines()
+                .filter(|l| !l.starts_with('#') && !l.trim().is_empty())
+                .collect();
+            assert_eq!(code.len(), 2, "{script}");
+            assert_eq!(code[0], "set -euo pipefail");
+            assert!(code[1].starts_with("exec '"), "{script}");
+            for l in script.lines().filter(|l| l.starts_with("#SBATCH")) {
+                let value = l.strip_prefix("#SBATCH ").unwrap();
+                assert!(
+                    value
+                        .chars()
+                        .all(|c| c.is_ascii_alphanumeric() || "-=_.,/+@%:".contains(c)),
+                    "{l}"
+                );
+            }
+            fs::write(
+                &script_file,
+                format!(
+                    "exec() {{ printf '%s\\0' \"$@\" > '{}'; }}\nsource '{}'\n",
+                    args_file.display(),
+                    script_file.with_extension("body").display()
+                ),
+            )
+            .unwrap();
+            fs::write(script_file.with_extension("body"), &script).unwrap();
+            let _ = fs::remove_file(&args_file);
+            let st = Command::new("bash")
+                .arg(&script_file)
+                .env("SLURM_ARRAY_TASK_ID", "2")
+                .env_remove("SLURM_CPUS_PER_TASK")
+                .status()
+                .unwrap();
+            assert!(st.success(), "{field} = {v:?}:\n{script}");
+            assert!(!pwned.exists(), "{field} = {v:?} executed:\n{script}");
+            let args = fs::read(&args_file).unwrap();
+            let args: Vec<String> = args
+                .split(|&b| b == 0)
+                .filter(|a| !a.is_empty())
+                .map(|a| String::from_utf8(a.to_vec()).unwrap())
+                .collect();
+            let (prog, spec) = if field == "program" {
+                (v.as_str(), "/data/map.toml")
+            } else {
+                ("/opt/nonsmooth", v.as_str())
+            };
+            assert_eq!(
+                args,
+                [
+                    prog,
+                    "study",
+                    "run",
+                    spec,
+                    "--out",
+                    "/data/out",
+                    "--shard",
+                    "2/3",
+                    "--threads",
+                    "1",
+                    "--quiet"
+                ],
+                "{field} = {v:?}"
+            );
+        }
+    }
+    assert!(sbatch_script(&study, &spec_path, &PlanSettings::new(3, "/data/out", "-x")).is_err());
+    // The command line refuses a hostile partition and prints no script.
+    let spec = d.join("map.toml");
+    fs::write(&spec, MAP).unwrap();
+    let (ok, out, err) = run_cli(
+        &[
+            os("study"),
+            os("plan"),
+            spec.as_os_str(),
+            os("--shards"),
+            os("3"),
+            os("--out"),
+            d.join("planned").as_os_str(),
+            os("--partition"),
+            os(&payloads[0]),
+        ],
+        60,
+    );
+    assert!(!ok && out.is_empty(), "{out}");
+    assert!(err.contains("--partition"), "{err}");
+    assert!(!pwned.exists());
+}

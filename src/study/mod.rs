@@ -124,6 +124,15 @@ pub enum StudyError {
         /// What is wrong.
         message: String,
     },
+    /// A setting of the sbatch script (`study plan`) is invalid: a value that is not a plain
+    /// Slurm token, or a path that cannot be written into the script safely.
+    #[error("study plan: `{field}` {message}")]
+    InvalidPlan {
+        /// The setting, e.g. `--partition`.
+        field: String,
+        /// What is wrong.
+        message: String,
+    },
     /// A shard out of range or unreadable.
     #[error("shard: {0}")]
     Shard(String),
