@@ -630,3 +630,87 @@ fn invalid_input_is_an_error() {
     let out = capped.run::<F64x4, _>(&short, &mut obs).unwrap();
     assert!(out[0].is_ok() && out[1].is_err(), "{out:?}");
 }
+
+/// Runs `f` on its own thread and waits at most `secs` seconds for it (a hang fails the
+/// test instead of stalling the suite).
+fn within<T: Send + 'static>(secs: u64, f: impl FnOnce() -> T + Send + 'static) -> T {
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let _ = tx.send(f());
+    });
+    rx.recv_timeout(std::time::Duration::from_secs(secs))
+        .expect("the ensemble did not finish in time")
+}
+
+/// The ensemble's results with `Record` observers: per trajectory its summary or the error
+/// message.
+fn run_records(jobs: Vec<Trajectory>) -> Vec<Result<Summary, String>> {
+    within(120, move || {
+        let mut recs: Vec<Record> = jobs
+            .iter()
+            .map(|j| Record::new(j.member.period()))
+            .collect();
+        let ens = Ensemble::new(tol(1e-8))
+            .unwrap()
+            .with_event(impact())
+            .unwrap();
+        let out = ens.run::<F64x8, _>(&jobs, &mut recs).unwrap();
+        recs.into_iter()
+            .zip(out)
+            .map(|(r, o)| {
+                o.map(|o| (r.sections(), r.events.clone(), o.stats, o.y))
+                    .map_err(|e| e.to_string())
+            })
+            .collect()
+    })
+}
+
+/// Issue 27: one trajectory among 64 with a landing grid `dt = −1` (set through the public
+/// field) hung the whole batch. Invalid trajectories — wherever they are in the batch,
+/// the first included — are now errors in their own result slots; every other trajectory
+/// completes, bit for bit as without them.
+#[test]
+fn an_invalid_trajectory_fails_alone() {
+    let omegas: Vec<f64> = (0..64).map(|i| 17.5 + 0.1 * i as f64).collect();
+    let good = paper_jobs(&omegas, 3.0);
+    let base = run_records(good.clone());
+    assert!(base.iter().all(Result::is_ok));
+    let nan = f64::NAN;
+    let cases: [&[(usize, (f64, f64))]; 2] = [
+        &[(37, (0.0, -1.0))],
+        &[
+            (0, (0.0, -1.0)),
+            (20, (0.0, 0.0)),
+            (41, (nan, 0.1)),
+            (63, (0.0, f64::INFINITY)),
+        ],
+    ];
+    for bad in cases {
+        let mut jobs = good.clone();
+        for &(k, grid) in bad {
+            jobs[k].grid = Some(grid);
+        }
+        let got = run_records(jobs);
+        for (k, (g, b)) in got.iter().zip(&base).enumerate() {
+            if bad.iter().any(|&(j, _)| j == k) {
+                let e = g.as_ref().expect_err("an invalid grid is an error");
+                assert!(e.contains("grid"), "trajectory {k}: {e}");
+            } else {
+                assert_eq!(g, b, "trajectory {k} with {bad:?}");
+            }
+        }
+    }
+    // A bad time span or state through the public fields fails alone too.
+    let mut jobs = good.clone();
+    jobs[0].t0 = nan;
+    jobs[5].y0 = Vector2::new(f64::INFINITY, 0.0);
+    jobs[6].t_end = -1.0;
+    let got = run_records(jobs);
+    for (k, (g, b)) in got.iter().zip(&base).enumerate() {
+        if [0, 5, 6].contains(&k) {
+            assert!(g.is_err(), "trajectory {k}");
+        } else {
+            assert_eq!(g, b, "trajectory {k}");
+        }
+    }
+}

@@ -542,3 +542,464 @@ q = { lo = 0.1, hi = 1.0, step = 0.01 }
         "system.parameters.x_i",
     );
 }
+
+/// A small, quick map (no Lyapunov exponent, no entropy index).
+const TINY: &str = r#"
+name = "tiny"
+[system]
+model = "paper"
+[grid]
+x = { parameter = "omega", start = 18.0, end = 24.0, points = 5 }
+[periods]
+transient = 10
+record = 10
+"#;
+
+/// Runs the command-line tool with `args`, killing it after `secs` seconds (a hang fails
+/// the test instead of stalling the suite); returns its status and output.
+fn run_cli(args: &[&std::ffi::OsStr], secs: u64) -> (bool, String, String) {
+    use std::io::Read;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_nonsmooth"))
+        .args(args)
+        .env_remove("SLURM_ARRAY_TASK_ID")
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(secs);
+    let status = loop {
+        if let Some(st) = child.try_wait().unwrap() {
+            break st;
+        }
+        if std::time::Instant::now() > deadline {
+            child.kill().unwrap();
+            child.wait().unwrap();
+            panic!("nonsmooth {args:?} did not finish within {secs} s");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    };
+    let (mut out, mut err) = (String::new(), String::new());
+    child
+        .stdout
+        .take()
+        .unwrap()
+        .read_to_string(&mut out)
+        .unwrap();
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut err)
+        .unwrap();
+    (status.success(), out, err)
+}
+
+fn os(s: &str) -> &std::ffi::OsStr {
+    std::ffi::OsStr::new(s)
+}
+
+fn shard_manifests(dir: &Path) -> usize {
+    fs::read_dir(dir).map_or(0, |rd| {
+        rd.filter(|e| {
+            e.as_ref()
+                .is_ok_and(|e| e.file_name().to_string_lossy().ends_with(".json"))
+        })
+        .count()
+    })
+}
+
+/// Issue 27: `transient = 4000000000` passed `study check`, and `study run` exited 0 with
+/// every point failed on the 10⁹-section limit of a run. Work beyond a limit is an error of
+/// the spec, naming the field and the limit, in `check` and in `run` before any point runs.
+#[test]
+fn work_beyond_a_limit_is_rejected_before_any_point_runs() {
+    let limit_error = |text: &str, field: &str, limit: &str| match Study::from_toml(text) {
+        Err(StudyError::InvalidSpec { field: f, message }) => {
+            assert_eq!(f, field, "{message}");
+            assert!(message.contains(limit), "{f} {message}: no limit {limit}");
+        }
+        other => panic!("expected an error naming {field}, got {other:?}"),
+    };
+    limit_error(
+        &TINY.replace("transient = 10", "transient = 4000000000"),
+        "periods.transient",
+        "999999999",
+    );
+    limit_error(
+        &TINY
+            .replace("transient = 10", "transient = 999999990")
+            .replace(
+                "[periods]",
+                "[integration]\nmax_steps = 2000000000\n[periods]",
+            ),
+        "periods",
+        "999999999",
+    );
+    // Fewer steps than periods: steps land on every period, so every point would stop.
+    limit_error(
+        &TINY.replace("[periods]", "[integration]\nmax_steps = 19\n[periods]"),
+        "integration.max_steps",
+        "20",
+    );
+    limit_error(
+        &TINY.replace(
+            "[periods]",
+            "[record]\nlyapunov = { periods = 100000001 }\n[periods]",
+        ),
+        "record.lyapunov.periods",
+        "100000000",
+    );
+    limit_error(
+        &TINY.replace(
+            "[periods]",
+            "[record]\nq = { lo = 0.0, hi = 1.0, step = 1e-9 }\n[periods]",
+        ),
+        "record.q.step",
+        "16777216",
+    );
+    // At the limits the spec is valid.
+    let at = TINY
+        .replace("transient = 10", "transient = 999999989")
+        .replace(
+            "[periods]",
+            "[integration]\nmax_steps = 999999999\n[periods]",
+        );
+    assert!(Study::from_toml(&at).is_ok());
+
+    // The command line: `check` and `run` fail naming the field; `run` writes nothing.
+    let d = scratch("limits");
+    let spec = d.join("big.toml");
+    fs::write(
+        &spec,
+        TINY.replace("transient = 10", "transient = 4000000000"),
+    )
+    .unwrap();
+    let (ok, _, err) = run_cli(&[os("study"), os("check"), spec.as_os_str()], 60);
+    assert!(!ok && err.contains("periods.transient"), "{err}");
+    let out = d.join("out");
+    let (ok, _, err) = run_cli(
+        &[
+            os("study"),
+            os("run"),
+            spec.as_os_str(),
+            os("--out"),
+            out.as_os_str(),
+            os("--quiet"),
+        ],
+        60,
+    );
+    assert!(!ok && err.contains("periods.transient"), "{err}");
+    assert_eq!(shard_manifests(&out), 0, "no point may run");
+}
+
+/// A `study run` whose every point failed exits non-zero (the shard files are written, with
+/// the reasons in their status column); so does the merge of such a study.
+#[test]
+fn a_run_or_merge_where_every_point_failed_exits_non_zero() {
+    let d = scratch("all-failed");
+    let spec = d.join("capped.toml");
+    // 20 steps for 20 periods: valid, but every point needs more.
+    fs::write(
+        &spec,
+        TINY.replace("[periods]", "[integration]\nmax_steps = 20\n[periods]"),
+    )
+    .unwrap();
+    let out = d.join("out");
+    let (ok, _, err) = run_cli(
+        &[
+            os("study"),
+            os("run"),
+            spec.as_os_str(),
+            os("--out"),
+            out.as_os_str(),
+            os("--quiet"),
+        ],
+        120,
+    );
+    assert!(!ok, "{err}");
+    assert!(
+        err.contains("every point of shard 1/1 failed (5 of 5)"),
+        "{err}"
+    );
+    assert_eq!(shard_manifests(&out), 1, "the shard files are written");
+    let (_, recs) = read_shards(&out).unwrap();
+    assert!(recs.iter().all(|r| !r.is_ok()));
+    let (ok, _, err) = run_cli(&[os("study"), os("merge"), out.as_os_str()], 120);
+    assert!(!ok, "{err}");
+    assert!(
+        err.contains("every point of the study failed (5 of 5"),
+        "{err}"
+    );
+    assert!(out.join("merged.csv").exists());
+}
+
+/// Issue 27: an `x0` axis from −1e308 to 1e308 gave the axis values NaN, inf, inf (the
+/// linspace overflowed), the spec was accepted, the NaN point ran (from the rest state) and
+/// was recorded `ok`, and `study merge` hung (plotters' tick loop on a range that is not
+/// finite). The values are now −1e308, 0, 1e308, and the merge draws an axis whose range
+/// overflows over its grid index.
+#[test]
+fn an_axis_across_the_f64_range_has_finite_values_and_merges() {
+    let text = r#"
+name = "huge"
+[system]
+model = "duffing_ueda"
+[grid]
+x = { parameter = "x0", start = -1e308, end = 1e308, points = 3 }
+y = { parameter = "v0", start = -1e308, end = 1e308, points = 3 }
+[periods]
+transient = 20
+record = 10
+"#;
+    let study = Study::from_toml(text).unwrap();
+    let xs: Vec<f64> = (0..3).map(|i| study.values(i).0).collect();
+    assert_eq!(xs, [-1e308, 0.0, 1e308]);
+    for i in 0..study.points() {
+        let (x, y) = study.values(i);
+        assert!(x.is_finite() && y.is_finite(), "point {i}: {x}, {y}");
+    }
+    let d = scratch("huge-axis");
+    let spec = d.join("huge.toml");
+    fs::write(&spec, text).unwrap();
+    let out = d.join("out");
+    let (ok, _, err) = run_cli(
+        &[
+            os("study"),
+            os("run"),
+            spec.as_os_str(),
+            os("--out"),
+            out.as_os_str(),
+            os("--quiet"),
+        ],
+        120,
+    );
+    assert!(ok, "{err}");
+    let (_, recs) = read_shards(&out).unwrap();
+    // The origin runs; a start at x0 = ±1e308 does not (its force overflows).
+    assert!(recs[4].is_ok(), "{}", recs[4].status);
+    for i in [0, 2, 3, 5, 6, 8] {
+        assert!(!recs[i].is_ok(), "point {i}");
+    }
+    let (ok, _, err) = run_cli(&[os("study"), os("merge"), out.as_os_str()], 120);
+    assert!(ok, "{err}");
+    let table = fs::read_to_string(out.join("merged.csv")).unwrap();
+    for line in table.lines().skip(1) {
+        let xy: Vec<f64> = line
+            .split(',')
+            .skip(3)
+            .take(2)
+            .map(|v| v.parse().unwrap())
+            .collect();
+        assert!(xy.iter().all(|v| v.is_finite()), "{line}");
+    }
+    assert!(out.join("merged.png").exists());
+}
+
+/// Issue 27: a manifest that claims one point more than its shard has gave "5 points,
+/// shard 1/3 of 15 points has 5". Each count is now checked on its own, and the message
+/// says which is claimed and which was found.
+#[test]
+fn a_manifest_with_a_wrong_count_says_which() {
+    let study = Study::from_toml(TINY).unwrap();
+    let d = scratch("claims");
+    run_in_shards(&study, &d, 2);
+    let j = d.join("shard-00001-of-00002.json");
+    let orig = fs::read_to_string(&j).unwrap();
+    let tamper = |key: &str, delta: i64| {
+        let mut v: serde_json::Value = serde_json::from_str(&orig).unwrap();
+        let n = v[key].as_i64().unwrap();
+        v[key] = (n + delta).into();
+        fs::write(&j, serde_json::to_string_pretty(&v).unwrap()).unwrap();
+        match Merged::from_dir(&d) {
+            Err(StudyError::Corrupt(m)) => m,
+            other => panic!("{key}: {other:?}"),
+        }
+    };
+    // Shard 1 of 2 of 5 points holds points 0, 2, 4.
+    let m = tamper("points", 1);
+    assert!(
+        m.contains("the manifest claims 4 points, shard 1/2 of a study of 5 points has 3"),
+        "{m}"
+    );
+    let m = tamper("total_points", 1);
+    assert!(
+        m.contains("the manifest claims a study of 6 points, its spec has 5"),
+        "{m}"
+    );
+    let m = tamper("failed_points", 2);
+    assert!(
+        m.contains("the manifest claims 2 failed points, its points file"),
+        "{m}"
+    );
+    assert!(m.ends_with("holds 0"), "{m}");
+    fs::write(&j, &orig).unwrap();
+    assert!(Merged::from_dir(&d).is_ok());
+}
+
+/// Issue 27 (security): `study plan --partition` was copied into the sbatch script
+/// unchecked, so a newline put a command on its own line. Every value written into the
+/// script is checked: `#SBATCH` values must be plain tokens, the shell's words are
+/// single-quoted and hold no control characters. Each hostile value is rejected, or the
+/// script — run by bash with `exec` replaced by a function that records its arguments —
+/// executes nothing of it and passes it through unchanged.
+#[test]
+fn plan_rejects_or_quotes_every_hostile_value() {
+    let study = Study::from_toml(MAP).unwrap();
+    let d = scratch("plan-hostile");
+    let pwned = d.join("pwned");
+    let p = pwned.display().to_string();
+    let payloads = [
+        format!("x\ntouch {p}"),
+        format!("x\r\ntouch {p}"),
+        format!("x'; touch {p}; '"),
+        format!("x\"; touch {p}; \""),
+        format!("$(touch {p})"),
+        format!("`touch {p}`"),
+        format!("x; touch {p}"),
+        format!("x && touch {p} #"),
+        format!("${{IFS}}touch${{IFS}}{p}"),
+    ];
+    let base = || PlanSettings::new(3, "/data/out", "/opt/nonsmooth");
+    let spec_path = PathBuf::from("/data/map.toml");
+    // The values of `#SBATCH` lines: every payload is rejected, naming the setting.
+    for v in &payloads {
+        for (field, settings) in [
+            ("--partition", base().partition(Some(v.clone()))),
+            ("--time", base().time(v.clone())),
+            ("--out", PlanSettings::new(3, v.clone(), "/opt/nonsmooth")),
+        ] {
+            match sbatch_script(&study, &spec_path, &settings) {
+                Err(e) => assert!(e.to_string().contains(field), "{field}: {e}"),
+                Ok(s) => panic!("{field} = {v:?} accepted:\n{s}"),
+            }
+        }
+    }
+    for bad in ["gpu normal", "gpu%x", "", "a/b"] {
+        assert!(
+            sbatch_script(&study, &spec_path, &base().partition(Some(bad.into()))).is_err(),
+            "{bad:?}"
+        );
+    }
+    assert!(
+        sbatch_script(
+            &study,
+            &spec_path,
+            &base().partition(Some("gpu,long-1.x_2".into()))
+        )
+        .is_ok()
+    );
+    // The study's name (the job name) is checked by the spec.
+    for v in &payloads {
+        let text = MAP.replace("name = \"map\"", &format!("name = {v:?}"));
+        assert!(Study::from_toml(&text).is_err(), "name {v:?}");
+    }
+    // The program and spec paths are shell words: control characters and a leading '-'
+    // are rejected, everything else is quoted and reaches the program unchanged.
+    let script_file = d.join("job.sh");
+    let args_file = d.join("args");
+    for v in &payloads {
+        for field in ["program", "spec path"] {
+            let (settings, spec) = if field == "program" {
+                (
+                    PlanSettings::new(3, "/data/out", v.clone()),
+                    spec_path.clone(),
+                )
+            } else {
+                (base(), PathBuf::from(v))
+            };
+            let script = match sbatch_script(&study, &spec, &settings) {
+                Err(e) => {
+                    assert!(v.contains(['\n', '\r']), "{field} = {v:?}: {e}");
+                    assert!(e.to_string().contains(field), "{e}");
+                    continue;
+                }
+                Ok(s) => s,
+            };
+            // Only two lines execute: `set` and the `exec` of the program.
+            let code: Vec<&str> = script
+                .lines()
+                .filter(|l| !l.starts_with('#') && !l.trim().is_empty())
+                .collect();
+            assert_eq!(code.len(), 2, "{script}");
+            assert_eq!(code[0], "set -euo pipefail");
+            assert!(code[1].starts_with("exec '"), "{script}");
+            for l in script.lines().filter(|l| l.starts_with("#SBATCH")) {
+                let value = l.strip_prefix("#SBATCH ").unwrap();
+                assert!(
+                    value
+                        .chars()
+                        .all(|c| c.is_ascii_alphanumeric() || "-=_.,/+@%:".contains(c)),
+                    "{l}"
+                );
+            }
+            fs::write(
+                &script_file,
+                format!(
+                    "exec() {{ printf '%s\\0' \"$@\" > '{}'; }}\nsource '{}'\n",
+                    args_file.display(),
+                    script_file.with_extension("body").display()
+                ),
+            )
+            .unwrap();
+            fs::write(script_file.with_extension("body"), &script).unwrap();
+            let _ = fs::remove_file(&args_file);
+            let st = Command::new("bash")
+                .arg(&script_file)
+                .env("SLURM_ARRAY_TASK_ID", "2")
+                .env_remove("SLURM_CPUS_PER_TASK")
+                .status()
+                .unwrap();
+            assert!(st.success(), "{field} = {v:?}:\n{script}");
+            assert!(!pwned.exists(), "{field} = {v:?} executed:\n{script}");
+            let args = fs::read(&args_file).unwrap();
+            let args: Vec<String> = args
+                .split(|&b| b == 0)
+                .filter(|a| !a.is_empty())
+                .map(|a| String::from_utf8(a.to_vec()).unwrap())
+                .collect();
+            let (prog, spec) = if field == "program" {
+                (v.as_str(), "/data/map.toml")
+            } else {
+                ("/opt/nonsmooth", v.as_str())
+            };
+            assert_eq!(
+                args,
+                [
+                    prog,
+                    "study",
+                    "run",
+                    spec,
+                    "--out",
+                    "/data/out",
+                    "--shard",
+                    "2/3",
+                    "--threads",
+                    "1",
+                    "--quiet"
+                ],
+                "{field} = {v:?}"
+            );
+        }
+    }
+    assert!(sbatch_script(&study, &spec_path, &PlanSettings::new(3, "/data/out", "-x")).is_err());
+    // The command line refuses a hostile partition and prints no script.
+    let spec = d.join("map.toml");
+    fs::write(&spec, MAP).unwrap();
+    let (ok, out, err) = run_cli(
+        &[
+            os("study"),
+            os("plan"),
+            spec.as_os_str(),
+            os("--shards"),
+            os("3"),
+            os("--out"),
+            d.join("planned").as_os_str(),
+            os("--partition"),
+            os(&payloads[0]),
+        ],
+        60,
+    );
+    assert!(!ok && out.is_empty(), "{out}");
+    assert!(err.contains("--partition"), "{err}");
+    assert!(!pwned.exists());
+}

@@ -9,12 +9,18 @@
 //!
 //! `run` without `--shard` runs the whole study (shard 1/1) unless it runs inside a Slurm
 //! array task, where it takes its shard from `SLURM_ARRAY_TASK_*`.
+//!
+//! Exit status: 0 on success; 1 for an error, and also when every point of the shard
+//! (`run`) or of the study (`merge`) failed — the files are written all the same, and
+//! their `status` column says why. Some failed points among others are a warning only.
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
-use nonsmooth::study::{Merged, PlanSettings, Shard, Study, run_to_dir, sbatch_script};
+use nonsmooth::study::{
+    Merged, PlanSettings, Shard, ShardManifest, Study, run_to_dir, sbatch_script,
+};
 
 const USAGE: &str = "\
 usage:
@@ -24,6 +30,8 @@ usage:
   nonsmooth study merge DIR [--out FILE]
       Checks that every shard of one study is in DIR and writes the merged table FILE
       (default DIR/merged.csv) with FILE's stem + .sections.csv, .attractors.csv, .png.
+  run and merge exit non-zero when every point failed (the files are still written: their
+  status column says why); some failed points are a warning.
   nonsmooth study plan SPEC --shards N [--out DIR] [--cpus C] [--time HH:MM:SS] [--partition P]
       Prints an sbatch script running the study as a job array of N tasks.
   nonsmooth study check SPEC
@@ -158,6 +166,21 @@ fn run(args: &[String]) -> Res<()> {
         manifest.display(),
         t0.elapsed().as_secs_f64()
     );
+    let m = ShardManifest::read(&manifest).map_err(|e| e.to_string())?;
+    if m.points > 0 && m.failed_points == m.points {
+        return Err(format!(
+            "every point of shard {shard} failed ({} of {}); the status column of {} says why",
+            m.failed_points,
+            m.points,
+            out.join(&m.points_file).display()
+        ));
+    }
+    if m.failed_points > 0 {
+        eprintln!(
+            "warning: {} of {} points failed (their status column says which)",
+            m.failed_points, m.points
+        );
+    }
     Ok(())
 }
 
@@ -186,6 +209,14 @@ fn merge(args: &[String]) -> Res<()> {
     );
     for f in files {
         println!("{}", f.display());
+    }
+    if failed > 0 && failed == m.records.len() {
+        let first = &m.records[0];
+        return Err(format!(
+            "every point of the study failed ({failed} of {failed}; point 0: {}); the merged \
+             files are written, their status column says why",
+            first.status
+        ));
     }
     if failed > 0 {
         eprintln!("warning: {failed} points have a failure (their status column says which)");

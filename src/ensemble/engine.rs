@@ -13,6 +13,10 @@ use crate::integrate::{DenseOutput, IntegrateError, Stats, StepOptions, Toleranc
 
 /// One trajectory of an ensemble: a [`Member`], its start and end, and an optional landing
 /// grid `origin + i·dt` that every step lands on (the sweeps' sections at `t = i·2π/ω`).
+///
+/// The constructors validate; values set through the public fields are validated when a
+/// run starts ([`check`](Self::check)), and an invalid trajectory is an error in its own
+/// result slot of [`Ensemble::run`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Trajectory {
     /// The model.
@@ -56,6 +60,26 @@ impl Trajectory {
         crate::validate::positive("periods", periods)?;
         let tau = member.period();
         Self::new(member, 0.0, y0, periods * tau)?.with_grid(0.0, tau)
+    }
+
+    /// Checks what the constructors check, for a trajectory whose public fields were set
+    /// directly: the time span, the initial state and the landing grid.
+    ///
+    /// # Errors
+    /// [`IntegrateError::InvalidTimeSpan`] unless `t0 < t_end`, both finite;
+    /// [`IntegrateError::NonFiniteState`] for a non-finite `y0`; [`ParameterError`] naming
+    /// `grid origin` unless it is finite, `grid dt` unless it is finite and > 0.
+    pub fn check(&self) -> Result<()> {
+        let (t0, t_end) = (self.t0, self.t_end);
+        if !(t0.is_finite() && t_end.is_finite() && t_end > t0) {
+            return Err(IntegrateError::InvalidTimeSpan { t0, t_end }.into());
+        }
+        crate::integrate::check_state(&self.y0)?;
+        if let Some((origin, dt)) = self.grid {
+            crate::validate::finite("grid origin", origin)?;
+            crate::validate::positive("grid dt", dt)?;
+        }
+        Ok(())
     }
 
     /// Makes every step land on `origin + i·dt` (computed from `i`, never accumulated).
@@ -203,10 +227,16 @@ impl<G: EventFunction<f64, 2>> Ensemble<G> {
     /// the next one in order; the result of each trajectory does not depend on `V`, on the
     /// order of the slice or on what runs in the other lanes.
     ///
+    /// Every trajectory is checked ([`Trajectory::check`]) before the lanes start: an
+    /// invalid one (fields set directly to a reversed time span, a non-finite state, a
+    /// landing grid with `dt ≤ 0`) never enters a lane; its result is the error, and the
+    /// others run as they would without it.
+    ///
     /// # Errors
     /// The outer error: [`ParameterError`] if `observers` and `trajectories` differ in
     /// length. Each trajectory's own result is an element of the vector: its
-    /// [`Outcome`], or the error that stopped it (the scalar driver's errors).
+    /// [`Outcome`], or the error that stopped it (the scalar driver's errors, or that of
+    /// [`Trajectory::check`]).
     pub fn run<V: Lanes, O: Observer<f64, 2>>(
         &self,
         trajectories: &[Trajectory],
@@ -222,8 +252,17 @@ impl<G: EventFunction<f64, 2>> Ensemble<G> {
         }
         let mut out: Vec<Option<Result<Outcome<f64, 2>>>> = Vec::with_capacity(trajectories.len());
         out.resize_with(trajectories.len(), || None);
-        if let Some(first) = trajectories.first() {
-            Engine::<V, G>::new(self, trajectories, first).run(observers, &mut out);
+        // The valid trajectories, in order: the lanes' queue.
+        let mut queue = Vec::with_capacity(trajectories.len());
+        for (j, job) in trajectories.iter().enumerate() {
+            match job.check() {
+                Ok(()) => queue.push(j),
+                Err(e) => out[j] = Some(Err(e)),
+            }
+        }
+        if let Some(&first) = queue.first() {
+            Engine::<V, G>::new(self, trajectories, &queue, &trajectories[first])
+                .run(observers, &mut out);
         }
         Ok(out
             .into_iter()
@@ -339,6 +378,9 @@ impl Slot {
 struct Engine<'a, V: Lanes, G> {
     cfg: &'a Ensemble<G>,
     jobs: &'a [Trajectory],
+    /// The indices of the valid trajectories, in order ([`Trajectory::check`]).
+    queue: &'a [usize],
+    /// The next position in `queue`.
     next: usize,
     slots: Vec<Slot>,
     /// On the heap, like the step's output: on the stack, the speed of the vector step
@@ -373,15 +415,21 @@ fn lanes_of(mut mask: u32) -> impl Iterator<Item = usize> {
 }
 
 impl<'a, V: Lanes, G: EventFunction<f64, 2>> Engine<'a, V, G> {
-    fn new(cfg: &'a Ensemble<G>, jobs: &'a [Trajectory], first: &Trajectory) -> Self {
+    fn new(
+        cfg: &'a Ensemble<G>,
+        jobs: &'a [Trajectory],
+        queue: &'a [usize],
+        first: &Trajectory,
+    ) -> Self {
         let z = V::splat(0.0);
         let packed = Packed::splat(&first.member);
-        // Idle lanes step from a benign state (the first job's start, h = 1e-6): their
-        // results are never used and their state never changes.
+        // Idle lanes step from a benign state (the first valid job's start, h = 1e-6):
+        // their results are never used and their state never changes.
         let (t, x, v) = (first.t0, first.y0[0], first.y0[1]);
         Self {
             cfg,
             jobs,
+            queue,
             next: 0,
             slots: (0..V::LANES).map(|_| Slot::idle()).collect(),
             st: Box::new(LaneState {
@@ -411,8 +459,7 @@ impl<'a, V: Lanes, G: EventFunction<f64, 2>> Engine<'a, V, G> {
     ) {
         self.st.active = self.st.active.with_lane(i, 0.0);
         self.slots[i].job = None;
-        while self.next < self.jobs.len() {
-            let j = self.next;
+        while let Some(&j) = self.queue.get(self.next) {
             self.next += 1;
             match self.start(i, j, &mut observers[j]) {
                 Ok(()) => {
@@ -427,11 +474,8 @@ impl<'a, V: Lanes, G: EventFunction<f64, 2>> Engine<'a, V, G> {
     fn start<O: Observer<f64, 2>>(&mut self, i: usize, j: usize, obs: &mut O) -> Result<()> {
         let job = &self.jobs[j];
         let cfg = self.cfg;
+        // The time span, state and grid were checked before the run (`Trajectory::check`).
         let (t0, y0, t_end) = (job.t0, job.y0, job.t_end);
-        if !(t0.is_finite() && t_end.is_finite() && t_end > t0) {
-            return Err(IntegrateError::InvalidTimeSpan { t0, t_end }.into());
-        }
-        crate::integrate::check_state(&y0)?;
         cfg.opts
             .validate()
             .map_err(IntegrateError::InvalidSettings)?;
@@ -562,7 +606,7 @@ impl<'a, V: Lanes, G: EventFunction<f64, 2>> Engine<'a, V, G> {
     ) {
         let mut step = Box::new(StepOut::new());
         while self.st.active.bits() != 0 {
-            if self.next >= self.jobs.len()
+            if self.next >= self.queue.len()
                 && <V::Half as Lanes>::LANES < V::LANES
                 && self.st.active.bits().count_ones() as usize <= <V::Half as Lanes>::LANES
             {
@@ -660,6 +704,7 @@ impl<'a, V: Lanes, G: EventFunction<f64, 2>> Engine<'a, V, G> {
         Engine {
             cfg: self.cfg,
             jobs: self.jobs,
+            queue: self.queue,
             next: self.next,
             slots,
             st: half,

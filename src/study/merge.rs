@@ -306,12 +306,49 @@ impl Merged {
             Some(y) => (y.points, y.parameter.clone(), (y.start, y.end)),
             None => (1, String::new(), (0.0, 1.0)),
         };
-        let half = |a: f64, b: f64, n: usize| {
-            let d = if n > 1 { (b - a) / (n - 1) as f64 } else { 1.0 };
-            (a - 0.5 * d, b + 0.5 * d, d)
+        let (xlab, ylab) = (gx.parameter.clone(), ylab);
+        // The chart's range: the axis values widened by half a cell. plotters computes its
+        // tick marks in a loop that never ends on a range that is not finite or whose
+        // width overflows; such an axis (one across most of the f64 range) is drawn over
+        // its grid index instead.
+        let range = |a: f64, b: f64, n: usize| -> Option<(f64, f64, f64)> {
+            let d = if n > 1 {
+                let m = (n - 1) as f64;
+                let d = (b - a) / m;
+                if d.is_finite() { d } else { b / m - a / m }
+            } else {
+                1.0
+            };
+            let (lo, hi) = (a - 0.5 * d, b + 0.5 * d);
+            let ok = [d, lo, hi, hi - lo].iter().all(|v| v.is_finite()) && hi > lo;
+            ok.then_some((lo, hi, d))
         };
-        let (xl, xh, dx) = half(gx.start, gx.end, gx.points);
-        let (yl, yh, dy) = half(y0, y1, ny);
+        let by_index = |n: usize| ((-0.5, n as f64 - 0.5, 1.0), true);
+        let ((xl, xh, dx), x_index) =
+            range(gx.start, gx.end, gx.points).map_or_else(|| by_index(gx.points), |r| (r, false));
+        let ((yl, yh, dy), y_index) =
+            range(y0, y1, ny).map_or_else(|| by_index(ny), |r| (r, false));
+        let xlab = if x_index {
+            format!("{xlab} (grid index)")
+        } else {
+            xlab
+        };
+        let ylab = if y_index {
+            format!("{ylab} (grid index)")
+        } else {
+            ylab
+        };
+        let place = |index: usize| -> (f64, f64) {
+            let (ix, iy) = self.study.coordinates(index);
+            let (x, y) = self.study.values(index);
+            let x = if x_index { ix as f64 } else { x };
+            let y = match &spec.grid.y {
+                None => 0.5,
+                Some(_) if y_index => iy as f64,
+                Some(_) => y,
+            };
+            (x, y)
+        };
         let w = area.dim_in_pixel().0;
         let (plot, side) = area.split_horizontally(w.saturating_sub(300));
         let mut chart = ChartBuilder::on(&plot)
@@ -324,14 +361,13 @@ impl Merged {
         chart
             .configure_mesh()
             .disable_mesh()
-            .x_desc(gx.parameter.clone())
+            .x_desc(xlab)
             .y_desc(ylab)
             .draw()
             .map_err(|x| e(&x))?;
         chart
             .draw_series(self.records.iter().zip(colours).map(|(r, c)| {
-                let (x, y) = self.study.values(r.index);
-                let y = if y.is_nan() { 0.5 } else { y };
+                let (x, y) = place(r.index);
                 Rectangle::new(
                     [(x - 0.5 * dx, y - 0.5 * dy), (x + 0.5 * dx, y + 0.5 * dy)],
                     c.filled(),

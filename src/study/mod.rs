@@ -102,8 +102,8 @@ pub use merge::Merged;
 pub use plan::{PlanSettings, sbatch_script};
 pub use shard::{SHARD_FORMAT, Shard, ShardManifest, check_output_dir, read_shards, write_shard};
 pub use spec::{
-    AttractorSpec, Axis, GridSpec, InitialSpec, IntegrationSpec, LyapunovSpec, MAX_POINTS,
-    PeriodsSpec, QSpec, RecordSpec, Study, StudySpec, SystemSpec,
+    AttractorSpec, Axis, GridSpec, InitialSpec, IntegrationSpec, LyapunovSpec, MAX_PERIODS,
+    MAX_POINTS, PeriodsSpec, QSpec, RecordSpec, Study, StudySpec, SystemSpec,
 };
 
 use thiserror::Error;
@@ -120,6 +120,15 @@ pub enum StudyError {
     #[error("study spec: `{field}` {message}")]
     InvalidSpec {
         /// The field, e.g. `grid.x.points`.
+        field: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// A setting of the sbatch script (`study plan`) is invalid: a value that is not a plain
+    /// Slurm token, or a path that cannot be written into the script safely.
+    #[error("study plan: `{field}` {message}")]
+    InvalidPlan {
+        /// The setting, e.g. `--partition`.
         field: String,
         /// What is wrong.
         message: String,

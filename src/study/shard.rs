@@ -147,6 +147,18 @@ pub struct ShardManifest {
     pub sections_fnv: String,
 }
 
+impl ShardManifest {
+    /// Reads a manifest file (e.g. the one [`write_shard`] returns).
+    ///
+    /// # Errors
+    /// [`StudyError::Io`] naming the file if it cannot be read; [`StudyError::Corrupt`] if
+    /// it is not a manifest.
+    pub fn read(path: &Path) -> Result<Self, StudyError> {
+        let text = fs::read_to_string(path).map_err(|e| io(path, e))?;
+        serde_json::from_str(&text).map_err(|e| corrupt(path, format!("unreadable manifest: {e}")))
+    }
+}
+
 /// A float in the shortest form that reads back to the same bits.
 pub(crate) fn fmt_f64(v: f64) -> String {
     let a = v.abs();
@@ -560,15 +572,48 @@ pub fn read_shards(dir: &Path) -> Result<(Study, Vec<PointRecord>), StudyError> 
     let mut slots: Vec<Option<PointRecord>> = vec![None; total];
     for (i, (p, m)) in &by_index {
         let shard = Shard::new(*i, n)?;
-        let recs = read_shard(dir, m, p)?;
         let expected: Vec<usize> = shard_indices(total, shard).collect();
-        if recs.len() != expected.len() || recs.len() != m.points {
+        // The manifest's counts against the spec, then the points file against both: each
+        // message says which count is claimed and which was found.
+        if m.total_points != total {
             return Err(corrupt(
                 p,
                 format!(
-                    "{} points, shard {shard} of {total} points has {}",
-                    recs.len(),
+                    "the manifest claims a study of {} points, its spec has {total}",
+                    m.total_points
+                ),
+            ));
+        }
+        if m.points != expected.len() {
+            return Err(corrupt(
+                p,
+                format!(
+                    "the manifest claims {} points, shard {shard} of a study of {total} points \
+                     has {}",
+                    m.points,
                     expected.len()
+                ),
+            ));
+        }
+        let recs = read_shard(dir, m, p)?;
+        if recs.len() != m.points {
+            return Err(corrupt(
+                p,
+                format!(
+                    "the manifest claims {} points, its points file {} holds {}",
+                    m.points,
+                    m.points_file,
+                    recs.len()
+                ),
+            ));
+        }
+        let failed = recs.iter().filter(|r| !r.is_ok()).count();
+        if failed != m.failed_points {
+            return Err(corrupt(
+                p,
+                format!(
+                    "the manifest claims {} failed points, its points file {} holds {failed}",
+                    m.failed_points, m.points_file
                 ),
             ));
         }

@@ -12,6 +12,12 @@ use super::model::{ModelKind, ParameterSet};
 /// The most grid points of one study (10⁸: a 10⁴ × 10⁴ plane).
 pub const MAX_POINTS: usize = 100_000_000;
 
+/// The most forcing periods (`transient + record`) of one point: a point's run visits a
+/// section at every forcing period, and one run visits at most 10⁹ sections (the
+/// stroboscopic sampler's limit; one less here, for the rounding of the last section
+/// time).
+pub const MAX_PERIODS: u64 = 999_999_999;
+
 /// A study as written in its TOML file (after defaults are filled in).
 ///
 /// Read it with [`StudySpec::from_toml`], which also validates it; [`Study::new`] turns a
@@ -88,8 +94,9 @@ pub struct GridSpec {
     pub y: Option<Axis>,
 }
 
-/// One grid axis: `points` values `start + k·(end − start)/(points − 1)`, computed from
-/// `k` (never accumulated).
+/// One grid axis: `points` values `start + (end − start)·s` with `s = k/(points − 1)`,
+/// computed from `k` (never accumulated); where `end − start` overflows (an axis across
+/// most of the `f64` range), as `start·(1 − s) + end·s`, which stays finite.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Axis {
@@ -105,12 +112,20 @@ pub struct Axis {
 }
 
 impl Axis {
-    /// The `k`-th value.
+    /// The `k`-th value (finite for finite `start` and `end`).
     pub fn value(&self, k: usize) -> f64 {
         if self.points <= 1 {
-            self.start
+            return self.start;
+        }
+        let s = k as f64 / (self.points - 1) as f64;
+        let span = self.end - self.start;
+        if span.is_finite() {
+            // The form of every existing study: its values stay the same bits.
+            self.start + span * s
         } else {
-            self.start + (self.end - self.start) * (k as f64 / (self.points - 1) as f64)
+            // `start < 0 < end` here: two terms of opposite sign, each at most the larger
+            // of |start|, |end|, cannot overflow.
+            self.start * (1.0 - s) + self.end * s
         }
     }
 
@@ -162,7 +177,8 @@ impl Default for IntegrationSpec {
     }
 }
 
-/// Forcing periods per point.
+/// Forcing periods per point: `transient + record` at most [`MAX_PERIODS`], and no more
+/// than `integration.max_steps` (a point takes at least one step per period).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PeriodsSpec {
@@ -432,6 +448,35 @@ impl StudySpec {
         if self.periods.record == 0 {
             return Err(invalid("periods.record", "must be >= 1"));
         }
+        let periods = u64::from(self.periods.transient) + u64::from(self.periods.record);
+        if periods > MAX_PERIODS {
+            let field = if u64::from(self.periods.transient) > MAX_PERIODS {
+                "periods.transient"
+            } else {
+                "periods"
+            };
+            return Err(invalid(
+                field,
+                format!(
+                    "transient + record = {} + {} = {periods} forcing periods per point \
+                     exceeds the limit of {MAX_PERIODS} (MAX_PERIODS: one run visits at most \
+                     10^9 sections)",
+                    self.periods.transient, self.periods.record
+                ),
+            ));
+        }
+        // Every step lands on the period grid: a point takes at least one step per period.
+        if (self.integration.max_steps as u64) < periods {
+            return Err(invalid(
+                "integration.max_steps",
+                format!(
+                    "{} is below the {periods} forcing periods (transient + record) of a \
+                     point: every step lands on the period grid, so every point would stop \
+                     at the step cap; allow at least {periods} steps",
+                    self.integration.max_steps
+                ),
+            ));
+        }
         positive_finite("record.period_tol", self.record.period_tol)?;
         if self.record.max_period == 0 {
             return Err(invalid("record.max_period", "must be >= 1"));
@@ -443,6 +488,17 @@ impl StudySpec {
                     format!(
                         "must be >= 10 (the spread uses 10 blocks; got {})",
                         l.periods
+                    ),
+                ));
+            }
+            if l.periods > crate::lyapunov::MAX_INTERVALS {
+                return Err(invalid(
+                    "record.lyapunov.periods",
+                    format!(
+                        "{} exceeds the limit of {} intervals of one estimate \
+                         (lyapunov::MAX_INTERVALS)",
+                        l.periods,
+                        crate::lyapunov::MAX_INTERVALS
                     ),
                 ));
             }
@@ -458,6 +514,10 @@ impl StudySpec {
                 ));
             }
             positive_finite("record.q.step", q.step)?;
+            // The histogram itself (bins at most `Histogram::MAX_BINS`, resolvable edges):
+            // otherwise every point's `q` would be NaN without a word.
+            crate::entropy::Histogram::<f64>::new(q.lo, q.hi, q.step)
+                .map_err(|e| invalid("record.q.step", e.to_string()))?;
         }
         if let Some(s) = self.attractors.scales {
             positive_finite("attractors.scales[0]", s[0])?;
@@ -478,6 +538,16 @@ impl StudySpec {
         for (field, a) in &axes {
             for k in 0..a.points {
                 let v = a.value(k);
+                if !v.is_finite() {
+                    return Err(invalid(
+                        field.to_string(),
+                        format!(
+                            "value {k} of {} ({} from {} to {} in {} points) is {v}: every \
+                             axis value must be finite",
+                            a.parameter, a.parameter, a.start, a.end, a.points
+                        ),
+                    ));
+                }
                 let mut p = set.clone();
                 let mut y0 = self.initial.state;
                 for (_, b) in &axes {
@@ -660,5 +730,40 @@ mod tests {
         assert_eq!(a.value(0), 17.5);
         assert_eq!(a.value(60), 25.0);
         assert_eq!(a.value(30), 21.25);
+    }
+
+    #[test]
+    fn an_axis_across_the_f64_range_has_finite_values() {
+        let a = Axis {
+            parameter: "x0".into(),
+            start: -1e308,
+            end: 1e308,
+            points: 3,
+        };
+        assert_eq!([a.value(0), a.value(1), a.value(2)], [-1e308, 0.0, 1e308]);
+        let b = Axis {
+            parameter: "x0".into(),
+            start: -f64::MAX,
+            end: f64::MAX,
+            points: 7,
+        };
+        assert!((0..7).all(|k| b.value(k).is_finite()));
+        assert!((0..6).all(|k| b.value(k) < b.value(k + 1)));
+        assert_eq!((b.value(0), b.value(6)), (-f64::MAX, f64::MAX));
+    }
+
+    #[test]
+    fn max_periods_is_within_the_section_limit_of_a_run() {
+        use crate::drive::Observer;
+        use crate::sample::Stroboscopic;
+        for omega in [20.0, 17.3, 1.0, 1e-3, 123.456, 22.73] {
+            let period = std::f64::consts::TAU / omega;
+            let s = Stroboscopic::<f64, 2>::periodic(0.0, period, 0.0, 16).unwrap();
+            // The end of a point's run as `sweep::run_point` computes it.
+            let t_end = (MAX_PERIODS as f64) * period;
+            assert!(s.check_span(0.0, t_end).is_ok(), "ω = {omega}");
+            let over = (MAX_PERIODS as f64 + 2.0) * period;
+            assert!(s.check_span(0.0, over).is_err(), "ω = {omega}");
+        }
     }
 }
