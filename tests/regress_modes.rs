@@ -199,14 +199,13 @@ fn forced_linear(a: f64, w: f64) -> impl Fn(f64, f64, f64, f64, f64) -> (f64, f6
     }
 }
 
+/// Mode transitions `(t, mode entered)`.
+type Transitions = Vec<(f64, SlipMode)>;
+
 /// A Den Hartog oscillator `ẍ + x + F sgn ẋ ∋ F₀ cos ωt` (m = k = F₀ = 1): the crate's
 /// transitions with the default stepper options, the worst violation of the static limit
 /// (stuck) and of the slip direction (slipping) between step ends, and the reference.
-fn den_hartog(
-    ratio: f64,
-    w: f64,
-    periods: f64,
-) -> (Vec<(f64, SlipMode)>, Vec<(f64, SlipMode)>, f64, usize) {
+fn den_hartog(ratio: f64, w: f64, periods: f64) -> (Transitions, Transitions, f64, usize) {
     let model = Mechanical::<f64, 1, 2>::with_masses([1.0])
         .unwrap()
         .with_elements(Element::on_dof(0, LinearSpring::new(1.0).unwrap()).unwrap())
@@ -395,20 +394,18 @@ fn belt_with_forced_speed_matches_the_exact_flow() {
 // ---------------------------------------------------------------------------------------
 // Rigid sticking on a stop.
 
-/// `ẍ + 2ζẋ + x = cos ωt` with a rigid stop at `x = d` (restitution `e`): the run with
-/// sticking, the releases, and the worst violation of "stuck only while the stop pushes"
-/// (`cos ωt ≥ d`) between step ends.
-fn impact_oscillator(
-    w: f64,
-    d: f64,
-    e: f64,
-    periods: f64,
-) -> (
+/// Stick and release times, the worst violation between step ends, the impacts.
+type StopRun = (
     Vec<f64>,
     Vec<f64>,
     f64,
     ImpactSequence<f64, Gap<f64, 1, Constant<f64>>>,
-) {
+);
+
+/// `ẍ + 2ζẋ + x = cos ωt` with a rigid stop at `x = d` (restitution `e`): the run with
+/// sticking, the releases, and the worst violation of "stuck only while the stop pushes"
+/// (`cos ωt ≥ d`) between step ends.
+fn impact_oscillator(w: f64, d: f64, e: f64, periods: f64) -> StopRun {
     let zeta = 0.05;
     let model = Mechanical::<f64, 1, 2>::with_masses([1.0])
         .unwrap()

@@ -22,7 +22,7 @@ mod surface;
 
 pub use period::{Regime, detect_period, try_detect_period};
 pub use samplers::{
-    Impact, ImpactSequence, PeriodRecord, PeriodSummary, Periodic, PhaseClock, Section,
-    SectionClock, SectionPoint, Stroboscopic, Trajectory,
+    Impact, ImpactSequence, MAX_SECTIONS_PER_RUN, PeriodRecord, PeriodSummary, Periodic,
+    PhaseClock, Section, SectionClock, SectionPoint, Stroboscopic, Trajectory,
 };
 pub use surface::Surface;

@@ -13,10 +13,10 @@ use super::model::{ModelKind, ParameterSet};
 pub const MAX_POINTS: usize = 100_000_000;
 
 /// The most forcing periods (`transient + record`) of one point: a point's run visits a
-/// section at every forcing period, and one run visits at most 10⁹ sections (the
-/// stroboscopic sampler's limit; one less here, for the rounding of the last section
-/// time).
-pub const MAX_PERIODS: u64 = 999_999_999;
+/// section at every forcing period, and one run visits at most
+/// [`MAX_SECTIONS_PER_RUN`](crate::sample::MAX_SECTIONS_PER_RUN) sections (one less here,
+/// for the rounding of the last section time).
+pub const MAX_PERIODS: u64 = crate::sample::MAX_SECTIONS_PER_RUN - 1;
 
 /// A study as written in its TOML file (after defaults are filled in).
 ///
