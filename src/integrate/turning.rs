@@ -85,10 +85,10 @@
 use nalgebra::{SVector, Vector2};
 
 use super::{DenseOutput, HermiteDense, IntegrateError, Stats, Stepper};
-use crate::error::ParameterError;
 use crate::force::ContactOnset;
 use crate::roots::brent;
 use crate::scalar::lit;
+use crate::validate::ParameterError;
 use crate::validate::positive;
 use crate::{Dynamics, Real};
 

@@ -2,13 +2,13 @@ use crate::Real;
 use nalgebra::SVector;
 
 use crate::drive::{Control, EventRecord, Observer, StepView};
-use crate::error::ParameterError;
 use crate::event::{Direction, EventFunction, Stop, locate};
 use crate::excite::Excitation;
 use crate::integrate::DenseOutput;
 use crate::roots::golden_max;
 use crate::sample::Surface;
 use crate::scalar::lit;
+use crate::validate::ParameterError;
 use crate::validate::{finite, positive};
 
 /// The times `t_i` of a stroboscopic section.

@@ -5,11 +5,11 @@ use nalgebra::{SVector, Vector2};
 use super::{SignalError, TimeSeries};
 use crate::Dynamics;
 use crate::drive::{Observer, Outcome, Simulation};
-use crate::error::ParameterError;
 use crate::event::{Direction, Event, EventFunction, EventSet, Level};
 use crate::integrate::{Dopri5, Stats, Tolerances};
 use crate::model::paper::PaperParameters;
 use crate::sample::{Impact, ImpactSequence, Surface, Trajectory};
+use crate::validate::ParameterError;
 use crate::validate::{finite, non_negative, positive};
 
 /// How the paper's rotor is driven: at a constant angular frequency, or on the experiment's
