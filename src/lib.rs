@@ -24,7 +24,7 @@
 //!
 //! ## Quick start
 //! ```
-//! use nonsmooth::model::paper::PAPER;
+//! use nonsmooth::systems::paper::PAPER;
 //! use nonsmooth::Dynamics;
 //! use nalgebra::Vector2;
 //!

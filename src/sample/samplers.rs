@@ -166,7 +166,7 @@ impl<R> Store<R> {
 /// ```
 /// use nonsmooth::drive::Simulation;
 /// use nonsmooth::integrate::{Dopri5, Tolerances};
-/// use nonsmooth::model::paper::PAPER;
+/// use nonsmooth::systems::paper::PAPER;
 /// use nonsmooth::sample::Stroboscopic;
 /// use nalgebra::Vector2;
 ///
