@@ -171,7 +171,7 @@ pub trait Observer<T: Real, const N: usize> {
 
     /// Called by [`run_modes`] before each segment of a run through modes, with the
     /// segment's start time and its mode's name
-    /// ([`ModeSystem::mode_name`](modes::ModeSystem::mode_name)): every step and event
+    /// ([`ModeSystem::mode_name`]): every step and event
     /// until the next call belongs to that mode.
     fn on_mode(&mut self, _t: T, _mode: &'static str) {}
 
