@@ -8,7 +8,7 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use nonsmooth::analysis::{
     AmplitudePhase, LinearizedResponse, Spectrum, SpectrumAnalyzer, TurningPoint, fit_harmonics,
 };
-use nonsmooth::model::paper::PAPER;
+use nonsmooth::systems::paper::PAPER;
 
 const N: usize = 4096;
 const OMEGA: f64 = 14.0;

@@ -18,7 +18,7 @@ use nonsmooth::ensemble::{
 };
 use nonsmooth::event::{Direction, Event, Stop};
 use nonsmooth::integrate::{Dopri5, Tolerances};
-use nonsmooth::model::paper::PAPER;
+use nonsmooth::systems::paper::PAPER;
 
 struct Setup {
     jobs: Vec<Trajectory>,

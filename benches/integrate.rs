@@ -24,8 +24,8 @@ use nonsmooth::Dynamics;
 use nonsmooth::drive::Simulation;
 use nonsmooth::event::{Direction, Event, Level};
 use nonsmooth::integrate::{Dop853, Dopri5, Stepper, Tolerances, TurningPoints};
-use nonsmooth::model::paper::PAPER;
 use nonsmooth::sample::{ImpactSequence, Stroboscopic};
+use nonsmooth::systems::paper::PAPER;
 use std::hint::black_box;
 
 #[path = "common/scalar.rs"]

@@ -8,7 +8,7 @@ use nonsmooth::integrate::{Dopri5, Tolerances};
 use nonsmooth::lyapunov::{
     Norm, PAPER_D0, TangentSpace, TwoTrajectory, pair_tolerances, tangent_tolerances,
 };
-use nonsmooth::model::paper::PAPER;
+use nonsmooth::systems::paper::PAPER;
 use std::hint::black_box;
 
 fn tle(c: &mut Criterion) {

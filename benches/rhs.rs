@@ -6,7 +6,7 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use nalgebra::Vector2;
 use nonsmooth::Dynamics;
-use nonsmooth::model::paper::PAPER;
+use nonsmooth::systems::paper::PAPER;
 use std::hint::black_box;
 
 #[path = "common/scalar.rs"]

@@ -7,8 +7,8 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use nalgebra::Vector2;
 use nonsmooth::integrate::{Dopri5, Tolerances};
-use nonsmooth::model::paper::{PAPER, PaperOscillator};
 use nonsmooth::sweep::{Stop, SweepConfig, SweepSystem, sweep};
+use nonsmooth::systems::paper::{PAPER, PaperOscillator};
 use std::hint::black_box;
 
 fn make(w: f64) -> nonsmooth::Result<SweepSystem<PaperOscillator<f64>>> {

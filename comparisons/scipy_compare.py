@@ -40,7 +40,7 @@ except ImportError:  # pragma: no cover - environment dependent
 HERE = os.path.dirname(os.path.abspath(__file__))
 RESULTS = os.path.join(HERE, "results")
 
-# The paper's parameters (nonsmooth::model::paper::PAPER).
+# The paper's parameters (nonsmooth::systems::paper::PAPER).
 # err x10 is the worst end error over the brief's 5 fixed starts (forcing periods); the RMS
 # and the impact errors use every start of the reference (40, see README.md).
 BRIEF_STARTS = (100, 120, 140, 160, 180)

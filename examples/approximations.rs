@@ -4,8 +4,8 @@
 //! Run with `cargo run --example approximations`.
 
 use nonsmooth::analysis::{AmplitudePhase, LinearizedResponse, TurningPoint};
-use nonsmooth::model::paper::PAPER;
 use nonsmooth::roots::brent;
+use nonsmooth::systems::paper::PAPER;
 
 fn row(name: &str, paper: Option<f64>, ours: f64) {
     match paper {

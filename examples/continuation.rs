@@ -28,7 +28,6 @@ use nonsmooth::excite::Harmonic;
 use nonsmooth::force::{CubicSpring, ViscousDamper};
 use nonsmooth::integrate::{Dopri5, Tolerances};
 use nonsmooth::lyapunov::tangent_tolerances;
-use nonsmooth::model::paper::PAPER;
 use nonsmooth::model::{Element, Load, Mechanical};
 use nonsmooth::orbit::{
     BifurcationKind, Branch, ContinuationSettings, Shooting, follow, period_doubled,
@@ -37,6 +36,7 @@ use nonsmooth::output::csv::{
     Cell, SweepColumns, write_bifurcations, write_branch, write_table_path,
 };
 use nonsmooth::sample::Stroboscopic;
+use nonsmooth::systems::paper::PAPER;
 
 type Duffing = Mechanical<
     f64,

@@ -15,8 +15,8 @@ use nalgebra::Vector2;
 use nonsmooth::ensemble::{Ensemble, F64x8, F64x16, IndependentSweep, Member, Simd};
 use nonsmooth::event::Stop;
 use nonsmooth::integrate::{Dopri5, Tolerances};
-use nonsmooth::model::paper::{PAPER, PaperOscillator};
 use nonsmooth::sweep::{SweepConfig, SweepDirection, SweepSystem, sweep};
+use nonsmooth::systems::paper::{PAPER, PaperOscillator};
 
 fn make(w: f64) -> nonsmooth::Result<SweepSystem<PaperOscillator<f64>>> {
     Ok(SweepSystem {

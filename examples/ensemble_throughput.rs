@@ -31,7 +31,7 @@ use nonsmooth::ensemble::{
 };
 use nonsmooth::event::{Direction, Event, Stop};
 use nonsmooth::integrate::{DenseOutput, Dopri5, Tolerances};
-use nonsmooth::model::paper::PAPER;
+use nonsmooth::systems::paper::PAPER;
 
 /// Section points (steps land on them: a step ending on a grid time is a section) and
 /// the number of impacts.

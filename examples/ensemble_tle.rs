@@ -18,7 +18,7 @@ use nonsmooth::integrate::{Dopri5, Tolerances};
 use nonsmooth::lyapunov::{
     DiagramSettings, IntervalRule, Norm, PAPER_D0, TwoTrajectory, pair_tolerances,
 };
-use nonsmooth::model::paper::PAPER;
+use nonsmooth::systems::paper::PAPER;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();

@@ -108,7 +108,7 @@ use nalgebra::Vector2;
 use nonsmooth::drive::{Control, EventRecord, Observer, Simulation, StepView};
 use nonsmooth::event::{Direction, Event, Stop};
 use nonsmooth::integrate::{DenseOutput, Dop853, Dopri5, Stats, Stepper, Tolerances};
-use nonsmooth::model::paper::{PAPER, PaperParameters};
+use nonsmooth::systems::paper::{PAPER, PaperParameters};
 
 /// The frequency of the comparison workloads W1 and W2 (chaotic attractor).
 const OMEGA_W: f64 = 20.465;

@@ -12,8 +12,8 @@
 mod common;
 
 use common::{Orbit, orbit, regime, secs};
-use nonsmooth::model::paper::PAPER;
 use nonsmooth::output::csv::{STATE_XV, write_section_points_path};
+use nonsmooth::systems::paper::PAPER;
 
 const OMEGAS: [f64; 3] = [15.0, 16.7, 18.0];
 

@@ -38,11 +38,11 @@ use std::time::Instant;
 use nalgebra::Vector2;
 use nonsmooth::Dynamics;
 use nonsmooth::integrate::{Dopri5, Tolerances};
-use nonsmooth::model::paper::PAPER;
 use nonsmooth::signal::{
     Forcing, LowPass, PhaseSection, SyntheticExperiment, ThresholdCrossing, section_frequencies,
 };
 use nonsmooth::sweep::{Stop, ramp};
+use nonsmooth::systems::paper::PAPER;
 
 struct Args {
     from: f64,

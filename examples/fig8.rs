@@ -14,8 +14,8 @@ mod common;
 
 use common::{Orbit, orbit, regime, secs};
 use indicatif::{ProgressBar, ProgressStyle};
-use nonsmooth::model::paper::PAPER;
 use nonsmooth::output::csv::{Cell, write_table_path};
+use nonsmooth::systems::paper::PAPER;
 
 const OMEGAS: [f64; 8] = [14.0, 14.1, 15.0, 16.0, 17.0, 17.5, 18.0, 19.0];
 

@@ -39,8 +39,8 @@ use nonsmooth::identify::{
     Forcing, M2_TO_MM2, NelderMeadOptions, PAPER_FIT_PARAMETERS, PaperFit, paper_parameter,
     set_paper_parameter,
 };
-use nonsmooth::model::paper::PAPER;
 use nonsmooth::signal::{CsvOptions, SyntheticExperiment, TimeSeries};
+use nonsmooth::systems::paper::PAPER;
 
 struct Args {
     omega: f64,

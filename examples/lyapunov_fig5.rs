@@ -19,7 +19,7 @@ use nonsmooth::lyapunov::{
     Branch, DiagramPoint, DiagramSettings, IntervalRule, Norm, PAPER_D0, pair_tolerances,
     tle_diagram,
 };
-use nonsmooth::model::paper::PAPER;
+use nonsmooth::systems::paper::PAPER;
 
 struct Args {
     from: f64,

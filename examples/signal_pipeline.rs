@@ -10,11 +10,11 @@
 use std::f64::consts::PI;
 use std::path::PathBuf;
 
-use nonsmooth::model::paper::PAPER;
 use nonsmooth::signal::{
     CsvOptions, LowPass, PhaseSection, ThresholdCrossing, TimeSeries, intervals,
     section_frequencies,
 };
+use nonsmooth::systems::paper::PAPER;
 
 /// SplitMix64 (Steele, Lea & Flood 2014): a tiny deterministic generator for pseudo-noise.
 struct SplitMix64(u64);

@@ -43,8 +43,8 @@ use std::time::Instant;
 use nalgebra::Vector2;
 use nonsmooth::drive::{Control, Observer, Simulation, StepView};
 use nonsmooth::integrate::{DenseOutput, Dop853, Dopri5, Stepper, Tolerances, TurningPoints};
-use nonsmooth::model::paper::PAPER;
 use nonsmooth::sample::Stroboscopic;
+use nonsmooth::systems::paper::PAPER;
 
 const OMEGA: f64 = 20.465;
 

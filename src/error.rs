@@ -6,43 +6,7 @@
 
 use thiserror::Error;
 
-/// A parameter that failed validation in a constructor.
-#[derive(Debug, Clone, PartialEq, Error)]
-#[error("invalid parameter `{name}` = {}: must be {requirement}", Compact(*value))]
-pub struct ParameterError {
-    /// The parameter's name as documented on the constructor.
-    pub name: &'static str,
-    /// The rejected value (as `f64`).
-    pub value: f64,
-    /// What the value must satisfy, e.g. `"finite and > 0"`.
-    pub requirement: &'static str,
-}
-
-/// A value printed in full when moderate and in scientific notation when very large or small
-/// (`1e-300`, not three hundred zeros).
-struct Compact(f64);
-
-impl std::fmt::Display for Compact {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let a = self.0.abs();
-        if a != 0.0 && a.is_finite() && !(1e-4..1e7).contains(&a) {
-            write!(f, "{:e}", self.0)
-        } else {
-            write!(f, "{}", self.0)
-        }
-    }
-}
-
-impl ParameterError {
-    /// Builds the error.
-    pub fn new(name: &'static str, value: f64, requirement: &'static str) -> Self {
-        Self {
-            name,
-            value,
-            requirement,
-        }
-    }
-}
+pub use crate::validate::ParameterError;
 
 /// The crate's error: every fallible function returns [`Result`].
 #[derive(Debug, Clone, Error)]

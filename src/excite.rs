@@ -5,9 +5,9 @@
 //! frequency it is the root of a quadratic, never an accumulated sum.
 
 use crate::Real;
-use crate::error::ParameterError;
 use crate::fastmath;
 use crate::scalar::lit;
+use crate::validate::ParameterError;
 use crate::validate::{finite, non_negative, positive};
 
 /// `x` clamped to the finite range: `±∞ → ±MAX` (NaN stays NaN; a type without a largest

@@ -24,7 +24,7 @@
 //!
 //! ## Quick start
 //! ```
-//! use nonsmooth::model::paper::PAPER;
+//! use nonsmooth::systems::paper::PAPER;
 //! use nonsmooth::Dynamics;
 //! use nalgebra::Vector2;
 //!
@@ -80,6 +80,7 @@ pub use dynamics::Dynamics;
 #[doc = include_str!("../README.md")]
 #[cfg(doctest)]
 pub struct ReadmeDoctests;
-pub use error::{Error, ParameterError, Result};
+pub use error::{Error, Result};
 pub use force::ForceLaw;
 pub use scalar::Real;
+pub use validate::ParameterError;

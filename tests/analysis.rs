@@ -14,8 +14,8 @@ use nonsmooth::analysis::{
 };
 use nonsmooth::force::LinearSpring;
 use nonsmooth::model::Oscillator;
-use nonsmooth::model::paper::PAPER;
 use nonsmooth::roots::brent;
+use nonsmooth::systems::paper::PAPER;
 
 // ---------------------------------------------------------------------------------------
 // helpers
@@ -739,7 +739,7 @@ fn public_types_are_send_sync_clone() {
     check::<
         AmplitudePhase<
             f64,
-            nonsmooth::model::paper::PaperLaws<f64>,
+            nonsmooth::systems::paper::PaperLaws<f64>,
             nonsmooth::excite::UnbalancedRotor<f64>,
         >,
     >();

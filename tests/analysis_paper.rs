@@ -4,7 +4,7 @@
 use nalgebra::Vector2;
 use nonsmooth::analysis::{Spectrum, first_grazing, fit_harmonics, steady_samples};
 use nonsmooth::integrate::{Dopri5, Tolerances};
-use nonsmooth::model::paper::PAPER;
+use nonsmooth::systems::paper::PAPER;
 
 fn tol() -> Tolerances<f64, 2> {
     Tolerances::per_component(1e-10, [1e-14, 1e-12]).unwrap()

@@ -10,8 +10,8 @@ use nonsmooth::ensemble::{
 };
 use nonsmooth::event::{Direction, Event, Level, Stop};
 use nonsmooth::integrate::{Dopri5, Stats, Tolerances};
-use nonsmooth::model::paper::{PAPER, PaperParameters};
 use nonsmooth::sample::Stroboscopic;
+use nonsmooth::systems::paper::{PAPER, PaperParameters};
 
 /// Section points and event times of one run.
 #[derive(Debug, Clone)]

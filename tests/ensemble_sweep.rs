@@ -9,8 +9,8 @@ use nonsmooth::ensemble::{
 };
 use nonsmooth::event::{Direction, Event, Stop};
 use nonsmooth::integrate::{Dopri5, Tolerances};
-use nonsmooth::model::paper::{PAPER, PaperOscillator};
 use nonsmooth::sweep::{SweepPoint, SweepSystem, sweep};
+use nonsmooth::systems::paper::{PAPER, PaperOscillator};
 
 fn tol() -> Tolerances<f64, 2> {
     Tolerances::per_component(1e-8, [1e-12, 1e-10]).unwrap()

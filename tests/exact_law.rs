@@ -6,7 +6,7 @@ use nalgebra::Vector2;
 use nonsmooth::drive::{Control, Observer, Simulation, StepView};
 use nonsmooth::event::{Direction, Event, Stop};
 use nonsmooth::integrate::{DenseOutput, Dop853, Dopri5, Stats, Stepper, Tolerances};
-use nonsmooth::model::paper::{PAPER, PaperParameters};
+use nonsmooth::systems::paper::{PAPER, PaperParameters};
 
 /// W1/W2 of `comparisons/` (chaotic attractor).
 const OMEGA: f64 = 20.465;

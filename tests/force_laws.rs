@@ -3,7 +3,7 @@
 
 use nonsmooth::ForceLaw;
 use nonsmooth::force::{DryFriction, HertzContact, LinearSpring, Side, ViscousDamper};
-use nonsmooth::model::paper::PAPER;
+use nonsmooth::systems::paper::PAPER;
 use nonsmooth::testing::{
     Axis, CheckConfig, CheckReport, ContactClaim, LawSpec, LawViolation, Property, Variable,
     check_law, points_in,

@@ -17,11 +17,11 @@ use nonsmooth::identify::{
     Forcing, IdentifyError, M2_TO_MM2, PaperFit, Parameter, paper_parameter, set_paper_parameter,
 };
 use nonsmooth::integrate::IntegrateError;
-use nonsmooth::model::paper::{PAPER, PaperParameters};
 use nonsmooth::signal::{
     CsvOptions, LowPass, PAPER_IMPACT_OFFSET, SyntheticExperiment, SyntheticRecord,
     ThresholdCrossing, TimeSeries,
 };
+use nonsmooth::systems::paper::{PAPER, PaperParameters};
 
 const OMEGA: f64 = 17.0;
 const DURATION: f64 = 1.0;

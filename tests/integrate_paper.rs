@@ -5,7 +5,7 @@ use nalgebra::Vector2;
 use nonsmooth::drive::{Control, EventRecord, Observer, Simulation};
 use nonsmooth::event::{Direction, Event, Level};
 use nonsmooth::integrate::{Dop853, Dopri5, StepOptions, Stepper, Tolerances};
-use nonsmooth::model::paper::{PAPER, PaperParameters};
+use nonsmooth::systems::paper::{PAPER, PaperParameters};
 
 #[derive(Default)]
 struct Impacts(Vec<EventRecord<f64, 2>>);

@@ -8,7 +8,7 @@ use nonsmooth::lyapunov::{
     DiagramSettings, IntervalRule, LyapunovError, Norm, PAPER_D0, TangentSpace, TwoTrajectory,
     decades, pair_tolerances, separation_study, tangent_tolerances, tle_diagram,
 };
-use nonsmooth::model::paper::PAPER;
+use nonsmooth::systems::paper::PAPER;
 use nonsmooth::testing::{DampedOscillator, Lorenz};
 use nonsmooth::{Dynamics, Error};
 

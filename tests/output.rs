@@ -375,8 +375,8 @@ fn section_points_and_impacts_in_f32_and_f64() {
 #[test]
 fn paper_sweep_written_and_read_back() {
     use nonsmooth::integrate::{Dopri5, Tolerances};
-    use nonsmooth::model::paper::PAPER;
     use nonsmooth::sweep::{Stop, SweepConfig, SweepSystem, sweep};
+    use nonsmooth::systems::paper::PAPER;
 
     let config = SweepConfig::grid(19.0, 19.1, 0.05)
         .unwrap()

@@ -3,12 +3,12 @@
 
 use nalgebra::Vector2;
 use nonsmooth::integrate::{Dopri5, Tolerances};
-use nonsmooth::model::paper::{PAPER, PaperOscillator};
 use nonsmooth::sample::Regime;
 use nonsmooth::sweep::{
     Branch, Stop, SweepConfig, SweepDirection, SweepError, SweepPoint, SweepResult, SweepSystem,
     hysteresis, run_point, sweep, transitions,
 };
+use nonsmooth::systems::paper::{PAPER, PaperOscillator};
 
 fn stop() -> Stop {
     Stop {

@@ -10,7 +10,7 @@ use nonsmooth::event::{Direction, Event, Level, Stop};
 use nonsmooth::force::{LinearSpring, ViscousDamper};
 use nonsmooth::integrate::{DenseOutput, Dop853, Dopri5, Tolerances, TurningPoints};
 use nonsmooth::model::Oscillator;
-use nonsmooth::model::paper::{PAPER, PaperParameters};
+use nonsmooth::systems::paper::{PAPER, PaperParameters};
 
 const OMEGA: f64 = 20.465;
 const BAND: f64 = 3e-3;

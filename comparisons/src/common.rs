@@ -6,7 +6,7 @@ use std::cell::Cell;
 use std::rc::Rc;
 use std::time::Instant;
 
-use nonsmooth::model::paper::PAPER;
+use nonsmooth::systems::paper::PAPER;
 
 /// CPU time of the calling thread (s). Timings use it rather than wall time: the machine
 /// is shared with other jobs, which inflate wall time by descheduling.

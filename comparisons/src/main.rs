@@ -17,7 +17,7 @@ mod ours;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use nonsmooth::model::paper::PAPER;
+use nonsmooth::systems::paper::PAPER;
 
 use common::{Job, RunResult, Status};
 use de::DeMethod;
@@ -896,7 +896,7 @@ fn rhs_cost_ns(w2_start: [f64; 2]) -> (f64, f64) {
     use std::cell::RefCell;
     use std::hint::black_box;
     struct Rec<'a>(
-        &'a nonsmooth::model::paper::PaperOscillator<f64>,
+        &'a nonsmooth::systems::paper::PaperOscillator<f64>,
         RefCell<Vec<(f64, Vector2<f64>)>>,
     );
     impl Dynamics<f64, 2> for Rec<'_> {

@@ -9,7 +9,7 @@ use nonsmooth::event::{Direction, Event, Level};
 use nonsmooth::integrate::{
     DenseOutput, Dop853, Dopri5, Rosenbrock23, StepOptions, Stepper, Tolerances, TurningPoints,
 };
-use nonsmooth::model::paper::{PAPER, PaperOscillator};
+use nonsmooth::systems::paper::{PAPER, PaperOscillator};
 use nonsmooth::sample::Stroboscopic;
 
 use crate::common::{Counter, Job, RunResult, Status};

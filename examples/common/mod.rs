@@ -9,7 +9,6 @@ use nalgebra::Vector2;
 use nonsmooth::drive::Simulation;
 use nonsmooth::event::{Direction, Event, Level};
 use nonsmooth::integrate::{Dopri5, Tolerances};
-use nonsmooth::model::paper::{PAPER, PaperOscillator};
 use nonsmooth::output::csv::{SweepColumns, write_sweep_files};
 use nonsmooth::sample::{
     Impact, ImpactSequence, Regime, SectionPoint, Stroboscopic, Trajectory, detect_period,
@@ -18,6 +17,7 @@ use nonsmooth::sweep::{
     Branch, Stop, SweepConfig, SweepDirection, SweepPoint, SweepResult, SweepSystem, Transition,
     hysteresis, run_point, transitions,
 };
+use nonsmooth::systems::paper::{PAPER, PaperOscillator};
 
 /// Command-line arguments: `[--quick] [--out DIR | DIR]`.
 #[derive(Debug, Clone)]

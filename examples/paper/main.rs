@@ -163,14 +163,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "",
         );
     }
-    let osc = nonsmooth::model::paper::PAPER.oscillator::<f64>(14.0)?;
+    let osc = nonsmooth::systems::paper::PAPER.oscillator::<f64>(14.0)?;
     let lin = nonsmooth::analysis::LinearizedResponse::new(
         &osc,
         ap.x0,
-        nonsmooth::model::paper::PAPER.c,
+        nonsmooth::systems::paper::PAPER.c,
     )?;
     let ap6 =
-        nonsmooth::analysis::AmplitudePhase::new(&osc, ap.x0, nonsmooth::model::paper::PAPER.c)?
+        nonsmooth::analysis::AmplitudePhase::new(&osc, ap.x0, nonsmooth::systems::paper::PAPER.c)?
             .solve(14.0, nonsmooth::analysis::TurningPoint::Upper)?;
     write_csv(
         &a.out,

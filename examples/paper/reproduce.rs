@@ -16,11 +16,11 @@ use nonsmooth::lyapunov::{
     Diagram, DiagramSettings, IntervalRule, Norm, PAPER_D0, TwoTrajectory, pair_tolerances,
     tle_diagram,
 };
-use nonsmooth::model::paper::{PAPER, PaperOscillator};
 use nonsmooth::sweep::{
     Stop, SweepConfig, SweepDirection, SweepPoint, SweepResult, SweepSystem, Transition, run_point,
     sweep,
 };
+use nonsmooth::systems::paper::{PAPER, PaperOscillator};
 
 pub type Res<T> = Result<T, nonsmooth::Error>;
 

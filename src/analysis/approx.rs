@@ -153,7 +153,7 @@ fn equilibrium<T: Real, L: ForceLaw<T>, E: Excitation<T>>(
 /// # Examples
 /// ```
 /// use nonsmooth::analysis::LinearizedResponse;
-/// use nonsmooth::model::paper::PAPER;
+/// use nonsmooth::systems::paper::PAPER;
 /// let osc = PAPER.oscillator::<f64>(14.0)?;
 /// let x0 = PAPER.static_equilibrium()?;
 /// let lin = LinearizedResponse::new(&osc, x0, PAPER.c)?;
@@ -401,7 +401,7 @@ impl TurningPoint {
 /// # Examples
 /// ```
 /// use nonsmooth::analysis::{AmplitudePhase, TurningPoint};
-/// use nonsmooth::model::paper::PAPER;
+/// use nonsmooth::systems::paper::PAPER;
 /// let osc = PAPER.oscillator::<f64>(14.0)?;
 /// let ap = AmplitudePhase::new(&osc, PAPER.static_equilibrium()?, PAPER.c)?;
 /// let s = ap.solve(14.0, TurningPoint::Upper)?;

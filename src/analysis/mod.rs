@@ -41,8 +41,8 @@ pub use spectrum::{
 };
 pub use steady::{SteadySamples, first_grazing, steady_min_gap, steady_samples};
 
-use crate::error::ParameterError;
 use crate::roots::RootError;
+use crate::validate::ParameterError;
 
 /// Errors of the harmonic analysis and of the approximate solutions.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -7,7 +7,7 @@ use rustfft::num_complex::Complex;
 use rustfft::{Fft, FftPlanner};
 
 use super::AnalysisError;
-use crate::error::ParameterError;
+use crate::validate::ParameterError;
 
 /// Default relative tolerance on the number of periods covered: `|n·dt·ω/2π − P| ≤ 10⁻⁶·P`.
 ///

@@ -9,7 +9,7 @@
 //! use nonsmooth::drive::{Simulation, Termination};
 //! use nonsmooth::event::{Direction, Event, Level};
 //! use nonsmooth::integrate::{Dopri5, Tolerances};
-//! use nonsmooth::model::paper::PAPER;
+//! use nonsmooth::systems::paper::PAPER;
 //! use nalgebra::Vector2;
 //!
 //! // The paper's oscillator at ω = 20.465 rad/s from rest, impacts = upward crossings of x_I.

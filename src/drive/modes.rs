@@ -46,9 +46,10 @@ use thiserror::Error;
 
 use super::{Observer, Outcome};
 use crate::Real;
-use crate::error::{ParameterError, Result};
+use crate::error::Result;
 use crate::event::EventError;
 use crate::scalar::{lit, to_f64};
+use crate::validate::ParameterError;
 
 /// Errors of runs through modes.
 #[derive(Debug, Clone, PartialEq, Error)]

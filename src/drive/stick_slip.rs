@@ -52,11 +52,12 @@ use nalgebra::SVector;
 
 use super::modes::{ModeError, ModeSystem, Segment, rate_along_flow};
 use super::{Observer, Simulation, Termination};
-use crate::error::{ParameterError, Result};
+use crate::error::Result;
 use crate::event::{Direction, Event, EventFunction};
 use crate::excite::Excitation;
 use crate::integrate::Stepper;
 use crate::model::{Coordinate, Elements, Loads, Mechanical, shorter};
+use crate::validate::ParameterError;
 use crate::validate::{finite, non_negative};
 use crate::{Dynamics, Real};
 

@@ -7,9 +7,10 @@ use super::math::LaneMath;
 use super::model::{Member, Packed, scalar_rhs};
 use super::{Lanes, Simd};
 use crate::drive::{Control, EventRecord, Observer, Outcome, StepView, Termination, landing_limit};
-use crate::error::{ParameterError, Result};
+use crate::error::Result;
 use crate::event::{Direction, Event, EventError, EventFunction, EventHistory, ZenoGuard, locate};
 use crate::integrate::{DenseOutput, IntegrateError, Stats, StepOptions, Tolerances};
+use crate::validate::ParameterError;
 
 /// One trajectory of an ensemble: a [`Member`], its start and end, and an optional landing
 /// grid `origin + i·dt` that every step lands on (the sweeps' sections at `t = i·2π/ω`).

@@ -93,7 +93,7 @@
 //! use nonsmooth::drive::Simulation;
 //! use nonsmooth::ensemble::{Ensemble, F64x4, Member, Trajectory};
 //! use nonsmooth::integrate::{Dopri5, Tolerances};
-//! use nonsmooth::model::paper::PAPER;
+//! use nonsmooth::systems::paper::PAPER;
 //!
 //! let tol = Tolerances::per_component(1e-8, [1e-12, 1e-10])?;
 //! let y0 = Vector2::new(PAPER.static_equilibrium()?, 0.0);

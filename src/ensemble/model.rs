@@ -5,9 +5,9 @@ use nalgebra::SVector;
 use super::Lanes;
 use super::math::{LaneMath, pow_masked, sin};
 use crate::Dynamics;
-use crate::error::ParameterError;
 use crate::scalar::Exponent;
 use crate::systems::paper::{PaperOscillator, PaperParameters};
+use crate::validate::ParameterError;
 
 /// One member of an ensemble: the paper's oscillator (any [`PaperParameters`], not only
 /// the paper's set) forced at `ω`, with its scalar model kept beside it.

@@ -193,7 +193,7 @@ fn point(
 /// use nonsmooth::ensemble::{Ensemble, F64x4, IndependentSweep, Member, sweep_independent};
 /// use nonsmooth::event::Stop;
 /// use nonsmooth::integrate::Tolerances;
-/// use nonsmooth::model::paper::PAPER;
+/// use nonsmooth::systems::paper::PAPER;
 ///
 /// let tol = Tolerances::per_component(1e-8, [1e-12, 1e-10])?;
 /// let members = [19.0, 19.1, 19.2].map(|w| Member::paper(w)).into_iter().collect::<Result<Vec<_>, _>>()?;

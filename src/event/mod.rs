@@ -51,9 +51,9 @@ use nalgebra::SVector;
 use thiserror::Error;
 
 use crate::Real;
-use crate::error::ParameterError;
 use crate::model::Coordinate;
 use crate::scalar::lit;
+use crate::validate::ParameterError;
 use crate::validate::non_negative;
 
 /// Event errors.

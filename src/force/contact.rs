@@ -1,7 +1,7 @@
 //! Compliant contact: the generalized Hertz law with nonlinear damping.
 
-use crate::error::ParameterError;
 use crate::scalar::{Exponent, lit};
+use crate::validate::ParameterError;
 use crate::validate::{finite, non_negative, positive};
 use crate::{ForceLaw, Real};
 

@@ -1,6 +1,6 @@
 //! Regularized dry (Coulomb) friction.
 
-use crate::error::ParameterError;
+use crate::validate::ParameterError;
 use crate::validate::{non_negative, normal_square, positive};
 use crate::{ForceLaw, Real};
 

@@ -1,6 +1,6 @@
 //! Linear spring and viscous damper.
 
-use crate::error::ParameterError;
+use crate::validate::ParameterError;
 use crate::validate::non_negative;
 use crate::{ForceLaw, Real};
 

@@ -1,6 +1,6 @@
 //! Piecewise-linear stiffness with a gap: backlash (dead zone) and bilinear stops.
 
-use crate::error::ParameterError;
+use crate::validate::ParameterError;
 use crate::validate::non_negative;
 use crate::{ForceLaw, Real};
 

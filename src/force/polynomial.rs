@@ -1,6 +1,6 @@
 //! Polynomial springs: the cubic (Duffing) spring and any polynomial stiffness.
 
-use crate::error::ParameterError;
+use crate::validate::ParameterError;
 use crate::validate::finite;
 use crate::{ForceLaw, Real};
 

@@ -1,7 +1,7 @@
 //! Nelder–Mead fitting in a [`ParameterSpace`].
 
 use super::{IdentifyError, ParamValues, ParameterSpace};
-use crate::error::ParameterError;
+use crate::validate::ParameterError;
 use crate::validate::positive;
 
 /// Settings of [`fit_nelder_mead`].

@@ -51,8 +51,8 @@ pub use paper::{
 };
 pub use space::{ParamValues, Parameter, ParameterSpace, Transform};
 
-use crate::error::ParameterError;
 use crate::signal::SignalError;
+use crate::validate::ParameterError;
 
 /// Errors of parameter identification.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -11,8 +11,8 @@ use super::{
     fit_nelder_mead, objective_f0,
 };
 use crate::integrate::Tolerances;
-use crate::model::paper::PaperParameters;
 use crate::signal::TimeSeries;
+use crate::systems::paper::PaperParameters;
 
 pub use crate::signal::Forcing;
 
@@ -108,7 +108,7 @@ pub fn set_paper_parameter(
 /// # Examples
 /// ```
 /// use nonsmooth::identify::{Forcing, PaperFit};
-/// use nonsmooth::model::paper::PAPER;
+/// use nonsmooth::systems::paper::PAPER;
 /// use nonsmooth::signal::SyntheticExperiment;
 ///
 /// // Half a second "measured" at ω = 20.465 rad/s with the paper's parameters…
@@ -416,8 +416,8 @@ impl PaperFit {
 mod tests {
     use super::*;
     use crate::identify::model_fit::Nodes;
-    use crate::model::paper::PAPER;
     use crate::sample::SectionClock;
+    use crate::systems::paper::PAPER;
 
     #[test]
     fn names_map_to_fields() {

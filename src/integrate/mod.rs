@@ -37,8 +37,8 @@ pub use turning::{SegmentCounts, TurningDense, TurningPoints};
 use nalgebra::SVector;
 use thiserror::Error;
 
-use crate::error::ParameterError;
 use crate::scalar::{lit, to_f64};
+use crate::validate::ParameterError;
 use crate::validate::positive;
 use crate::{Dynamics, Real};
 

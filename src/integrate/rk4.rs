@@ -5,8 +5,8 @@ use nalgebra::SVector;
 use super::{
     Accepted, Core, DenseOutput, IntegrateError, Stats, Stepper, all_finite, core_accessors,
 };
-use crate::error::ParameterError;
 use crate::scalar::{lit, to_f64};
+use crate::validate::ParameterError;
 use crate::validate::positive;
 use crate::{Dynamics, Real};
 

@@ -85,10 +85,10 @@
 use nalgebra::{SVector, Vector2};
 
 use super::{DenseOutput, HermiteDense, IntegrateError, Stats, Stepper};
-use crate::error::ParameterError;
 use crate::force::ContactOnset;
 use crate::roots::brent;
 use crate::scalar::lit;
+use crate::validate::ParameterError;
 use crate::validate::positive;
 use crate::{Dynamics, Real};
 
@@ -106,7 +106,7 @@ const MAX_SEGMENT_STEPS: u32 = 10_000;
 /// ```
 /// use nonsmooth::drive::Simulation;
 /// use nonsmooth::integrate::{Tolerances, TurningPoints};
-/// use nonsmooth::model::paper::PAPER;
+/// use nonsmooth::systems::paper::PAPER;
 /// use nalgebra::Vector2;
 ///
 /// let osc = PAPER.oscillator::<f64>(20.465)?;

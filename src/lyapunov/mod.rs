@@ -66,7 +66,7 @@
 //!
 //! The crate's paper model uses the rate regularization
 //! `sgn(ẋ)|ẋ|^{n3} → ẋ(ẋ²+η²)^{(n3−1)/2}` with `η = 10⁻⁸ m/s`
-//! ([`PAPER.eta`](crate::model::paper::PaperParameters::eta)), whose slope at `ẋ = 0` is
+//! ([`PAPER.eta`](crate::systems::paper::PaperParameters::eta)), whose slope at `ẋ = 0` is
 //! `η^{n3−1} ≈ 3·10⁶ (m/s)^{n3−1}`: `J` is finite but very large in short windows around
 //! each reversal in contact — `J_ẋẋ = −∂F/∂ẋ/m ≈ −k_I·b·δ^{3/2}·η^{n3−1}/m` is about
 //! `−10⁶ s⁻¹` for the cart resting in the stop (`δ ≈ 5 µm`) and `−10⁸ s⁻¹` at the turning

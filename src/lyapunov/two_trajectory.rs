@@ -235,7 +235,7 @@ where
     /// ```
     /// use nonsmooth::integrate::{Dopri5, Tolerances};
     /// use nonsmooth::lyapunov::{Norm, TwoTrajectory};
-    /// use nonsmooth::model::paper::PAPER;
+    /// use nonsmooth::systems::paper::PAPER;
     /// let tol = Tolerances::per_component(1e-8, [1e-12, 1e-10])?;
     /// let est = TwoTrajectory::<_, 2, 4, _, _>::with_tolerances(
     ///     PAPER.oscillator::<f64>(14.0)?,

@@ -3,10 +3,10 @@
 use nalgebra::{SMatrix, SVector};
 use thiserror::Error;
 
-use crate::error::ParameterError;
 use crate::excite::Excitation;
 use crate::linalg::Lu;
 use crate::scalar::{lit, to_f64};
+use crate::validate::ParameterError;
 use crate::validate::finite;
 use crate::{Dynamics, ForceLaw, Real};
 

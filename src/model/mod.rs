@@ -9,14 +9,12 @@
 //! - [`Oscillator`]: the one-degree-of-freedom case `m·ẍ + ΣF(x, ẋ) = f(t)` in scalar form
 //!   (bit-identical to `Mechanical` with `N = 1`, without the vector bookkeeping).
 //!
-//! Ready-made systems — the paper's impact oscillator among them — are in
-//! [`systems`](crate::systems); [`paper`] is kept here as an alias of
-//! [`systems::paper`](crate::systems::paper).
+//! Ready-made systems — the paper's impact oscillator among them, in
+//! [`systems::paper`](crate::systems::paper) — are in [`systems`](crate::systems).
 
 mod mechanical;
 mod oscillator;
 
-pub use crate::systems::paper;
 pub(crate) use mechanical::shorter;
 pub use mechanical::{Coordinate, Element, Elements, Load, Loads, Mechanical, ModelError};
 pub use oscillator::Oscillator;

@@ -1,10 +1,11 @@
 use nalgebra::{SMatrix, SVector};
 
-use crate::error::{ParameterError, Result};
+use crate::error::Result;
 use crate::excite::Excitation;
 use crate::model::{Coordinate, Element, Load, Mechanical};
 use crate::roots::brent;
 use crate::scalar::lit;
+use crate::validate::ParameterError;
 use crate::validate::positive;
 use crate::{Dynamics, ForceLaw, Real};
 

@@ -3,7 +3,7 @@
 use nalgebra::SVector;
 
 use crate::Real;
-use crate::error::ParameterError;
+use crate::validate::ParameterError;
 
 /// The regime read from a sequence of section points.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

@@ -2,13 +2,13 @@ use crate::Real;
 use nalgebra::SVector;
 
 use crate::drive::{Control, EventRecord, Observer, StepView};
-use crate::error::ParameterError;
 use crate::event::{Direction, EventFunction, Stop, locate};
 use crate::excite::Excitation;
 use crate::integrate::DenseOutput;
 use crate::roots::golden_max;
 use crate::sample::Surface;
 use crate::scalar::lit;
+use crate::validate::ParameterError;
 use crate::validate::{finite, positive};
 
 /// The times `t_i` of a stroboscopic section.
@@ -166,7 +166,7 @@ impl<R> Store<R> {
 /// ```
 /// use nonsmooth::drive::Simulation;
 /// use nonsmooth::integrate::{Dopri5, Tolerances};
-/// use nonsmooth::model::paper::PAPER;
+/// use nonsmooth::systems::paper::PAPER;
 /// use nonsmooth::sample::Stroboscopic;
 /// use nalgebra::Vector2;
 ///

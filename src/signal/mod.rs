@@ -62,8 +62,8 @@ pub use synthetic::{
     Forcing, ModelExperiment, ModelRecord, NormalNoise, SyntheticExperiment, SyntheticRecord,
 };
 
-use crate::error::ParameterError;
 use crate::scalar::to_f64;
+use crate::validate::ParameterError;
 
 /// Where in the data a problem was found.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

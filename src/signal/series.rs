@@ -9,7 +9,7 @@ use super::{
     Location, LowPass, PhaseSection, PoincarePoint, SignalError, ThresholdCrossing,
     validate_finite, validate_samples,
 };
-use crate::error::ParameterError;
+use crate::validate::ParameterError;
 
 /// A column of a CSV file, by header name or by 0-based index.
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]

@@ -5,11 +5,11 @@ use nalgebra::{SVector, Vector2};
 use super::{SignalError, TimeSeries};
 use crate::Dynamics;
 use crate::drive::{Observer, Outcome, Simulation};
-use crate::error::ParameterError;
 use crate::event::{Direction, Event, EventFunction, EventSet, Level};
 use crate::integrate::{Dopri5, Stats, Tolerances};
-use crate::model::paper::PaperParameters;
 use crate::sample::{Impact, ImpactSequence, Surface, Trajectory};
+use crate::systems::paper::PaperParameters;
+use crate::validate::ParameterError;
 use crate::validate::{finite, non_negative, positive};
 
 /// How the paper's rotor is driven: at a constant angular frequency, or on the experiment's
@@ -166,7 +166,7 @@ impl NormalNoise {
 ///
 /// # Example
 /// ```
-/// use nonsmooth::model::paper::PAPER;
+/// use nonsmooth::systems::paper::PAPER;
 /// use nonsmooth::signal::{Forcing, SyntheticExperiment};
 ///
 /// // 0.5 s at ω = 20.465 rad/s, 1 kHz, 2 µm noise and a 1 µm, 60 Hz hum.
@@ -699,7 +699,7 @@ fn go<S: Dynamics<f64, 2>, Ev: EventSet<f64, 2>, O: Observer<f64, 2>>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::paper::PAPER;
+    use crate::systems::paper::PAPER;
 
     #[test]
     fn normal_noise_moments_and_determinism() {

@@ -3,8 +3,8 @@
 use std::collections::BTreeMap;
 
 use super::StudyError;
-use crate::model::paper::{PAPER, PaperParameters};
 use crate::systems::DuffingUeda;
+use crate::systems::paper::{PAPER, PaperParameters};
 
 /// A model of the catalogue.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -74,7 +74,7 @@ pub struct StudySpec {
 #[serde(deny_unknown_fields)]
 pub struct SystemSpec {
     /// `"paper"` (the paper's cart; parameters as in
-    /// [`PaperParameters`](crate::model::paper::PaperParameters) plus `omega` and
+    /// [`PaperParameters`](crate::systems::paper::PaperParameters) plus `omega` and
     /// `amplitude_factor`, a factor on the unbalance `m0e`) or `"duffing_ueda"` (`k`, `b`,
     /// `omega`, `amplitude_factor` on `b`).
     pub model: String,

@@ -538,7 +538,7 @@ pub(crate) fn impacts_per_period(
 /// ```
 /// use nalgebra::Vector2;
 /// use nonsmooth::integrate::{Dopri5, Tolerances};
-/// use nonsmooth::model::paper::PAPER;
+/// use nonsmooth::systems::paper::PAPER;
 /// use nonsmooth::sweep::{SweepConfig, SweepSystem, Stop, SweepDirection, sweep};
 ///
 /// let config = SweepConfig::grid(19.0, 19.2, 0.1)?.direction(SweepDirection::Up).transients(40, 20).record(10)?;

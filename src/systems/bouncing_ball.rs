@@ -16,11 +16,11 @@
 //! `y(t) = s(t)`) is [`testing::BallOnTableExact`](crate::testing) (feature `testing`).
 
 use crate::Real;
-use crate::error::ParameterError;
 use crate::event::{Gap, NewtonImpact};
 use crate::excite::{Excitation, Harmonic};
 use crate::model::{Coordinate, Load, Mechanical};
 use crate::scalar::lit;
+use crate::validate::ParameterError;
 use crate::validate::positive;
 
 /// A constant force (gravity on a unit mass: `−g`).

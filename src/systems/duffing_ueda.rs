@@ -14,11 +14,11 @@
 //! Lyapunov exponent is ≈ 0.10 per unit time.
 
 use crate::Real;
-use crate::error::ParameterError;
 use crate::excite::Harmonic;
 use crate::force::{CubicSpring, ViscousDamper};
 use crate::model::{Element, Load, Mechanical};
 use crate::scalar::lit;
+use crate::validate::ParameterError;
 use crate::validate::{finite, non_negative, positive};
 
 /// The elements of [`DuffingUedaModel`]: cubic spring and damper on `x`.

@@ -13,11 +13,12 @@
 //! The paper's eq. (1) and the parameter set of its Sect. 2 ([`PAPER`]).
 
 use crate::Real;
-use crate::error::{ParameterError, Result};
+use crate::error::Result;
 use crate::excite::{Excitation, RampedRotor, UnbalancedRotor};
 use crate::force::{DryFriction, HertzContact, LinearSpring, ViscousDamper};
 use crate::model::{Element, Load, Mechanical, Oscillator};
 use crate::scalar::lit;
+use crate::validate::ParameterError;
 
 /// The force laws of the paper's model, summed as a tuple.
 pub type PaperLaws<T> = (

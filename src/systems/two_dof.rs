@@ -21,12 +21,12 @@
 //! nondimensional illustration, not taken from either paper.
 
 use crate::Real;
-use crate::error::ParameterError;
 use crate::event::Gap;
 use crate::excite::Harmonic;
 use crate::force::{HertzContact, LinearSpring, ViscousDamper};
 use crate::model::{Coordinate, Element, Load, Mechanical};
 use crate::scalar::lit;
+use crate::validate::ParameterError;
 use crate::validate::{finite, non_negative, positive};
 
 /// The elements of [`TwoDofImpactModel`]: primary suspension, coupling, stop.

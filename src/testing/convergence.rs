@@ -1,6 +1,6 @@
 //! Observed order of convergence.
 
-use crate::error::ParameterError;
+use crate::validate::ParameterError;
 
 /// A least-squares fit `log err ≈ log C + p·log h`.
 #[derive(Debug, Clone, Copy, PartialEq)]

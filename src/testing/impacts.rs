@@ -3,9 +3,9 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::error::ParameterError;
 use crate::scalar::{lit, to_f64};
 use crate::testing::HarmonicOscillator;
+use crate::validate::ParameterError;
 use crate::validate::{finite, positive};
 use crate::{Dynamics, Real};
 

@@ -8,9 +8,9 @@ use std::fmt;
 use proptest::prelude::*;
 use thiserror::Error;
 
-use crate::error::ParameterError;
 use crate::force::Side;
 use crate::scalar::{epsilon, lit, to_f64};
+use crate::validate::ParameterError;
 use crate::{ForceLaw, Real};
 
 /// Which way a [`Axis::log_around`] axis extends from its centre.

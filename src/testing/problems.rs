@@ -2,8 +2,8 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::error::ParameterError;
 use crate::scalar::lit;
+use crate::validate::ParameterError;
 use crate::validate::{finite, positive};
 use crate::{Dynamics, Real};
 
