@@ -1,6 +1,5 @@
 use nalgebra::{SMatrix, SVector};
 
-use crate::error::Result;
 use crate::excite::Excitation;
 use crate::model::{Coordinate, Element, Load, Mechanical};
 use crate::roots::brent;
@@ -108,12 +107,12 @@ impl<T: Real, L: ForceLaw<T>, E: Excitation<T>> Oscillator<T, L, E> {
     /// by Brent's method to machine precision.
     ///
     /// # Errors
-    /// [`Error::Root`](crate::Error::Root) if the restoring force does not change sign on
-    /// `[lo, hi]` (no equilibrium there).
-    pub fn static_equilibrium(&self, lo: T, hi: T) -> Result<T> {
+    /// [`RootError`](crate::roots::RootError) if the restoring force does not change sign
+    /// on `[lo, hi]` (no equilibrium there).
+    pub fn static_equilibrium(&self, lo: T, hi: T) -> Result<T, crate::roots::RootError> {
         let f = |x: T| self.restoring_force(x);
         let tol = T::default_epsilon() * (lo.abs().max(hi.abs()));
-        Ok(brent(f, lo, hi, f(lo), f(hi), tol, 200)?)
+        brent(f, lo, hi, f(lo), f(hi), tol, 200)
     }
 }
 

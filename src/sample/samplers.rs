@@ -1,12 +1,11 @@
 use crate::Real;
 use nalgebra::SVector;
 
+use super::surface::{Surface, component_max, component_min};
 use crate::drive::{Control, EventRecord, Observer, StepView};
 use crate::event::{Direction, EventFunction, Stop, locate};
 use crate::excite::Excitation;
 use crate::integrate::DenseOutput;
-use crate::roots::golden_max;
-use crate::sample::Surface;
 use crate::scalar::lit;
 use crate::validate::ParameterError;
 use crate::validate::{finite, positive};
@@ -455,57 +454,6 @@ impl<T: Real, const N: usize, G: Surface<T, N>> Observer<T, N> for ImpactSequenc
         }
         Control::Continue
     }
-}
-
-/// The maximum of `y[pos]` over a step view, using the ends and, when `y[vel]` changes sign
-/// from + to −, the interior maximum of the interpolant (golden section).
-#[inline]
-pub(super) fn component_max<T: Real, const N: usize, D: DenseOutput<T, N>>(
-    s: &StepView<'_, T, N, D>,
-    pos: usize,
-    vel: usize,
-) -> T {
-    let mut m = s.y0[pos].max(s.y1[pos]);
-    if s.y0[vel] > T::zero() && s.y1[vel] < T::zero() {
-        let tol = (s.t1 - s.t0) * lit(1e-10);
-        let (_, v) = golden_max(
-            |t| {
-                let mut y = SVector::zeros();
-                s.dense.interpolate_unchecked(t, &mut y);
-                y[pos]
-            },
-            s.t0,
-            s.t1,
-            tol,
-        );
-        m = m.max(v);
-    }
-    m
-}
-
-/// The minimum of `y[pos]` over a step view (see [`component_max`]).
-#[inline]
-fn component_min<T: Real, const N: usize, D: DenseOutput<T, N>>(
-    s: &StepView<'_, T, N, D>,
-    pos: usize,
-    vel: usize,
-) -> T {
-    let mut m = s.y0[pos].min(s.y1[pos]);
-    if s.y0[vel] < T::zero() && s.y1[vel] > T::zero() {
-        let tol = (s.t1 - s.t0) * lit(1e-10);
-        let (_, v) = golden_max(
-            |t| {
-                let mut y = SVector::zeros();
-                s.dense.interpolate_unchecked(t, &mut y);
-                -y[pos]
-            },
-            s.t0,
-            s.t1,
-            tol,
-        );
-        m = m.min(-v);
-    }
-    m
 }
 
 /// A summary of one forcing period `[t_i, t_{i+1})`.

@@ -79,7 +79,7 @@ impl<T: Real, const N: usize> Surface<T, N> for Stop<T> {
     fn max_gap<D: DenseOutput<T, N>>(&self, s: &StepView<'_, T, N, D>) -> T {
         // Extremum of the component itself, then shifted (bit-identical to the first
         // stage's grazing margins).
-        super::samplers::component_max(s, self.position, self.velocity) - self.level
+        component_max(s, self.position, self.velocity) - self.level
     }
 }
 
@@ -91,4 +91,55 @@ impl<T: Real, const N: usize, const M: usize, S: Excitation<T>> Surface<T, M> fo
         }
         self.penetration_rate(t, &y.as_slice()[N..])
     }
+}
+
+/// The maximum of `y[pos]` over a step view, using the ends and, when `y[vel]` changes sign
+/// from + to −, the interior maximum of the interpolant (golden section).
+#[inline]
+pub(super) fn component_max<T: Real, const N: usize, D: DenseOutput<T, N>>(
+    s: &StepView<'_, T, N, D>,
+    pos: usize,
+    vel: usize,
+) -> T {
+    let mut m = s.y0[pos].max(s.y1[pos]);
+    if s.y0[vel] > T::zero() && s.y1[vel] < T::zero() {
+        let tol = (s.t1 - s.t0) * lit(1e-10);
+        let (_, v) = golden_max(
+            |t| {
+                let mut y = SVector::zeros();
+                s.dense.interpolate_unchecked(t, &mut y);
+                y[pos]
+            },
+            s.t0,
+            s.t1,
+            tol,
+        );
+        m = m.max(v);
+    }
+    m
+}
+
+/// The minimum of `y[pos]` over a step view (see [`component_max`]).
+#[inline]
+pub(super) fn component_min<T: Real, const N: usize, D: DenseOutput<T, N>>(
+    s: &StepView<'_, T, N, D>,
+    pos: usize,
+    vel: usize,
+) -> T {
+    let mut m = s.y0[pos].min(s.y1[pos]);
+    if s.y0[vel] < T::zero() && s.y1[vel] > T::zero() {
+        let tol = (s.t1 - s.t0) * lit(1e-10);
+        let (_, v) = golden_max(
+            |t| {
+                let mut y = SVector::zeros();
+                s.dense.interpolate_unchecked(t, &mut y);
+                -y[pos]
+            },
+            s.t0,
+            s.t1,
+            tol,
+        );
+        m = m.min(-v);
+    }
+    m
 }

@@ -4,7 +4,7 @@
 
 use std::collections::BTreeMap;
 
-use super::compute::PointRecord;
+use super::record::PointRecord;
 use super::spec::Study;
 
 /// One attractor found in a group of points with the same system parameters.

@@ -5,7 +5,8 @@ use std::collections::BTreeMap;
 use nalgebra::{SVector, Vector2};
 
 use super::model::{ModelKind, ParameterSet};
-use super::shard::Shard;
+use super::record::PointRecord;
+use super::shard::{Shard, shard_indices};
 use super::spec::{Study, apply_axis};
 use crate::Dynamics;
 use crate::ensemble::{Ensemble, F64x8, F64x16, IndependentSweep, Member, Simd, sweep_starts};
@@ -15,57 +16,6 @@ use crate::lyapunov::{Norm, TwoTrajectory};
 use crate::sample::Regime;
 use crate::sweep::{Stop, SweepError, SweepPoint, SweepSystem, run_point};
 use crate::systems::paper::PaperParameters;
-
-/// What one grid point gave. Every field is a function of the spec and the point index
-/// only (no shared state between points), so a point computes to the same bits in any
-/// shard, on any thread.
-#[derive(Debug, Clone, PartialEq)]
-pub struct PointRecord {
-    /// The point index `i = ix + nx·iy`.
-    pub index: usize,
-    /// `"ok"`, or what failed (the point's other fields hold what was computed before).
-    pub status: String,
-    /// The period in forcing periods (0: no period up to the maximum tested).
-    pub period: usize,
-    /// Impacts per forcing period (NaN if the run failed).
-    pub impacts_per_period: f64,
-    /// Top Lyapunov exponent (1/time unit; NaN if not recorded).
-    pub tle: f64,
-    /// Its standard error (NaN if not recorded).
-    pub tle_spread: f64,
-    /// Entropy index `q*` of the inter-impact intervals (NaN if not recorded or not
-    /// defined, e.g. one interval value on a periodic orbit).
-    pub q: f64,
-    /// The last stroboscopic points `(x, v)` (at most the spec's `record.poincare`, at
-    /// least the period).
-    pub sections: Vec<[f64; 2]>,
-    /// The attractor fingerprint: the cells of the section tessellation visited by the
-    /// recorded points, sorted (see the [module docs](super)); empty on a grid
-    /// without an initial-condition axis, where no two points share their parameters.
-    pub cells: Vec<(i64, i64)>,
-}
-
-impl PointRecord {
-    /// A point whose run failed.
-    pub fn failed(index: usize, message: String) -> Self {
-        Self {
-            index,
-            status: message,
-            period: 0,
-            impacts_per_period: f64::NAN,
-            tle: f64::NAN,
-            tle_spread: f64::NAN,
-            q: f64::NAN,
-            sections: Vec::new(),
-            cells: Vec::new(),
-        }
-    }
-
-    /// Whether the point computed without failure.
-    pub fn is_ok(&self) -> bool {
-        self.status == "ok"
-    }
-}
 
 /// Computes grid point `index` of `study` (a failure is recorded in the point's `status`,
 /// never lost).
@@ -307,12 +257,6 @@ fn fingerprint(points: &[SVector<f64, 2>], scales: [f64; 2], cell: f64) -> Vec<(
     let mut cells: Vec<(i64, i64)> = counted.into_iter().map(|(c, _)| c).collect();
     cells.sort_unstable();
     cells
-}
-
-/// The indices of `shard`: `i ≡ shard.index() − 1 (mod shard.count())`, ascending
-/// (round-robin spreads the costly regions of a map over all shards).
-pub fn shard_indices(total: usize, shard: Shard) -> impl Iterator<Item = usize> {
-    (shard.index() - 1..total).step_by(shard.count())
 }
 
 /// Points per batch of the paper model's lanes (a batch runs on one thread).

@@ -6,7 +6,7 @@ use plotters::prelude::*;
 
 use super::StudyError;
 use super::attractor::{AttractorSummary, identify, regime_class};
-use super::compute::PointRecord;
+use super::record::PointRecord;
 use super::shard::{fmt_f64, read_shards, sections_csv};
 use super::spec::Study;
 

@@ -93,14 +93,18 @@ mod compute;
 mod merge;
 mod model;
 mod plan;
+mod record;
 mod shard;
 mod spec;
 
 pub use attractor::{AttractorSummary, identify, regime_class};
-pub use compute::{MAX_CELLS, PointRecord, compute_point, run_shard, shard_indices};
+pub use compute::{MAX_CELLS, compute_point, run_shard};
 pub use merge::Merged;
 pub use plan::{PlanSettings, sbatch_script};
-pub use shard::{SHARD_FORMAT, Shard, ShardManifest, check_output_dir, read_shards, write_shard};
+pub use record::PointRecord;
+pub use shard::{
+    SHARD_FORMAT, Shard, ShardManifest, check_output_dir, read_shards, shard_indices, write_shard,
+};
 pub use spec::{
     AttractorSpec, Axis, GridSpec, InitialSpec, IntegrationSpec, LyapunovSpec, MAX_PERIODS,
     MAX_POINTS, PeriodsSpec, QSpec, RecordSpec, Study, StudySpec, SystemSpec,

@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use super::StudyError;
-use super::compute::{PointRecord, shard_indices};
+use super::record::PointRecord;
 use super::spec::{Study, StudySpec, fnv1a};
 
 /// The manifest format written and accepted.
@@ -640,4 +640,10 @@ pub fn read_shards(dir: &Path) -> Result<(Study, Vec<PointRecord>), StudyError> 
         })?);
     }
     Ok((study, out))
+}
+
+/// The indices of `shard`: `i ≡ shard.index() − 1 (mod shard.count())`, ascending
+/// (round-robin spreads the costly regions of a map over all shards).
+pub fn shard_indices(total: usize, shard: Shard) -> impl Iterator<Item = usize> {
+    (shard.index() - 1..total).step_by(shard.count())
 }

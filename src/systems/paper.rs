@@ -200,7 +200,7 @@ impl PaperParameters {
             // The spring's rest position is free of contact: it is the equilibrium.
             return Ok(0.0);
         }
-        osc.static_equilibrium(lo, hi)
+        Ok(osc.static_equilibrium(lo, hi)?)
     }
 
     /// The forcing period `2π/ω`.
