@@ -92,6 +92,25 @@ pub enum ModeError {
     },
 }
 
+impl ModeError {
+    /// [`ModeError::InconsistentStart`] with its diagnostics as `f64`.
+    pub(crate) fn inconsistent_start<T: Real>(
+        mode: &'static str,
+        t: T,
+        quantity: &'static str,
+        value: T,
+        requirement: String,
+    ) -> Self {
+        ModeError::InconsistentStart {
+            mode,
+            t: to_f64(t),
+            quantity,
+            value: to_f64(value),
+            requirement,
+        }
+    }
+}
+
 /// `dg/dt` along the flow `ẏ = dy` at `(t, y)` by a central difference
 /// `(g(t+h, y+h·dy) − g(t−h, y−h·dy))/2h`, `h = ε^{1/3}·s` with `s` the time unit
 /// `16·scale/2π` of a declared time scale (else one second). For the rates of mode

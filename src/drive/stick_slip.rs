@@ -355,14 +355,7 @@ where
     fn check_start(&self, mode: SlipMode, t: T, y: &SVector<T, M>) -> Result<()> {
         let v = self.friction.slip_velocity(t, y);
         let err = |quantity, value: T, requirement: String| -> Result<()> {
-            Err(ModeError::InconsistentStart {
-                mode: mode.name(),
-                t: crate::scalar::to_f64(t),
-                quantity,
-                value: crate::scalar::to_f64(value),
-                requirement,
-            }
-            .into())
+            Err(ModeError::inconsistent_start(mode.name(), t, quantity, value, requirement).into())
         };
         match mode {
             SlipMode::Forward | SlipMode::Backward => {

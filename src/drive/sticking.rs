@@ -332,14 +332,7 @@ where
         let (q, qd) = y.as_slice().split_at(N);
         let g = gap.penetration(t, q);
         let err = |quantity, value: T, requirement: String| -> Result<()> {
-            Err(ModeError::InconsistentStart {
-                mode: mode.name(),
-                t: crate::scalar::to_f64(t),
-                quantity,
-                value: crate::scalar::to_f64(value),
-                requirement,
-            }
-            .into())
+            Err(ModeError::inconsistent_start(mode.name(), t, quantity, value, requirement).into())
         };
         let tol = crate::scalar::to_f64(self.tolerance);
         match mode {
