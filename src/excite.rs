@@ -98,11 +98,17 @@ pub trait Excitation<T: Real> {
 /// second, and at least `ε^{1/3}·|t|` so that `t ± h` stay distinct: the step does not
 /// grow with `|t|` (the difference is taken between the representable neighbours used).
 fn central_difference<T: Real>(f: impl Fn(T) -> T, t: T, scale: Option<T>) -> T {
+    let (up, down) = difference_points(t, scale);
+    (f(up) - f(down)) / (up - down)
+}
+
+/// The points `t ± h` of a central difference in time, `h` as in [`central_difference`]
+/// (also used for the rates of mode conditions along the flow).
+pub(crate) fn difference_points<T: Real>(t: T, scale: Option<T>) -> (T, T) {
     let cbrt_eps = crate::scalar::epsilon::<T>().powf(lit(1.0 / 3.0));
     let unit = scale.map_or(T::one(), |h| lit::<T>(16.0) * h / T::two_pi());
     let h = cbrt_eps * unit.max(cbrt_eps * t.abs());
-    let (up, down) = (t + h, t - h);
-    (f(up) - f(down)) / (up - down)
+    (t + h, t - h)
 }
 
 impl<T: Real, E: Excitation<T> + ?Sized> Excitation<T> for &E {

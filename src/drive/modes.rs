@@ -48,7 +48,7 @@ use super::{Observer, Outcome};
 use crate::Real;
 use crate::error::Result;
 use crate::event::EventError;
-use crate::scalar::{lit, to_f64};
+use crate::scalar::to_f64;
 use crate::validate::ParameterError;
 
 /// Errors of runs through modes.
@@ -125,10 +125,7 @@ pub(crate) fn rate_along_flow<T: Real, const M: usize>(
     dy: &SVector<T, M>,
     scale: Option<T>,
 ) -> T {
-    let cbrt_eps = crate::scalar::epsilon::<T>().powf(lit(1.0 / 3.0));
-    let unit = scale.map_or(T::one(), |h| lit::<T>(16.0) * h / T::two_pi());
-    let h = cbrt_eps * unit.max(cbrt_eps * t.abs());
-    let (up, down) = (t + h, t - h);
+    let (up, down) = crate::excite::difference_points(t, scale);
     let (hu, hd) = (up - t, t - down);
     (g(up, &(y + dy * hu)) - g(down, &(y - dy * hd))) / (hu + hd)
 }
