@@ -30,7 +30,7 @@ pub enum Error {
     /// A run through modes (sticking, stick–slip) was started inconsistently or left its
     /// constraint.
     #[error(transparent)]
-    Mode(#[from] crate::drive::modes::ModeError),
+    Mode(#[from] crate::drive::ModeError),
     /// A sampler or sweep was misconfigured or failed.
     #[error(transparent)]
     Sweep(#[from] crate::sweep::SweepError),
@@ -55,6 +55,38 @@ pub enum Error {
     /// Writing output failed.
     #[error("output error: {0}")]
     Output(String),
+}
+
+impl From<crate::drive::RunError> for Error {
+    /// Variant by variant: a run's error keeps its kind (`RunError::Event(e)` becomes
+    /// [`Error::Event`]`(e)`).
+    fn from(e: crate::drive::RunError) -> Self {
+        use crate::drive::RunError;
+        match e {
+            RunError::Parameter(e) => Error::Parameter(e),
+            RunError::Root(e) => Error::Root(e),
+            RunError::Model(e) => Error::Model(e),
+            RunError::Integrate(e) => Error::Integrate(e),
+            RunError::Event(e) => Error::Event(e),
+            RunError::Mode(e) => Error::Mode(e),
+        }
+    }
+}
+
+impl From<Error> for crate::sweep::RunFailure {
+    /// The module error inside `e` (a sweep's run failed with it), or its message.
+    fn from(e: Error) -> Self {
+        use crate::sweep::RunFailure;
+        match e {
+            Error::Parameter(e) => RunFailure::Parameter(e),
+            Error::Model(e) => RunFailure::Model(e),
+            Error::Root(e) => RunFailure::Root(e),
+            Error::Integrate(e) => RunFailure::Integrate(e),
+            Error::Event(e) => RunFailure::Event(e),
+            Error::Mode(e) => RunFailure::Mode(e),
+            other => RunFailure::Other(other.to_string()),
+        }
+    }
 }
 
 /// `Result` with the crate's [`Error`](enum@Error).

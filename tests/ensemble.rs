@@ -33,7 +33,7 @@ impl Record {
 }
 
 impl Observer<f64, 2> for Record {
-    fn check_span(&self, t0: f64, t_end: f64) -> nonsmooth::Result<()> {
+    fn check_span(&self, t0: f64, t_end: f64) -> Result<(), nonsmooth::drive::RunError> {
         self.strobe.check_span(t0, t_end)
     }
     fn on_start(&mut self, t0: f64, y0: &Vector2<f64>) {

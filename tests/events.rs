@@ -2,10 +2,11 @@
 //! (analytic impact times, Zeno accumulation), grazing pairs inside one step.
 
 use nalgebra::Vector2;
+use nonsmooth::Dynamics;
+use nonsmooth::drive::RunError;
 use nonsmooth::drive::{Control, EventRecord, Observer, Simulation, Termination};
 use nonsmooth::event::{Direction, Event, EventError, FnEvent, Level, Restitution, ZenoGuard};
 use nonsmooth::integrate::{Dop853, Dopri5, Tolerances};
-use nonsmooth::{Dynamics, Error};
 
 struct Harmonic;
 impl Dynamics<f64, 2> for Harmonic {
@@ -140,7 +141,7 @@ fn zeno_accumulation_ends_the_run_cleanly() {
         .run(0.0, Vector2::new(h0, 0.0), 5.0, &mut obs)
         .unwrap_err();
     match e {
-        Error::Event(EventError::Zeno { t, count, .. }) => {
+        RunError::Event(EventError::Zeno { t, count, .. }) => {
             assert_eq!(count, 21);
             assert!(
                 t < t_inf && t_inf - t < 1e-3,

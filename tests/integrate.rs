@@ -2,11 +2,12 @@
 //! agreement between independent methods, bad input, determinism.
 
 use nalgebra::{SVector, Vector1, Vector2};
+use nonsmooth::Dynamics;
+use nonsmooth::drive::RunError;
 use nonsmooth::integrate::{
     DenseOutput, Dop853, Dopri5, IntegrateError, Rk4, Rosenbrock23, StepOptions, Stepper,
     Tolerances,
 };
-use nonsmooth::{Dynamics, Error};
 
 /// Least-squares slope of log(err) against log(h).
 fn convergence_order(hs: &[f64], errs: &[f64]) -> Option<f64> {
@@ -214,7 +215,7 @@ fn bad_input_is_reported() {
     assert!(
         matches!(
             e,
-            Error::Integrate(IntegrateError::NonFiniteState { index: 0, .. })
+            RunError::Integrate(IntegrateError::NonFiniteState { index: 0, .. })
         ),
         "{e}"
     );
@@ -224,7 +225,7 @@ fn bad_input_is_reported() {
     assert!(
         matches!(
             e,
-            Error::Integrate(IntegrateError::NonFiniteState { index: 1, .. })
+            RunError::Integrate(IntegrateError::NonFiniteState { index: 1, .. })
         ),
         "{e}"
     );
@@ -232,14 +233,20 @@ fn bad_input_is_reported() {
         .run(1.0, Vector2::new(1.0, 0.0), 0.5, &mut ())
         .unwrap_err();
     assert!(
-        matches!(e, Error::Integrate(IntegrateError::InvalidTimeSpan { .. })),
+        matches!(
+            e,
+            RunError::Integrate(IntegrateError::InvalidTimeSpan { .. })
+        ),
         "{e}"
     );
     let e = sim
         .run(0.0, Vector2::new(1.0, 0.0), f64::NAN, &mut ())
         .unwrap_err();
     assert!(
-        matches!(e, Error::Integrate(IntegrateError::InvalidTimeSpan { .. })),
+        matches!(
+            e,
+            RunError::Integrate(IntegrateError::InvalidTimeSpan { .. })
+        ),
         "{e}"
     );
     assert!(Tolerances::<f64, 2>::new(0.0, 1e-9).is_err());
@@ -263,7 +270,7 @@ fn bad_input_is_reported() {
     assert!(
         matches!(
             e,
-            Error::Integrate(IntegrateError::MaxSteps { max_steps: 10, .. })
+            RunError::Integrate(IntegrateError::MaxSteps { max_steps: 10, .. })
         ),
         "{e}"
     );
@@ -304,7 +311,7 @@ fn nan_mid_run_is_an_error_not_a_hang() {
         assert!(
             matches!(
                 e,
-                Error::Integrate(
+                RunError::Integrate(
                     IntegrateError::NonFiniteRhs { .. } | IntegrateError::StepSizeTooSmall { .. }
                 )
             ),

@@ -3,6 +3,8 @@
 //! span, and impacts on moving and N-DOF surfaces.
 
 use nalgebra::{SVector, Vector2};
+use nonsmooth::Dynamics;
+use nonsmooth::drive::RunError;
 use nonsmooth::drive::{Control, EventRecord, Observer, Simulation};
 use nonsmooth::event::{Direction, Event, EventError, FnEvent, Gap, Level, Restitution};
 use nonsmooth::excite::Harmonic;
@@ -10,7 +12,6 @@ use nonsmooth::integrate::{Dopri5, Stepper, Tolerances};
 use nonsmooth::model::Coordinate;
 use nonsmooth::sample::{ImpactSequence, PeriodSummary};
 use nonsmooth::testing::HarmonicOscillator;
-use nonsmooth::{Dynamics, Error};
 
 /// Collects event records.
 #[derive(Default)]
@@ -77,7 +78,7 @@ fn indices_outside_the_state_are_errors_not_panics() {
         .unwrap_err();
     assert!(matches!(
         e,
-        Error::Event(EventError::IndexOutOfRange { index: 5, len: 2 })
+        RunError::Event(EventError::IndexOutOfRange { index: 5, len: 2 })
     ));
     let mut sim = Simulation::new(oscillator(), Dopri5::new(tol())).with_events(
         Event::new(Level::new(0, 0.0).unwrap(), Direction::Rising)
@@ -88,14 +89,17 @@ fn indices_outside_the_state_are_errors_not_panics() {
         .unwrap_err();
     assert!(matches!(
         e,
-        Error::Event(EventError::IndexOutOfRange { index: 7, .. })
+        RunError::Event(EventError::IndexOutOfRange { index: 7, .. })
     ));
     // Samplers with a component index outside the state.
     let mut sim = Simulation::new(oscillator(), Dopri5::new(tol()));
     let mut imp = ImpactSequence::new(0, 3, 1, 0.0, 0.0, 10).unwrap();
     assert!(matches!(
         sim.run(0.0, Vector2::new(1.0, 0.0), 1.0, &mut imp),
-        Err(Error::Event(EventError::IndexOutOfRange { index: 3, .. }))
+        Err(RunError::Event(EventError::IndexOutOfRange {
+            index: 3,
+            ..
+        }))
     ));
     let mut per = PeriodSummary::periodic(0.0, 1.0, 0, 3, 1, 0.0, 0.0, 10).unwrap();
     assert!(sim.run(0.0, Vector2::new(1.0, 0.0), 1.0, &mut per).is_err());
@@ -111,7 +115,7 @@ fn non_finite_event_functions_are_errors() {
     let mut sim = Simulation::new(oscillator(), Dopri5::new(tol())).with_events(nan);
     assert!(matches!(
         sim.run(0.0, Vector2::new(1.0, 0.0), 10.0, &mut ()),
-        Err(Error::Event(EventError::NonFinite { index: 0, .. }))
+        Err(RunError::Event(EventError::NonFinite { index: 0, .. }))
     ));
     // NaN in part of the state space (√x for x < 0): no spurious event before, an error
     // once a step ends there. x = cos t leaves x > 0 at t = π/2.
@@ -126,7 +130,7 @@ fn non_finite_event_functions_are_errors() {
         .run(0.0, Vector2::new(1.0, 0.0), 10.0, &mut obs)
         .unwrap_err();
     match e {
-        Error::Event(EventError::NonFinite { t, .. }) => {
+        RunError::Event(EventError::NonFinite { t, .. }) => {
             assert!(t > std::f64::consts::FRAC_PI_2, "{t}")
         }
         other => panic!("{other}"),
@@ -174,7 +178,7 @@ fn the_zeno_guard_does_not_depend_on_the_span() {
         let mut sim = Simulation::new(Fall(g), Dopri5::new(tol())).with_events(ev);
         let mut obs = Events::default();
         match sim.run(0.0, Vector2::new(1.0, 0.0), t_end, &mut obs) {
-            Err(Error::Event(EventError::Zeno {
+            Err(RunError::Event(EventError::Zeno {
                 t,
                 count,
                 last_interval,

@@ -6,6 +6,8 @@
 use std::f64::consts::TAU;
 
 use nalgebra::SVector;
+use nonsmooth::drive::RunError;
+use nonsmooth::drive::Simulation;
 use nonsmooth::drive::{
     Control, Coulomb, EventRecord, ModeError, Observer, SlipMode, StepView, StickSlip, run_modes,
     run_with_sticking,
@@ -17,7 +19,6 @@ use nonsmooth::integrate::{DenseOutput, Dopri5, IntegrateError, Tolerances};
 use nonsmooth::model::{Coordinate, Element, Load, Mechanical};
 use nonsmooth::sample::ImpactSequence;
 use nonsmooth::systems::BouncingBallTable;
-use nonsmooth::{Error, drive::Simulation};
 use proptest::prelude::*;
 
 fn tol() -> Tolerances<f64, 2> {
@@ -570,7 +571,7 @@ fn a_start_mode_that_contradicts_the_state_is_an_error() {
         &mut (),
     );
     assert!(
-        matches!(r, Err(Error::Mode(ModeError::InconsistentStart { value, .. })) if value == 80.0),
+        matches!(r, Err(RunError::Mode(ModeError::InconsistentStart { value, .. })) if value == 80.0),
         "{r:?}"
     );
     // Forward slip while v_r < 0.
@@ -584,7 +585,7 @@ fn a_start_mode_that_contradicts_the_state_is_an_error() {
         &mut (),
     );
     assert!(
-        matches!(r, Err(Error::Mode(ModeError::InconsistentStart { .. }))),
+        matches!(r, Err(RunError::Mode(ModeError::InconsistentStart { .. }))),
         "{r:?}"
     );
     // Zero segments is a parameter error, not an accumulation.
@@ -597,7 +598,7 @@ fn a_start_mode_that_contradicts_the_state_is_an_error() {
         0,
         &mut (),
     );
-    assert!(matches!(r, Err(Error::Parameter(_))), "{r:?}");
+    assert!(matches!(r, Err(RunError::Parameter(_))), "{r:?}");
     // A rigid start 1 cm inside the table.
     let p = BouncingBallTable::with_gamma(1.2, 0.5).unwrap();
     let r = run_with_sticking(
@@ -611,7 +612,7 @@ fn a_start_mode_that_contradicts_the_state_is_an_error() {
         &mut (),
     );
     assert!(
-        matches!(r, Err(Error::Mode(ModeError::InconsistentStart { .. }))),
+        matches!(r, Err(RunError::Mode(ModeError::InconsistentStart { .. }))),
         "{r:?}"
     );
 }
@@ -731,7 +732,7 @@ fn a_run_that_needs_more_steps_than_the_cap_fails_up_front() {
         .with_events(Event::new(table, Direction::Rising).with_reset(p.impact::<f64>().unwrap()));
     let r = sim.run(0.0, SVector::from([0.0, 3.0]), 1e7, &mut ());
     assert!(
-        matches!(r, Err(Error::Integrate(IntegrateError::WorkExceedsCap { needed, .. })) if needed > 1e8),
+        matches!(r, Err(RunError::Integrate(IntegrateError::WorkExceedsCap { needed, .. })) if needed > 1e8),
         "{r:?}"
     );
 }

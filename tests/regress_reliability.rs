@@ -4,6 +4,7 @@
 
 use nalgebra::Vector2;
 use nonsmooth::Error;
+use nonsmooth::drive::RunError;
 use nonsmooth::drive::Simulation;
 use nonsmooth::excite::RampedRotor;
 use nonsmooth::integrate::{
@@ -32,7 +33,10 @@ fn nan_tolerances_through_public_fields_fail_before_the_first_step() {
     bad.rtol[1] = f64::NAN;
     let r = Simulation::new(osc(), Dopri5::new(bad)).run(0.0, y0(), 1.0, &mut ());
     assert!(
-        matches!(r, Err(Error::Integrate(IntegrateError::InvalidSettings(_)))),
+        matches!(
+            r,
+            Err(RunError::Integrate(IntegrateError::InvalidSettings(_)))
+        ),
         "{r:?}"
     );
     let mut neg = tol();
@@ -40,7 +44,7 @@ fn nan_tolerances_through_public_fields_fail_before_the_first_step() {
     let r = Simulation::new(osc(), Dop853::new(neg)).run(0.0, y0(), 1.0, &mut ());
     assert!(matches!(
         r,
-        Err(Error::Integrate(IntegrateError::InvalidSettings(_)))
+        Err(RunError::Integrate(IntegrateError::InvalidSettings(_)))
     ));
     // Step options through public fields.
     let mut opts = StepOptions::default();
@@ -53,7 +57,7 @@ fn nan_tolerances_through_public_fields_fail_before_the_first_step() {
     );
     assert!(matches!(
         r,
-        Err(Error::Integrate(IntegrateError::InvalidSettings(_)))
+        Err(RunError::Integrate(IntegrateError::InvalidSettings(_)))
     ));
     // Driven directly (no driver): the stepper still terminates, with an error.
     let mut st = Dopri5::new(bad);
@@ -76,7 +80,7 @@ fn a_step_below_the_time_resolution_is_an_error_not_a_loop() {
     assert!(
         matches!(
             r,
-            Err(Error::Integrate(IntegrateError::WorkExceedsCap { .. }))
+            Err(RunError::Integrate(IntegrateError::WorkExceedsCap { .. }))
         ),
         "{r:?}"
     );
@@ -95,7 +99,7 @@ fn work_that_provably_exceeds_the_cap_fails_at_once() {
             &mut (),
         );
         match r {
-            Err(Error::Integrate(IntegrateError::WorkExceedsCap {
+            Err(RunError::Integrate(IntegrateError::WorkExceedsCap {
                 needed, max_steps, ..
             })) => {
                 assert!(needed >= t_end / h_max * 0.999 && max_steps == 100_000_000);
@@ -110,7 +114,7 @@ fn work_that_provably_exceeds_the_cap_fails_at_once() {
     assert!(
         matches!(
             r,
-            Err(Error::Integrate(IntegrateError::WorkExceedsCap { .. }))
+            Err(RunError::Integrate(IntegrateError::WorkExceedsCap { .. }))
         ),
         "{r:?}"
     );
@@ -127,11 +131,11 @@ fn section_clocks_too_fine_for_the_span_are_errors_and_late_starts_are_fast() {
     // Period 1e-300: 10^300 sections per run. Before, the sampler looped inside one step.
     let mut s = Stroboscopic::<f64, 2>::periodic(0.0, 1e-300, 0.0, 10).unwrap();
     let r = Simulation::new(osc(), Dopri5::new(tol())).run(0.0, y0(), 1.0, &mut s);
-    assert!(matches!(r, Err(Error::Parameter(_))), "{r:?}");
+    assert!(matches!(r, Err(RunError::Parameter(_))), "{r:?}");
     // A period below the time resolution at t0 = 1e6 (sections coincide).
     let mut s = Stroboscopic::<f64, 2>::periodic(0.0, 1e-11, 0.0, 10).unwrap();
     let r = Simulation::new(osc(), Dopri5::new(tol())).run(1e6, y0(), 1e6 + 1e-9, &mut s);
-    assert!(matches!(r, Err(Error::Parameter(_))), "{r:?}");
+    assert!(matches!(r, Err(RunError::Parameter(_))), "{r:?}");
     // A phase clock started at t0 = 1e11: before, the first section index was counted up
     // from 0 (≈ 10^11 calls). Now a bisection; sections are then taken as usual.
     let rotor = RampedRotor::new(0.01, 20.0, 1e-9).unwrap();
@@ -322,7 +326,11 @@ fn implicit_method_on_the_exact_contact_law_reports_the_cause() {
     assert!(
         matches!(
             err,
-            nonsmooth::Error::Integrate(IntegrateError::InfiniteJacobian { row: 1, col: 1, .. })
+            nonsmooth::drive::RunError::Integrate(IntegrateError::InfiniteJacobian {
+                row: 1,
+                col: 1,
+                ..
+            })
         ),
         "{err}"
     );

@@ -55,8 +55,10 @@ fn run(gamma: f64, e: f64, t_end: f64) -> RunReport {
     let stop = match sim.run(0.0, SVector::<f64, 2>::new(0.0, v0), t_end, &mut watch) {
         Ok(_) => None,
         // (Its last impact is the exact one of the same index: counted in `agree9`.)
-        Err(nonsmooth::Error::Event(EventError::Zeno { t, .. })) => Some(format!("Zeno at {t}")),
-        Err(nonsmooth::Error::Event(EventError::Sticking { t, .. })) => {
+        Err(nonsmooth::drive::RunError::Event(EventError::Zeno { t, .. })) => {
+            Some(format!("Zeno at {t}"))
+        }
+        Err(nonsmooth::drive::RunError::Event(EventError::Sticking { t, .. })) => {
             Some(format!("sticking at {t}"))
         }
         Err(e) => panic!("Γ = {gamma}: {e}"),

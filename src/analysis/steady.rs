@@ -4,7 +4,7 @@ use nalgebra::SVector;
 
 use super::AnalysisError;
 use crate::Dynamics;
-use crate::drive::Simulation;
+use crate::drive::{RunError, Simulation};
 use crate::integrate::Stepper;
 use crate::roots::brent;
 use crate::sample::Trajectory;
@@ -56,7 +56,7 @@ where
             required: 2,
         });
     }
-    let sim_err = |e: crate::Error| AnalysisError::Simulation(e.to_string());
+    let sim_err = |e: RunError| AnalysisError::Simulation(e.to_string());
     let t0 = transient as f64 * period;
     let dt = period / per_period as f64;
     let mut traj = Trajectory::<f64, N>::new(t0, dt, t0, n + 1).map_err(|e| sim_err(e.into()))?;
@@ -141,7 +141,7 @@ pub fn first_grazing<const N: usize, S, St, F, G>(
 where
     S: Dynamics<f64, N>,
     St: Stepper<f64, N>,
-    F: Fn(f64) -> crate::Result<(S, f64, SVector<f64, N>)>,
+    F: Fn(f64) -> Result<(S, f64, SVector<f64, N>), RunError>,
     G: Fn() -> St,
 {
     let gap = |w: f64| -> Result<f64, AnalysisError> {

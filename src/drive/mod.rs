@@ -25,19 +25,22 @@
 
 use nalgebra::SVector;
 
+mod error;
 pub mod modes;
 pub mod stick_slip;
 pub mod sticking;
 
-pub use modes::{ModeError, ModeRun, ModeSystem, Segment, run_modes};
+pub use error::{ModeError, RunError};
+pub use modes::{ModeRun, ModeSystem, Segment, run_modes};
 pub use stick_slip::{Coulomb, SlipMode, StickSlip};
 pub use sticking::{Constrained, ContactMode, ModeLog, RigidContact, run_with_sticking};
 
-use crate::error::Result;
 use crate::event::{Direction, EventError, EventHistory, EventSet, MAX_EVENTS, ZenoGuard, locate};
 use crate::integrate::{DenseOutput, IntegrateError, Stats, Stepper, check_state};
 use crate::scalar::{lit, to_f64};
+use crate::validate::ParameterError;
 use crate::{Dynamics, Real};
+use error::Result;
 
 /// Whether a run goes on.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -346,9 +349,9 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
     ///
     /// # Errors
     /// [`ParameterError`](crate::ParameterError) if `max_steps == 0`.
-    pub fn max_steps(mut self, max_steps: usize) -> Result<Self> {
+    pub fn max_steps(mut self, max_steps: usize) -> Result<Self, ParameterError> {
         if max_steps == 0 {
-            return Err(crate::ParameterError::new("max_steps", 0.0, "> 0").into());
+            return Err(ParameterError::new("max_steps", 0.0, "> 0"));
         }
         self.max_steps = max_steps;
         Ok(self)
@@ -358,7 +361,7 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
     ///
     /// # Errors
     /// [`ParameterError`](crate::ParameterError) unless `tol` is finite and > 0.
-    pub fn event_tolerance(mut self, tol: T) -> Result<Self> {
+    pub fn event_tolerance(mut self, tol: T) -> Result<Self, ParameterError> {
         self.event_tol = crate::validate::positive("event_tol", tol)?;
         Ok(self)
     }
@@ -374,7 +377,7 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
     ///
     /// # Errors
     /// [`ParameterError`](crate::ParameterError) unless `dt` is finite and > 0.
-    pub fn landing_grid(mut self, grid: Option<(T, T)>) -> Result<Self> {
+    pub fn landing_grid(mut self, grid: Option<(T, T)>) -> Result<Self, ParameterError> {
         if let Some((o, dt)) = grid {
             crate::validate::finite("origin", o)?;
             crate::validate::positive("dt", dt)?;
@@ -1021,7 +1024,7 @@ fn crossing_between<T: Real>(
     })
 }
 
-fn non_finite<T: Real>(index: usize, t: T, g: T) -> crate::Error {
+fn non_finite<T: Real>(index: usize, t: T, g: T) -> RunError {
     EventError::NonFinite {
         index,
         t: to_f64(t),

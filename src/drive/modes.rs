@@ -12,8 +12,7 @@
 //! # Implementing a mode system
 //! ```
 //! use nalgebra::SVector;
-//! use nonsmooth::Result;
-//! use nonsmooth::drive::{Observer, Outcome, Simulation, Termination};
+//! use nonsmooth::drive::{Observer, Outcome, RunError, Simulation, Termination};
 //! use nonsmooth::drive::modes::{ModeSystem, Segment, run_modes};
 //! use nonsmooth::integrate::{Dopri5, Tolerances};
 //! use nonsmooth::testing::HarmonicOscillator;
@@ -24,7 +23,7 @@
 //!     type Mode = bool;
 //!     fn segment<O: Observer<f64, 2>>(
 //!         &mut self, mode: bool, t: f64, y: SVector<f64, 2>, t_end: f64, observer: &mut O,
-//!     ) -> Result<Segment<f64, 2, bool>> {
+//!     ) -> Result<Segment<f64, 2, bool>, RunError> {
 //!         let stop = (t + 1.0).min(t_end);
 //!         let mut sim = Simulation::new(self.0, Dopri5::new(Tolerances::new(1e-9, 1e-12)?));
 //!         let outcome = sim.run(t, y, stop, observer)?;
@@ -42,55 +41,14 @@
 use std::fmt::Debug;
 
 use nalgebra::SVector;
-use thiserror::Error;
 
+pub use super::error::ModeError;
+use super::error::Result;
 use super::{Observer, Outcome};
 use crate::Real;
-use crate::error::Result;
 use crate::event::EventError;
 use crate::scalar::to_f64;
 use crate::validate::ParameterError;
-
-/// Errors of runs through modes.
-#[derive(Debug, Clone, PartialEq, Error)]
-#[non_exhaustive]
-pub enum ModeError {
-    /// The start mode contradicts the start state: e.g. stuck while the force needed to
-    /// hold the contact exceeds the static limit, slipping forward while the slip velocity
-    /// is negative, or starting inside a rigid surface.
-    #[error(
-        "start mode {mode} contradicts the state at t = {t}: {quantity} = {value}, must be {requirement}"
-    )]
-    InconsistentStart {
-        /// The start mode.
-        mode: &'static str,
-        /// The start time.
-        t: f64,
-        /// The quantity that contradicts the mode.
-        quantity: &'static str,
-        /// Its value.
-        value: f64,
-        /// What the mode requires of it.
-        requirement: String,
-    },
-    /// A constrained mode left its constraint by more than the documented tolerance (the
-    /// integration drifted, e.g. a stuck body sinking into a rigid surface).
-    #[error(
-        "the constraint of mode {mode} is violated at t = {t}: {quantity} = {value} exceeds the tolerance {tolerance}"
-    )]
-    ConstraintDrift {
-        /// The mode.
-        mode: &'static str,
-        /// Time (a step end or a dense sample).
-        t: f64,
-        /// The constraint quantity (penetration, slip velocity).
-        quantity: &'static str,
-        /// Its value.
-        value: f64,
-        /// The tolerance.
-        tolerance: f64,
-    },
-}
 
 impl ModeError {
     /// [`ModeError::InconsistentStart`] with its diagnostics as `f64`.

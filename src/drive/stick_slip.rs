@@ -50,9 +50,9 @@
 
 use nalgebra::SVector;
 
+use super::error::Result;
 use super::modes::{ModeError, ModeSystem, Segment, rate_along_flow};
 use super::{Observer, Simulation, Termination};
-use crate::error::Result;
 use crate::event::{Direction, Event, EventFunction};
 use crate::excite::Excitation;
 use crate::integrate::Stepper;

@@ -24,9 +24,9 @@
 
 use nalgebra::SVector;
 
+use super::error::Result;
 use super::modes::{ModeError, ModeSystem, Segment, rate_along_flow, run_modes};
 use super::{Observer, Outcome, Simulation, Termination};
-use crate::error::Result;
 use crate::event::{Direction, Event, EventError, EventFunction, Gap, NewtonImpact};
 use crate::excite::Excitation;
 use crate::integrate::Stepper;
@@ -397,8 +397,8 @@ where
                     outcome,
                     next: None,
                 }),
-                Err(crate::Error::Event(EventError::Zeno { .. }))
-                | Err(crate::Error::Event(EventError::Sticking { .. })) => {
+                Err(super::RunError::Event(EventError::Zeno { .. }))
+                | Err(super::RunError::Event(EventError::Sticking { .. })) => {
                     let (ts, ys) = self.free.stepper().current();
                     let (ts, mut ys) = (ts, *ys);
                     self.constrained.project(ts, &mut ys);

@@ -2,7 +2,7 @@ use crate::Real;
 use nalgebra::SVector;
 
 use super::surface::{Surface, component_max, component_min};
-use crate::drive::{Control, EventRecord, Observer, StepView};
+use crate::drive::{Control, EventRecord, Observer, RunError, StepView};
 use crate::event::{Direction, EventFunction, Stop, locate};
 use crate::excite::Excitation;
 use crate::integrate::DenseOutput;
@@ -100,11 +100,11 @@ impl<T: Real, E: Excitation<T>> SectionClock<T> for PhaseClock<E> {
 
 /// The sections of `clock` in `[t0, t_end]` are at most [`MAX_SECTIONS_PER_RUN`] and each
 /// advances time.
-fn check_sections<T: Real, C: SectionClock<T>>(clock: &C, t0: T, t_end: T) -> crate::Result<()> {
+fn check_sections<T: Real, C: SectionClock<T>>(clock: &C, t0: T, t_end: T) -> Result<(), RunError> {
     let (a, b) = (clock.first_index_from(t0), clock.first_index_from(t_end));
     let count = b.saturating_sub(a);
     let too_many = || {
-        crate::Error::from(ParameterError::new(
+        RunError::from(ParameterError::new(
             "section clock",
             count as f64,
             "at most 10^9 sections per run, each advancing time (spacing too small for the span?)",
@@ -241,7 +241,7 @@ impl<T: Real, const N: usize, C: SectionClock<T>> Stroboscopic<T, N, C> {
 }
 
 impl<T: Real, const N: usize, C: SectionClock<T>> Observer<T, N> for Stroboscopic<T, N, C> {
-    fn check_span(&self, t0: T, t_end: T) -> crate::Result<()> {
+    fn check_span(&self, t0: T, t_end: T) -> Result<(), RunError> {
         check_sections(&self.clock, t0, t_end)
     }
 
@@ -405,7 +405,7 @@ impl<T: Real, G> ImpactSequence<T, G> {
 }
 
 impl<T: Real, const N: usize, G: Surface<T, N>> Observer<T, N> for ImpactSequence<T, G> {
-    fn check(&self) -> crate::Result<()> {
+    fn check(&self) -> Result<(), RunError> {
         Ok(self.surface.check()?)
     }
 
@@ -589,13 +589,13 @@ impl<T: Real, C: SectionClock<T>, G> PeriodSummary<T, C, G> {
 impl<T: Real, const N: usize, C: SectionClock<T>, G: Surface<T, N>> Observer<T, N>
     for PeriodSummary<T, C, G>
 {
-    fn check(&self) -> crate::Result<()> {
+    fn check(&self) -> Result<(), RunError> {
         crate::event::check_index(self.position, N)?;
         crate::event::check_index(self.velocity, N)?;
         Ok(self.surface.check()?)
     }
 
-    fn check_span(&self, t0: T, t_end: T) -> crate::Result<()> {
+    fn check_span(&self, t0: T, t_end: T) -> Result<(), RunError> {
         check_sections(&self.clock, t0, t_end)
     }
 

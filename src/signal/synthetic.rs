@@ -694,6 +694,7 @@ fn go<S: Dynamics<f64, 2>, Ev: EventSet<f64, 2>, O: Observer<f64, 2>>(
         .with_events(events)
         .max_steps(max_steps)?
         .run(0.0, y0, t_end, observer)
+        .map_err(Into::into)
 }
 
 #[cfg(test)]

@@ -26,7 +26,7 @@ use nalgebra::SVector;
 use thiserror::Error;
 
 use crate::Dynamics;
-use crate::drive::Simulation;
+use crate::drive::{RunError, Simulation};
 use crate::event::{Direction, Event, EventFunction};
 use crate::integrate::Stepper;
 use crate::sample::{ImpactSequence, PeriodSummary, Regime, Stroboscopic, Surface, detect_period};
@@ -105,7 +105,7 @@ pub enum SweepError {
 
 impl SweepError {
     /// A run at `param` failed with `error`.
-    pub fn failed(param: f64, error: crate::Error) -> Self {
+    pub fn failed(param: f64, error: impl Into<RunFailure>) -> Self {
         Self::Failed {
             param,
             source: error.into(),
@@ -134,20 +134,23 @@ pub enum RunFailure {
     /// Event handling failed (e.g. an accumulation of events).
     #[error(transparent)]
     Event(#[from] crate::event::EventError),
+    /// A run through modes was started inconsistently or left its constraint.
+    #[error(transparent)]
+    Mode(#[from] crate::drive::ModeError),
     /// Any other error, by its message.
     #[error("{0}")]
     Other(String),
 }
 
-impl From<crate::Error> for RunFailure {
-    fn from(e: crate::Error) -> Self {
+impl From<RunError> for RunFailure {
+    fn from(e: RunError) -> Self {
         match e {
-            crate::Error::Parameter(e) => Self::Parameter(e),
-            crate::Error::Model(e) => Self::Model(e),
-            crate::Error::Root(e) => Self::Root(e),
-            crate::Error::Integrate(e) => Self::Integrate(e),
-            crate::Error::Event(e) => Self::Event(e),
-            other => Self::Other(other.to_string()),
+            RunError::Parameter(e) => Self::Parameter(e),
+            RunError::Model(e) => Self::Model(e),
+            RunError::Root(e) => Self::Root(e),
+            RunError::Integrate(e) => Self::Integrate(e),
+            RunError::Event(e) => Self::Event(e),
+            RunError::Mode(e) => Self::Mode(e),
         }
     }
 }
@@ -435,7 +438,7 @@ where
     St: Stepper<f64, N>,
     G: Surface<f64, N> + Clone,
 {
-    let fail = |e: crate::Error| SweepError::failed(param, e);
+    let fail = |e: RunError| SweepError::failed(param, e);
     let period = sys.period;
     if !(period.is_finite() && period > 0.0) {
         return Err(SweepError::InvalidPeriod { param, period });
@@ -448,9 +451,9 @@ where
     let mut sim = Simulation::new(sys.system, stepper)
         .with_events(ev)
         .landing_grid(Some((0.0, period)))
-        .map_err(fail)?
+        .map_err(|e| fail(e.into()))?
         .max_steps(config.max_steps)
-        .map_err(fail)?;
+        .map_err(|e| fail(e.into()))?;
     let cap = 1 << 20;
     // Sections at i·period for i = transient+1 ..= transient+record.
     let mut strobe = Stroboscopic::<f64, N>::periodic(0.0, period, t_rec + 0.5 * period, cap)
@@ -555,7 +558,7 @@ pub(crate) fn impacts_per_period(
 /// assert_eq!(res.branches[0].points.len(), 3);
 /// # Ok::<(), nonsmooth::Error>(())
 /// ```
-pub fn sweep<const N: usize, S, St, F, G, Sf>(
+pub fn sweep<const N: usize, S, St, F, G, Sf, Fe>(
     config: &SweepConfig,
     make: F,
     stepper: G,
@@ -564,7 +567,8 @@ pub fn sweep<const N: usize, S, St, F, G, Sf>(
 where
     S: Dynamics<f64, N> + Send,
     St: Stepper<f64, N>,
-    F: Fn(f64) -> crate::Result<SweepSystem<S, Sf>> + Sync,
+    F: Fn(f64) -> Result<SweepSystem<S, Sf>, Fe> + Sync,
+    Fe: Into<RunFailure>,
     G: Fn() -> St + Sync,
     Sf: Surface<f64, N> + Clone + Send,
 {

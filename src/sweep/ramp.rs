@@ -4,7 +4,7 @@ use nalgebra::SVector;
 
 use super::{Stop, StopEvent, SweepError};
 use crate::Dynamics;
-use crate::drive::Simulation;
+use crate::drive::{RunError, Simulation};
 use crate::event::{Direction, Event};
 use crate::excite::Excitation;
 use crate::integrate::Stepper;
@@ -99,12 +99,12 @@ where
     St: Stepper<f64, N>,
     E: Excitation<f64> + Clone,
 {
-    let fail = |e: crate::Error| SweepError::failed(f64::NAN, e);
+    let fail = |e: RunError| SweepError::failed(f64::NAN, e);
     let ev = Event::new(StopEvent(Some(stop)), Direction::Rising);
     let mut sim = Simulation::new(system, stepper)
         .with_events(ev)
         .max_steps(usize::MAX)
-        .map_err(fail)?;
+        .map_err(|e| fail(e.into()))?;
     let cap = capacity;
     let mut strobe = Stroboscopic::<f64, N, _>::new(PhaseClock(excitation.clone()), 0.0, cap)
         .map_err(|e| fail(e.into()))?;
