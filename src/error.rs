@@ -36,10 +36,10 @@ pub enum Error {
     Sweep(#[from] crate::sweep::SweepError),
     /// A Lyapunov estimate failed.
     #[error(transparent)]
-    Lyapunov(#[from] crate::lyapunov::LyapunovError),
+    Lyapunov(crate::lyapunov::LyapunovError),
     /// A periodic orbit could not be computed.
     #[error(transparent)]
-    Orbit(#[from] crate::orbit::OrbitError),
+    Orbit(crate::orbit::OrbitError),
     /// An entropy estimate failed.
     #[error(transparent)]
     Entropy(#[from] crate::entropy::EntropyError),
@@ -73,18 +73,79 @@ impl From<crate::drive::RunError> for Error {
     }
 }
 
-impl From<Error> for crate::sweep::RunFailure {
-    /// The module error inside `e` (a sweep's run failed with it), or its message.
-    fn from(e: Error) -> Self {
-        use crate::sweep::RunFailure;
+impl From<crate::lyapunov::LyapunovError> for Error {
+    /// A failed run inside the estimate as the run's error itself, the rest as
+    /// [`Error::Lyapunov`].
+    fn from(e: crate::lyapunov::LyapunovError) -> Self {
         match e {
-            Error::Parameter(e) => RunFailure::Parameter(e),
-            Error::Model(e) => RunFailure::Model(e),
-            Error::Root(e) => RunFailure::Root(e),
-            Error::Integrate(e) => RunFailure::Integrate(e),
-            Error::Event(e) => RunFailure::Event(e),
-            Error::Mode(e) => RunFailure::Mode(e),
-            other => RunFailure::Other(other.to_string()),
+            crate::lyapunov::LyapunovError::Run(e) => e.into(),
+            e => Error::Lyapunov(e),
+        }
+    }
+}
+
+impl From<crate::orbit::OrbitError> for Error {
+    /// A failed run (or variational set-up) inside the orbit computation as that error
+    /// itself, the rest as [`Error::Orbit`].
+    fn from(e: crate::orbit::OrbitError) -> Self {
+        match e {
+            crate::orbit::OrbitError::Run(e) => e.into(),
+            crate::orbit::OrbitError::Lyapunov(e) => e.into(),
+            e => Error::Orbit(e),
+        }
+    }
+}
+
+impl Error {
+    /// The run's error inside `self`, if it is one of the engine's (parameters, roots,
+    /// models, integration, events, modes).
+    fn into_run(self) -> std::result::Result<crate::drive::RunError, Self> {
+        use crate::drive::RunError;
+        match self {
+            Error::Parameter(e) => Ok(RunError::Parameter(e)),
+            Error::Root(e) => Ok(RunError::Root(e)),
+            Error::Model(e) => Ok(RunError::Model(e)),
+            Error::Integrate(e) => Ok(RunError::Integrate(e)),
+            Error::Event(e) => Ok(RunError::Event(e)),
+            Error::Mode(e) => Ok(RunError::Mode(e)),
+            other => Err(other),
+        }
+    }
+}
+
+impl From<Error> for crate::lyapunov::LyapunovError {
+    /// For a system builder that returns the crate's `Result`: the engine's errors as
+    /// `Run`, a Lyapunov error as itself, the rest by message as `Build`.
+    fn from(e: Error) -> Self {
+        use crate::lyapunov::LyapunovError;
+        match e.into_run() {
+            Ok(e) => LyapunovError::Run(e),
+            Err(Error::Lyapunov(e)) => e,
+            Err(other) => LyapunovError::Build(other.to_string()),
+        }
+    }
+}
+
+impl From<Error> for crate::orbit::OrbitError {
+    /// For a problem builder that returns the crate's `Result`: the engine's errors as
+    /// `Run`, orbit and Lyapunov errors as themselves, the rest by message as `Build`.
+    fn from(e: Error) -> Self {
+        use crate::orbit::OrbitError;
+        match e.into_run() {
+            Ok(e) => OrbitError::Run(e),
+            Err(Error::Orbit(e)) => e,
+            Err(Error::Lyapunov(e)) => OrbitError::Lyapunov(e),
+            Err(other) => OrbitError::Build(other.to_string()),
+        }
+    }
+}
+
+impl From<Error> for crate::sweep::RunFailure {
+    /// The engine's error inside `e` (a sweep's run failed with it), or its message.
+    fn from(e: Error) -> Self {
+        match e.into_run() {
+            Ok(e) => e.into(),
+            Err(other) => crate::sweep::RunFailure::Other(other.to_string()),
         }
     }
 }

@@ -84,7 +84,7 @@ fn sweep(omegas: &[f64]) -> Vec<f64> {
 #[test]
 fn duffing_frequency_response_two_folds() {
     let tol = tol();
-    let build = |w: f64| -> nonsmooth::Result<_> {
+    let build = |w: f64| {
         Ok(Shooting::new(
             duffing(w)?,
             (),
@@ -189,7 +189,7 @@ fn paper_period_one_orbit_first_grazing() {
 
     use nonsmooth::systems::paper::PAPER;
     let tol = Tolerances::per_component(1e-10, [1e-14, 1e-12]).unwrap();
-    let build = |w: f64| -> nonsmooth::Result<_> {
+    let build = |w: f64| {
         Ok(Shooting::new(
             PAPER.oscillator::<f64>(w)?,
             (),
@@ -272,7 +272,7 @@ fn double_well(gamma: f64) -> nonsmooth::Result<DoubleWell> {
 fn double_well_duffing_period_doubling_cascade() {
     use nonsmooth::orbit::period_doubled;
     let tol = tol();
-    let build = |g: f64| -> nonsmooth::Result<_> {
+    let build = |g: f64| {
         Ok(Shooting::new(
             double_well(g)?,
             (),
@@ -425,7 +425,7 @@ fn contact_changes_of_a_two_harmonic_response_match_the_closed_form() {
         exact.push(0.5 * (lo + hi));
     }
     let tol = Tolerances::new(1e-11, 1e-13).unwrap();
-    let build = |a: f64| -> nonsmooth::Result<_> {
+    let build = |a: f64| {
         let model = Mechanical::<f64, 1, 2>::with_masses([1.0])?
             .with_elements(Element::on_dof(
                 0,

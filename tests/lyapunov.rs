@@ -3,6 +3,8 @@
 //! QR against two trajectories, the `d0` study), the Fig. 5 diagram, and bad input.
 
 use nalgebra::{Matrix2, SVector, Vector2, Vector3};
+use nonsmooth::Dynamics;
+use nonsmooth::drive::RunError;
 use nonsmooth::integrate::{Dopri5, Stepper, Tolerances};
 use nonsmooth::lyapunov::{
     DiagramSettings, IntervalRule, LyapunovError, Norm, PAPER_D0, TangentSpace, TwoTrajectory,
@@ -10,7 +12,6 @@ use nonsmooth::lyapunov::{
 };
 use nonsmooth::systems::paper::PAPER;
 use nonsmooth::testing::{DampedOscillator, Lorenz};
-use nonsmooth::{Dynamics, Error};
 
 const TAU: f64 = std::f64::consts::TAU;
 
@@ -318,7 +319,10 @@ fn exact_contact_law_needs_the_two_trajectory_method() {
         TangentSpace::<f64, 2, 2, 6, _, _>::new(osc, Dopri5::new(tol6), Norm::paper()).unwrap();
     qr.start(0.0, y).unwrap();
     let r = qr.transient(tau, 20).and_then(|_| qr.estimate(tau, 100));
-    assert!(matches!(r, Err(Error::Integrate(_))), "{r:?}");
+    assert!(
+        matches!(r, Err(LyapunovError::Run(RunError::Integrate(_)))),
+        "{r:?}"
+    );
     let tol4 = pair_tolerances::<f64, 2, 4>(&paper_tol()).unwrap();
     let mut tt =
         TwoTrajectory::<f64, 2, 4, _, _>::new(osc, Dopri5::new(tol4), PAPER_D0, Norm::paper())
@@ -469,13 +473,6 @@ fn diagram_is_a_continuation_in_both_directions() {
 // Bad input.
 // ---------------------------------------------------------------------------------------
 
-fn lyap(e: Error) -> LyapunovError {
-    match e {
-        Error::Lyapunov(l) => l,
-        other => panic!("not a Lyapunov error: {other}"),
-    }
-}
-
 #[test]
 fn bad_input_gives_clear_errors() {
     let osc = DampedOscillator::new(1.0, 0.1).unwrap();
@@ -483,7 +480,7 @@ fn bad_input_gives_clear_errors() {
     // Non-finite or non-positive d0.
     for d0 in [0.0, -1e-6, f64::NAN, f64::INFINITY] {
         let r = TwoTrajectory::<f64, 2, 4, _, _>::new(osc, Dopri5::new(tol4), d0, Norm::Euclidean);
-        let e = lyap(r.unwrap_err());
+        let e = r.unwrap_err();
         assert!(matches!(e, LyapunovError::InvalidSeparation { .. }), "{e}");
         assert!(e.to_string().contains("d0"));
     }
@@ -494,7 +491,7 @@ fn bad_input_gives_clear_errors() {
         1e-6,
         Norm::Euclidean,
     );
-    let e = lyap(r.unwrap_err());
+    let e = r.unwrap_err();
     assert_eq!(
         e,
         LyapunovError::Dimension {
@@ -511,7 +508,7 @@ fn bad_input_gives_clear_errors() {
         Norm::Euclidean,
     );
     assert!(matches!(
-        lyap(r.unwrap_err()),
+        r.unwrap_err(),
         LyapunovError::Dimension { expected: 6, .. }
     ));
     // Bad weights.
@@ -522,22 +519,21 @@ fn bad_input_gives_clear_errors() {
         Norm::Weighted([1.0, 0.0]),
     );
     assert!(matches!(
-        lyap(r.unwrap_err()),
+        r.unwrap_err(),
         LyapunovError::InvalidWeight { index: 1, .. }
     ));
     // Non-finite state and time.
     let mut est =
         TwoTrajectory::<f64, 2, 4, _, _>::new(osc, Dopri5::new(tol4), 1e-6, Norm::Euclidean)
             .unwrap();
-    let e = lyap(est.start(0.0, Vector2::new(f64::NAN, 0.0)).unwrap_err());
+    let e = est.start(0.0, Vector2::new(f64::NAN, 0.0)).unwrap_err();
     assert!(
         matches!(e, LyapunovError::NonFinite { what: "y0[0]", .. }),
         "{e}"
     );
-    let e = lyap(
-        est.start(f64::INFINITY, Vector2::new(0.0, 0.0))
-            .unwrap_err(),
-    );
+    let e = est
+        .start(f64::INFINITY, Vector2::new(0.0, 0.0))
+        .unwrap_err();
     assert!(
         matches!(e, LyapunovError::NonFinite { what: "t0", .. }),
         "{e}"
@@ -545,12 +541,12 @@ fn bad_input_gives_clear_errors() {
     // Zero intervals (and one: no spread).
     est.start(0.0, Vector2::new(1.0, 0.0)).unwrap();
     for n in [0, 1] {
-        let e = lyap(est.estimate(1.0, n).unwrap_err());
+        let e = est.estimate(1.0, n).unwrap_err();
         assert!(matches!(e, LyapunovError::TooFewIntervals { .. }), "{e}");
     }
     // Bad interval.
     for tau in [0.0, -1.0, f64::NAN] {
-        let e = lyap(est.estimate(tau, 10).unwrap_err());
+        let e = est.estimate(tau, 10).unwrap_err();
         assert!(matches!(e, LyapunovError::InvalidInterval { .. }), "{e}");
     }
     // The QR method without a Jacobian.
@@ -567,14 +563,14 @@ fn bad_input_gives_clear_errors() {
             .unwrap();
     let mut qr =
         TangentSpace::<f64, 2, 2, 6, _, _>::new(NoJac, Dopri5::new(tol6), Norm::Euclidean).unwrap();
-    let e = lyap(qr.start(0.0, Vector2::new(1.0, 0.0)).unwrap_err());
+    let e = qr.start(0.0, Vector2::new(1.0, 0.0)).unwrap_err();
     assert!(matches!(e, LyapunovError::NoJacobian { .. }), "{e}");
     // Diagram: empty list, bad values.
     let settings = DiagramSettings::new(IntervalRule::ForcingPeriod, 1, 1, 10).unwrap();
     let make = |w: f64| Ok(PAPER.oscillator::<f64>(w)?);
     let st = Dopri5::new(pair_tolerances::<f64, 2, 4>(&paper_tol()).unwrap());
     let e = tle_diagram(make, &st, rest(), &[], PAPER_D0, Norm::paper(), &settings).unwrap_err();
-    assert_eq!(lyap(e), LyapunovError::NoParameters);
+    assert_eq!((e), LyapunovError::NoParameters);
     for bad in [f64::NAN, 0.0, -20.0] {
         let e = tle_diagram(
             make,
@@ -586,7 +582,7 @@ fn bad_input_gives_clear_errors() {
             &settings,
         )
         .unwrap_err();
-        assert!(matches!(lyap(e), LyapunovError::InvalidParameter { .. }));
+        assert!(matches!(e, LyapunovError::InvalidParameter { .. }));
     }
     let e = tle_diagram(
         make,
@@ -598,7 +594,7 @@ fn bad_input_gives_clear_errors() {
         &settings,
     )
     .unwrap_err();
-    assert!(matches!(lyap(e), LyapunovError::InvalidSeparation { .. }));
+    assert!(matches!(e, LyapunovError::InvalidSeparation { .. }));
     // Study: invalid d0 anywhere in the list is rejected up front.
     let e = separation_study(
         &osc,
@@ -612,6 +608,6 @@ fn bad_input_gives_clear_errors() {
         10,
     )
     .unwrap_err();
-    assert!(matches!(lyap(e), LyapunovError::InvalidSeparation { .. }));
+    assert!(matches!(e, LyapunovError::InvalidSeparation { .. }));
     assert_eq!(decades::<f64>(-2, -1, 1).len(), 2);
 }

@@ -250,7 +250,6 @@ fn impact_oscillator_orbit_through_restitution() {
 
 #[test]
 fn invalid_settings_are_errors() {
-    use nonsmooth::Error;
     use nonsmooth::orbit::{ContinuationSettings, Extremum, OrbitError, follow};
     let tol = Tolerances::new(1e-9, 1e-11).unwrap();
     let shooting = Shooting::new(
@@ -262,7 +261,7 @@ fn invalid_settings_are_errors() {
     for period in [0.0, -1.0, f64::NAN, f64::INFINITY] {
         assert!(matches!(
             shooting.find(0.0, period, y),
-            Err(Error::Orbit(OrbitError::InvalidSetting { .. }))
+            Err(OrbitError::InvalidSetting { .. })
         ));
     }
     assert!(shooting.clone().with_max_iterations(0).is_err());
@@ -270,7 +269,7 @@ fn invalid_settings_are_errors() {
     assert!(shooting.clone().with_newton_tolerance(f64::NAN).is_err());
     assert!(matches!(
         shooting.extremum(0.0, 1.0, y, 2, Extremum::Min),
-        Err(Error::Orbit(OrbitError::InvalidSetting { .. }))
+        Err(OrbitError::InvalidSetting { .. })
     ));
     // One Newton iteration from far away does not converge: a clear error, not a wrong orbit.
     let once = shooting.clone().with_max_iterations(1).unwrap();
@@ -280,7 +279,7 @@ fn invalid_settings_are_errors() {
             std::f64::consts::TAU / OMEGA,
             SVector::from([5.0, 5.0])
         ),
-        Err(Error::Orbit(OrbitError::NotConverged { .. }))
+        Err(OrbitError::NotConverged { .. })
     ));
     assert!(ContinuationSettings::new(1.0, 0.0, 0.1).is_err());
     assert!(ContinuationSettings::new(0.0, 1.0, 0.0).is_err());
@@ -292,7 +291,7 @@ fn invalid_settings_are_errors() {
     assert!(s.clone().with_scales(vec![1.0, 0.0], 1.0).is_err());
     // Scales for the wrong number of components.
     let wrong = s.with_scales(vec![1.0], 1.0).unwrap();
-    let build = |w: f64| -> nonsmooth::Result<_> {
+    let build = |w: f64| {
         Ok(Shooting::new(
             duffing_at(w),
             (),
@@ -301,7 +300,7 @@ fn invalid_settings_are_errors() {
     };
     assert!(matches!(
         follow(build, |w| std::f64::consts::TAU / w, 0.0, 0.5, y, &wrong),
-        Err(Error::Orbit(OrbitError::InvalidSetting { .. }))
+        Err(OrbitError::InvalidSetting { .. })
     ));
 }
 

@@ -3,6 +3,7 @@
 //! documented no-ops instead of panics, and invalid settings are rejected by name.
 
 use nalgebra::{Matrix2, SVector, Vector2};
+use nonsmooth::ForceLaw;
 use nonsmooth::drive::Simulation;
 use nonsmooth::event::{EventFunction, Level, ResetMap, Restitution};
 use nonsmooth::excite::{Excitation, Harmonic, RampedRotor, UnbalancedRotor};
@@ -13,7 +14,6 @@ use nonsmooth::lyapunov::tangent_tolerances;
 use nonsmooth::model::{Element, Load, Mechanical, ModelError};
 use nonsmooth::orbit::{ContinuationSettings, Extremum, Grazing, OrbitError, Shooting, follow};
 use nonsmooth::sample::{Regime, detect_period, try_detect_period};
-use nonsmooth::{Error, ForceLaw};
 
 /// Defect 1: `Level::value`/`rate` and `Restitution::apply` with a component index beyond
 /// the state panicked ("Matrix index out of bounds") when called directly.
@@ -423,7 +423,7 @@ fn continuation_rejects_a_nan_grazing_level() {
             .with_loads(Load::on_dof(0, Harmonic::cosine(0.5, w)?)?))
     };
     let tol = Tolerances::new(1e-10, 1e-12).unwrap();
-    let build = |w: f64| -> nonsmooth::Result<_> {
+    let build = |w: f64| {
         Ok(Shooting::new(
             model(w)?,
             (),
@@ -449,7 +449,7 @@ fn continuation_rejects_a_nan_grazing_level() {
                 .with_contact_changes(g),
         ] {
             match follow(build, period, 0.0, 0.5, SVector::zeros(), &s) {
-                Err(Error::Orbit(OrbitError::InvalidSetting { what, value, .. })) => {
+                Err(OrbitError::InvalidSetting { what, value, .. }) => {
                     assert!(what.contains("grazing"), "{what}");
                     assert!(value.is_nan() == level.is_nan() || value == component as f64);
                 }

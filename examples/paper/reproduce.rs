@@ -146,9 +146,7 @@ pub fn first_grazing_continuation(rtol: f64) -> Res<f64> {
     use nonsmooth::orbit::{BifurcationKind, ContinuationSettings, Shooting, follow};
     let tol = tolerances(rtol);
     let tangent = tangent_tolerances::<f64, 2, 2, 6>(&tol, rtol, rtol * 1e-2)?;
-    let build = |w: f64| -> nonsmooth::Result<_> {
-        Ok(Shooting::new(PAPER.oscillator::<f64>(w)?, (), tangent))
-    };
+    let build = |w: f64| Ok(Shooting::new(PAPER.oscillator::<f64>(w)?, (), tangent));
     let settings = ContinuationSettings::new(13.0, 14.3, 0.005)?
         .with_max_step(0.2)?
         .with_grazing(PAPER.grazing());
@@ -187,9 +185,7 @@ pub fn window_branch(
     use nonsmooth::sample::Stroboscopic;
     let tol = tolerances(rtol);
     let tangent = tangent_tolerances::<f64, 2, 2, 6>(&tol, rtol, rtol * 1e-2)?;
-    let build = |w: f64| -> nonsmooth::Result<_> {
-        Ok(Shooting::new(PAPER.oscillator::<f64>(w)?, (), tangent))
-    };
+    let build = |w: f64| Ok(Shooting::new(PAPER.oscillator::<f64>(w)?, (), tangent));
     let period = |w: f64| f64::from(k) * TAU / w;
     let mut sim = Simulation::new(PAPER.oscillator::<f64>(omega)?, Dopri5::new(tol));
     let mut none = Stroboscopic::<f64, 2>::periodic(0.0, TAU / omega, 0.0, 1)?;
@@ -205,7 +201,7 @@ pub fn window_branch(
     if !upward {
         settings = settings.downward();
     }
-    follow(build, period, 0.0, omega, orbit.state, &settings)
+    Ok(follow(build, period, 0.0, omega, orbit.state, &settings)?)
 }
 
 /// One frequency from rest with the paper's transients (100) and `record` periods.
@@ -315,7 +311,7 @@ pub fn tle_fig5(
         periods,
     )?;
     let tol = pair_tolerances::<f64, 2, 4>(&tolerances(rtol))?;
-    tle_diagram(
+    Ok(tle_diagram(
         |w: f64| Ok(PAPER.oscillator::<f64>(w)?),
         &Dopri5::new(tol),
         rest()?,
@@ -323,7 +319,7 @@ pub fn tle_fig5(
         PAPER_D0,
         Norm::paper(),
         &settings,
-    )
+    )?)
 }
 
 /// A synthetic experiment at ω = 17 rad/s (`duration` s at 1 kHz, σ = 2 µm noise and a

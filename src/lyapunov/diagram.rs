@@ -2,11 +2,11 @@
 
 use nalgebra::SVector;
 
+use super::Result;
 use super::{
     DEFAULT_BLOCKS, LyapunovError, Norm, TwoTrajectory, check_blocks, check_interval,
     check_intervals,
 };
-use crate::error::Result;
 use crate::integrate::{Stats, Stepper};
 use crate::scalar::{lit, to_f64};
 use crate::{Dynamics, Real};
@@ -246,22 +246,20 @@ where
     F: Fn(T) -> Result<S> + Sync,
 {
     if values.is_empty() {
-        return Err(LyapunovError::NoParameters.into());
+        return Err(LyapunovError::NoParameters);
     }
     for &p in values {
         if !p.is_finite() {
             return Err(LyapunovError::InvalidParameter {
                 value: to_f64(p),
                 requirement: "must be finite",
-            }
-            .into());
+            });
         }
         if settings.interval == IntervalRule::ForcingPeriod && !(p > T::zero()) {
             return Err(LyapunovError::InvalidParameter {
                 value: to_f64(p),
                 requirement: "must be > 0 (an angular forcing frequency) with IntervalRule::ForcingPeriod",
-            }
-            .into());
+            });
         }
     }
     check_intervals(settings.intervals, 2)?;
@@ -270,8 +268,7 @@ where
         return Err(LyapunovError::NonFinite {
             what: "t0",
             value: to_f64(settings.t0),
-        }
-        .into());
+        });
     }
     // Validate everything that can be validated before spending time on a branch.
     super::two_trajectory::check_pair_settings::<T, N, M>(d0, &norm)?;

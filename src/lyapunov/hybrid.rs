@@ -25,12 +25,12 @@
 
 use nalgebra::{SMatrix, SVector};
 
+use super::Result;
 use super::{
     DEFAULT_BLOCKS, Estimate, LyapunovError, Norm, Spectrum, Variational, block_standard_error,
     check_blocks, check_interval, check_intervals, check_state,
 };
 use crate::drive::{Control, EventRecord, Observer, Simulation};
-use crate::error::Result;
 use crate::event::{Direction, EventError, EventSet};
 use crate::integrate::{Stats, Stepper};
 use crate::linalg::gram_schmidt;
@@ -76,7 +76,7 @@ where
     /// [`LyapunovError::InvalidSeparation`] unless `d0` is finite and > 0; a bad norm.
     pub fn new(system: S, stepper: St, events: E, d0: T, norm: Norm<T, N>) -> Result<Self> {
         if !(d0.is_finite() && d0 > T::zero()) {
-            return Err(LyapunovError::InvalidSeparation { d0: to_f64(d0) }.into());
+            return Err(LyapunovError::InvalidSeparation { d0: to_f64(d0) });
         }
         norm.validate()?;
         let reference =
@@ -115,8 +115,7 @@ where
             return Err(LyapunovError::UnresolvedSeparation {
                 d0: to_f64(self.d0),
                 realized: to_f64(realized),
-            }
-            .into());
+            });
         }
         self.state = Some((t0, y0, z));
         Ok(())
@@ -145,8 +144,7 @@ where
                 return Err(LyapunovError::SeparationLost {
                     t: to_f64(t1),
                     separation: f64::INFINITY,
-                }
-                .into());
+                });
             }
             let t2 = t1 + step;
             let oy = self.reference.run(t1, y1, t2, &mut cy)?;
@@ -164,8 +162,7 @@ where
             return Err(LyapunovError::SeparationLost {
                 t: to_f64(t1),
                 separation: to_f64(d),
-            }
-            .into());
+            });
         }
         self.state = Some((t1, y1, y1 + delta * (self.d0 / d)));
         Ok(((d / self.d0).ln(), t1 - t))
@@ -396,7 +393,7 @@ where
     pub fn start(&mut self, t0: T, y0: SVector<T, N>) -> Result<()> {
         check_state(t0, &y0)?;
         if self.sim.system().system().jacobian(t0, &y0).is_none() {
-            return Err(LyapunovError::NoJacobian { t: to_f64(t0) }.into());
+            return Err(LyapunovError::NoJacobian { t: to_f64(t0) });
         }
         let mut psi = SMatrix::<T, N, K>::zeros();
         for c in 0..K {
@@ -419,8 +416,7 @@ where
                     t: to_f64(out.t),
                     index: c,
                     value: to_f64(r[c]),
-                }
-                .into());
+                });
             }
             *l = r[c].ln();
         }

@@ -139,8 +139,13 @@ pub use two_trajectory::{
 use nalgebra::SVector;
 use thiserror::Error;
 
+use crate::drive::{ModeError, RunError};
+use crate::event::EventError;
 use crate::integrate::{IntegrateError, Stats, Stepper};
+use crate::model::ModelError;
+use crate::roots::RootError;
 use crate::scalar::{lit, to_f64};
+use crate::validate::ParameterError;
 use crate::{Dynamics, Real};
 
 /// Errors of this module.
@@ -276,7 +281,37 @@ pub enum LyapunovError {
         /// What it must satisfy.
         requirement: &'static str,
     },
+    /// A run failed (a rejected setting, the integration, the events), or the system could
+    /// not be built. Converts into the crate's [`Error`](crate::Error) as the run's error
+    /// itself (`Error::Integrate(..)`, …).
+    #[error(transparent)]
+    Run(#[from] RunError),
+    /// A builder of the system at a parameter value failed with an error of another layer
+    /// (its message).
+    #[error("building the system failed: {0}")]
+    Build(String),
 }
+
+/// `Result` with [`LyapunovError`].
+pub(crate) type Result<T, E = LyapunovError> = std::result::Result<T, E>;
+
+macro_rules! via_run {
+    ($($err:ty),+) => {$(
+        impl From<$err> for LyapunovError {
+            fn from(e: $err) -> Self {
+                LyapunovError::Run(e.into())
+            }
+        }
+    )+};
+}
+via_run!(
+    ParameterError,
+    RootError,
+    ModelError,
+    IntegrateError,
+    EventError,
+    ModeError
+);
 
 /// Default number of blocks for the standard error.
 pub const DEFAULT_BLOCKS: usize = 10;
@@ -525,9 +560,9 @@ pub(crate) fn check_blocks(blocks: usize) -> Result<usize, LyapunovError> {
 }
 
 /// Validates a per-interval step cap.
-pub(crate) fn check_max_steps(max_steps: usize) -> crate::Result<usize> {
+pub(crate) fn check_max_steps(max_steps: usize) -> Result<usize> {
     if max_steps == 0 {
-        return Err(crate::ParameterError::new("max_steps", 0.0, ">= 1").into());
+        return Err(ParameterError::new("max_steps", 0.0, ">= 1").into());
     }
     Ok(max_steps)
 }
@@ -596,16 +631,15 @@ pub(crate) fn set_clock<T: Real, const M: usize, St: crate::integrate::Stepper<T
     stepper: &mut St,
     started: bool,
     t0: T,
-) -> crate::Result<()> {
+) -> Result<()> {
     if !t0.is_finite() {
         return Err(LyapunovError::NonFinite {
             what: "t0",
             value: crate::scalar::to_f64(t0),
-        }
-        .into());
+        });
     }
     if !started {
-        return Err(LyapunovError::NotStarted.into());
+        return Err(LyapunovError::NotStarted);
     }
     let z = *stepper.current().1;
     stepper.reset_state(t0, z);

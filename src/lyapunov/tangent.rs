@@ -2,11 +2,11 @@
 
 use nalgebra::{SMatrix, SVector};
 
+use super::Result;
 use super::{
     DEFAULT_BLOCKS, DEFAULT_MAX_STEPS_PER_INTERVAL, LyapunovError, Norm, block_standard_error,
     check_blocks, check_interval_at, check_intervals, check_state, grid_time, integrate_to,
 };
-use crate::error::Result;
 use crate::integrate::{Stats, Stepper, Tolerances};
 use crate::linalg::gram_schmidt;
 use crate::scalar::{lit, nan, to_f64};
@@ -355,7 +355,7 @@ where
     pub fn start(&mut self, t0: T, y0: SVector<T, N>) -> Result<()> {
         check_state(t0, &y0)?;
         if self.var.system().jacobian(t0, &y0).is_none() {
-            return Err(LyapunovError::NoJacobian { t: to_f64(t0) }.into());
+            return Err(LyapunovError::NoJacobian { t: to_f64(t0) });
         }
         let psi = SMatrix::<T, N, K>::identity();
         self.stepper.reset_state(t0, self.var.join(&y0, &psi));
@@ -478,7 +478,7 @@ where
         mut sink: impl FnMut(usize, [T; K]),
     ) -> Result<()> {
         if !self.started {
-            return Err(LyapunovError::NotStarted.into());
+            return Err(LyapunovError::NotStarted);
         }
         let t_start = self.stepper.current().0;
         for k in 0..intervals {
@@ -498,8 +498,7 @@ where
                         t: to_f64(t_k),
                         index: j,
                         value: to_f64(r[j]),
-                    }
-                    .into());
+                    });
                 }
                 s[j] = r[j].ln() / tau;
             }
@@ -639,13 +638,7 @@ mod tests {
         qr.transient(1.0, 2).unwrap();
         let r = qr.estimate(1.0, 2);
         assert!(
-            matches!(
-                r,
-                Err(crate::Error::Lyapunov(LyapunovError::TangentCollapse {
-                    index: 1,
-                    ..
-                }))
-            ),
+            matches!(r, Err(LyapunovError::TangentCollapse { index: 1, .. })),
             "{r:?}"
         );
     }
@@ -677,11 +670,11 @@ mod tests {
                 .unwrap();
         assert!(matches!(
             qr.start(0.0, Vector2::new(1.0, 0.0)),
-            Err(crate::Error::Lyapunov(LyapunovError::NoJacobian { .. }))
+            Err(LyapunovError::NoJacobian { .. })
         ));
         assert!(matches!(
             qr.estimate(1.0, 5),
-            Err(crate::Error::Lyapunov(LyapunovError::NotStarted))
+            Err(LyapunovError::NotStarted)
         ));
         let mut qr = TangentSpace::<f64, 2, 2, 6, _, _>::new(
             Diag(1.0, 1.0),

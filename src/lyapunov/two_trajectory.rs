@@ -2,12 +2,12 @@
 
 use nalgebra::{SMatrix, SVector};
 
+use super::Result;
 use super::{
     DEFAULT_BLOCKS, DEFAULT_MAX_STEPS_PER_INTERVAL, Estimate, LyapunovError, Norm,
     block_standard_error, check_blocks, check_interval, check_interval_at, check_intervals,
     check_state, grid_time, integrate_to,
 };
-use crate::error::Result;
 use crate::integrate::{Stepper, Tolerances};
 use crate::scalar::{lit, to_f64};
 use crate::{Dynamics, Real};
@@ -269,7 +269,7 @@ where
     pub fn with_direction(mut self, direction: SVector<T, N>) -> Result<Self> {
         let n = self.norm.norm(&direction);
         if !(n.is_finite() && n > T::zero() && direction.iter().all(|v| v.is_finite())) {
-            return Err(LyapunovError::InvalidDirection.into());
+            return Err(LyapunovError::InvalidDirection);
         }
         self.direction = direction / n;
         Ok(self)
@@ -307,8 +307,7 @@ where
             return Err(LyapunovError::UnresolvedSeparation {
                 d0: to_f64(self.d0),
                 realized: to_f64(realized),
-            }
-            .into());
+            });
         }
         self.stepper.reset_state(t0, self.pair.join(&y0, &y1));
         self.started = true;
@@ -423,7 +422,7 @@ where
         mut sink: impl FnMut(usize, T),
     ) -> Result<()> {
         if !self.started {
-            return Err(LyapunovError::NotStarted.into());
+            return Err(LyapunovError::NotStarted);
         }
         let t_start = self.stepper.current().0;
         // The separation at the start of the current interval (d0 up to rounding).
@@ -442,8 +441,7 @@ where
                 return Err(LyapunovError::SeparationLost {
                     t: to_f64(t_k),
                     separation: to_f64(d),
-                }
-                .into());
+                });
             }
             sink(k, (d / d_start).ln() / tau);
             let b_new = a + delta * (self.d0 / d);
@@ -452,8 +450,7 @@ where
                 return Err(LyapunovError::UnresolvedSeparation {
                     d0: to_f64(self.d0),
                     realized: to_f64(d_start),
-                }
-                .into());
+                });
             }
             self.stepper.reset_state(t_k, self.pair.join(&a, &b_new));
         }
@@ -646,44 +643,33 @@ mod tests {
         for d0 in [0.0, -1e-6, f64::NAN, f64::INFINITY] {
             assert!(matches!(
                 mk(d0),
-                Err(crate::Error::Lyapunov(
-                    LyapunovError::InvalidSeparation { .. }
-                ))
+                Err(LyapunovError::InvalidSeparation { .. })
             ));
         }
         let mut est = mk(1e-6).unwrap();
         assert!(matches!(
             est.estimate(1.0, 10),
-            Err(crate::Error::Lyapunov(LyapunovError::NotStarted))
+            Err(LyapunovError::NotStarted)
         ));
         assert!(matches!(
             est.start(0.0, SVector::<f64, 1>::new(f64::NAN)),
-            Err(crate::Error::Lyapunov(LyapunovError::NonFinite {
-                what: "y0[0]",
-                ..
-            }))
+            Err(LyapunovError::NonFinite { what: "y0[0]", .. })
         ));
         // d0 far below the rounding of the state.
         assert!(matches!(
             est.start(0.0, SVector::<f64, 1>::new(1e12)),
-            Err(crate::Error::Lyapunov(
-                LyapunovError::UnresolvedSeparation { .. }
-            ))
+            Err(LyapunovError::UnresolvedSeparation { .. })
         ));
         est.start(0.0, SVector::<f64, 1>::new(1.0)).unwrap();
         for n in [0, 1] {
             assert!(matches!(
                 est.estimate(1.0, n),
-                Err(crate::Error::Lyapunov(
-                    LyapunovError::TooFewIntervals { .. }
-                ))
+                Err(LyapunovError::TooFewIntervals { .. })
             ));
         }
         assert!(matches!(
             est.estimate(0.0, 5),
-            Err(crate::Error::Lyapunov(
-                LyapunovError::InvalidInterval { .. }
-            ))
+            Err(LyapunovError::InvalidInterval { .. })
         ));
         assert!(est.transient(1.0, 0).is_ok());
         assert!(
@@ -723,10 +709,7 @@ mod tests {
         assert!((est.norm().norm(&est.separation()) - 1e-3).abs() < 1e-15);
         let r = est.estimate(1.0, 4);
         assert!(
-            matches!(
-                r,
-                Err(crate::Error::Lyapunov(LyapunovError::SeparationLost { .. }))
-            ),
+            matches!(r, Err(LyapunovError::SeparationLost { .. })),
             "{r:?}"
         );
     }

@@ -41,7 +41,7 @@
 //!
 //! let zeta = 0.1;
 //! let tol = Tolerances::new(1e-10, 1e-12)?;
-//! let build = |w: f64| -> nonsmooth::Result<_> {
+//! let build = |w: f64| {
 //!     let model = Mechanical::<f64, 1, 2>::with_masses([1.0])?
 //!         .with_elements(Element::on_dof(0, (LinearSpring::new(1.0)?, ViscousDamper::new(2.0 * zeta)?))?)
 //!         .with_loads(Load::on_dof(0, Harmonic::cosine(1.0, w)?)?);
@@ -64,9 +64,9 @@
 
 use nalgebra::{Complex, DMatrix, DVector, SMatrix, SVector};
 
+use super::Result;
 use super::{Extremum, OrbitError, Shooting, modulus, multipliers};
 use crate::Dynamics;
-use crate::error::Result;
 use crate::event::EventSet;
 
 /// A grazing test: the orbit's [`Extremum`] of `component` minus `level`.
@@ -222,13 +222,12 @@ impl ContinuationSettings {
     }
 }
 
-fn invalid(what: &'static str, requirement: &'static str, value: f64) -> crate::Error {
+fn invalid(what: &'static str, requirement: &'static str, value: f64) -> OrbitError {
     OrbitError::InvalidSetting {
         what,
         requirement,
         value,
     }
-    .into()
 }
 
 /// The kind of a located bifurcation.
@@ -334,8 +333,7 @@ where
         iterations: 0,
         step: f64::NAN,
         residual: f64::NAN,
-    }
-    .into())
+    })
 }
 
 /// A point of a branch.
@@ -523,8 +521,7 @@ where
             iterations: 10,
             step: f64::NAN,
             residual: f64::NAN,
-        }
-        .into())
+        })
     }
 
     /// The point at a converged `u`: tangent, multipliers, tests.

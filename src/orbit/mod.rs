@@ -61,13 +61,16 @@ use nalgebra::{Complex, DMatrix, SMatrix, SVector};
 
 use crate::Real;
 use crate::drive::Simulation;
+use crate::drive::{ModeError, RunError};
 use crate::dynamics::Dynamics;
-use crate::error::Result;
-use crate::event::EventSet;
-use crate::integrate::{Dopri5, Tolerances};
+use crate::event::{EventError, EventSet};
+use crate::integrate::{Dopri5, IntegrateError, Tolerances};
 use crate::linalg::Lu;
-use crate::lyapunov::{Norm, Saltation, Variational};
+use crate::lyapunov::{LyapunovError, Norm, Saltation, Variational};
+use crate::model::ModelError;
+use crate::roots::RootError;
 use crate::scalar::{lit, to_f64};
+use crate::validate::ParameterError;
 
 pub mod continuation;
 
@@ -109,7 +112,40 @@ pub enum OrbitError {
         /// The value.
         value: f64,
     },
+    /// A run failed (the integration, the events, a rejected setting), or the system could
+    /// not be built. Converts into the crate's [`Error`](crate::Error) as the run's error
+    /// itself (`Error::Integrate(..)`, …).
+    #[error(transparent)]
+    Run(#[from] RunError),
+    /// The variational system (state and monodromy matrix) could not be set up.
+    #[error(transparent)]
+    Lyapunov(#[from] LyapunovError),
+    /// A builder of the problem at a parameter value failed with an error of another layer
+    /// (its message).
+    #[error("building the problem failed: {0}")]
+    Build(String),
 }
+
+/// `Result` with [`OrbitError`].
+pub(crate) type Result<T, E = OrbitError> = std::result::Result<T, E>;
+
+macro_rules! via_run {
+    ($($err:ty),+) => {$(
+        impl From<$err> for OrbitError {
+            fn from(e: $err) -> Self {
+                OrbitError::Run(e.into())
+            }
+        }
+    )+};
+}
+via_run!(
+    ParameterError,
+    RootError,
+    ModelError,
+    IntegrateError,
+    EventError,
+    ModeError
+);
 
 /// A periodic orbit found by [`Shooting::find`].
 #[derive(Debug, Clone, PartialEq)]
@@ -197,8 +233,7 @@ where
                 what: "the Newton tolerance factor",
                 requirement: "finite and > 0",
                 value: factor,
-            }
-            .into());
+            });
         }
         self.newton_tolerance = factor;
         Ok(self)
@@ -214,8 +249,7 @@ where
                 what: "the iteration cap",
                 requirement: "at least 1",
                 value: 0.0,
-            }
-            .into());
+            });
         }
         self.max_iterations = iterations;
         Ok(self)
@@ -318,8 +352,7 @@ where
             iterations: self.max_iterations,
             step,
             residual: to_f64(residual.amax()),
-        }
-        .into())
+        })
     }
 
     /// The periodic orbit of period `period` by multiple shooting from `m = guesses.len()`
@@ -351,8 +384,7 @@ where
                 what: "the number of shooting points",
                 requirement: "at least 1",
                 value: 0.0,
-            }
-            .into());
+            });
         }
         check_period(period)?;
         let h = period / lit(m as f64);
@@ -439,8 +471,7 @@ where
             iterations: self.max_iterations,
             step,
             residual: to_f64(largest(&residuals)),
-        }
-        .into())
+        })
     }
 }
 
@@ -453,8 +484,7 @@ fn check_period<T: Real>(period: T) -> Result<()> {
             what: "the period",
             requirement: "finite and > 0",
             value: to_f64(period),
-        }
-        .into())
+        })
     }
 }
 
@@ -593,8 +623,7 @@ where
                 what: "the component",
                 requirement: "below the state size",
                 value: component as f64,
-            }
-            .into());
+            });
         }
         let direction = match which {
             Extremum::Min => crate::event::Direction::Rising,
