@@ -259,7 +259,7 @@ where
     /// the events' resets).
     ///
     /// # Errors
-    /// Integration and event errors of the run; [`LyapunovError`](crate::lyapunov::LyapunovError)
+    /// Integration and event errors of the run; [`LyapunovError`]
     /// if `M ≠ N + N²` or the system has no Jacobian.
     pub fn flow(
         &self,
