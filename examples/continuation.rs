@@ -41,14 +41,13 @@ use nonsmooth::systems::paper::PAPER;
 type Duffing = Mechanical<
     f64,
     1,
-    2,
     Element<f64, 1, (CubicSpring<f64>, ViscousDamper<f64>)>,
     Load<f64, 1, Harmonic<f64>>,
 >;
 
 /// `ẍ + cẋ + k₁x + x³ = F cos ωt`.
 fn duffing(k1: f64, c: f64, force: f64, omega: f64) -> nonsmooth::Result<Duffing> {
-    Ok(Mechanical::<f64, 1, 2>::with_masses([1.0])?
+    Ok(Mechanical::with_masses([1.0])?
         .with_elements(Element::on_dof(
             0,
             (CubicSpring::new(k1, 1.0)?, ViscousDamper::new(c)?),

@@ -17,13 +17,12 @@ const F: f64 = 0.5;
 type Duffing = Mechanical<
     f64,
     1,
-    2,
     Element<f64, 1, (CubicSpring<f64>, ViscousDamper<f64>)>,
     Load<f64, 1, Harmonic<f64>>,
 >;
 
 fn duffing(omega: f64) -> nonsmooth::Result<Duffing> {
-    Ok(Mechanical::<f64, 1, 2>::with_masses([1.0])?
+    Ok(Mechanical::with_masses([1.0])?
         .with_elements(Element::on_dof(
             0,
             (CubicSpring::new(1.0, 1.0)?, ViscousDamper::new(C)?),
@@ -253,14 +252,13 @@ fn paper_period_one_orbit_first_grazing() {
 type DoubleWell = Mechanical<
     f64,
     1,
-    2,
     Element<f64, 1, (CubicSpring<f64>, ViscousDamper<f64>)>,
     Load<f64, 1, Harmonic<f64>>,
 >;
 
 /// The double-well Duffing oscillator `ẍ + 0.3ẋ − x + x³ = γ cos 1.2t`.
 fn double_well(gamma: f64) -> nonsmooth::Result<DoubleWell> {
-    Ok(Mechanical::<f64, 1, 2>::with_masses([1.0])?
+    Ok(Mechanical::with_masses([1.0])?
         .with_elements(Element::on_dof(
             0,
             (CubicSpring::new(-1.0, 1.0)?, ViscousDamper::new(0.3)?),
@@ -426,7 +424,7 @@ fn contact_changes_of_a_two_harmonic_response_match_the_closed_form() {
     }
     let tol = Tolerances::new(1e-11, 1e-13).unwrap();
     let build = |a: f64| {
-        let model = Mechanical::<f64, 1, 2>::with_masses([1.0])?
+        let model = Mechanical::with_masses([1.0])?
             .with_elements(Element::on_dof(
                 0,
                 (LinearSpring::new(1.0)?, ViscousDamper::new(2.0 * zeta)?),
@@ -448,7 +446,15 @@ fn contact_changes_of_a_two_harmonic_response_match_the_closed_form() {
             level,
             extremum: Extremum::Min,
         });
-    let branch = follow(build, |_| period, 0.0, 0.05, SVector::zeros(), &settings).unwrap();
+    let branch = follow(
+        build,
+        |_| period,
+        0.0,
+        0.05,
+        SVector::<f64, 2>::zeros(),
+        &settings,
+    )
+    .unwrap();
     let found: Vec<f64> = branch
         .bifurcations
         .iter()

@@ -26,7 +26,7 @@ fn forced_impact_oscillator_exponents_through_restitution() {
     let (c, e) = (0.1_f64, 0.8_f64);
     for (d, omega, periodic) in [(0.3_f64, 1.5_f64, true), (-0.2, 1.2, false)] {
         let model = || {
-            Mechanical::<f64, 1, 2>::with_masses([1.0])
+            Mechanical::with_masses([1.0])
                 .unwrap()
                 .with_elements((
                     Element::on_dof(0, LinearSpring::new(1.0).unwrap()).unwrap(),

@@ -37,10 +37,10 @@ impl ForceLaw<f64> for VanDerPol {
     }
 }
 
-type Forced = Mechanical<f64, 1, 2, Element<f64, 1, VanDerPol>, Load<f64, 1, Harmonic<f64>>>;
+type Forced = Mechanical<f64, 1, Element<f64, 1, VanDerPol>, Load<f64, 1, Harmonic<f64>>>;
 
 fn van_der_pol(omega: f64) -> nonsmooth::Result<Forced> {
-    Ok(Mechanical::<f64, 1, 2>::with_masses([1.0])?
+    Ok(Mechanical::with_masses([1.0])?
         .with_elements(Element::on_dof(0, VanDerPol(EPS))?)
         .with_loads(Load::on_dof(0, Harmonic::cosine(F, omega)?)?))
 }

@@ -197,7 +197,7 @@ fn impact_oscillator_orbit_through_restitution() {
     use nonsmooth::event::{Direction, Event, Level, Restitution};
     use nonsmooth::force::LinearSpring;
     let (c, e, d, omega) = (0.1_f64, 0.8_f64, 0.3_f64, 1.5_f64);
-    let model = Mechanical::<f64, 1, 2>::with_masses([1.0])
+    let model = Mechanical::with_masses([1.0])
         .unwrap()
         .with_elements(
             Element::on_dof(
@@ -305,7 +305,7 @@ fn invalid_settings_are_errors() {
 }
 
 fn duffing_at(omega: f64) -> impl Dynamics<f64, 2> + Clone {
-    Mechanical::<f64, 1, 2>::with_masses([1.0])
+    Mechanical::with_masses([1.0])
         .unwrap()
         .with_elements(
             Element::on_dof(
@@ -327,7 +327,7 @@ fn extrema_along_an_orbit_are_exact() {
     use nonsmooth::force::LinearSpring;
     use nonsmooth::orbit::Extremum;
     let (zeta, omega) = (0.05_f64, 1.3_f64);
-    let model = Mechanical::<f64, 1, 2>::with_masses([1.0])
+    let model = Mechanical::with_masses([1.0])
         .unwrap()
         .with_elements(
             Element::on_dof(
@@ -347,7 +347,9 @@ fn extrema_along_an_orbit_are_exact() {
         tangent_tolerances::<f64, 2, 2, 6>(&tol, 1e-11, 1e-13).unwrap(),
     );
     let period = std::f64::consts::TAU / omega;
-    let orbit = shooting.find(0.0, period, SVector::zeros()).unwrap();
+    let orbit = shooting
+        .find(0.0, period, SVector::<f64, 2>::zeros())
+        .unwrap();
     let d = (1.0 - omega * omega).powi(2) + (2.0 * zeta * omega).powi(2);
     let a = 1.0 / d.sqrt();
     let minima = shooting
@@ -376,7 +378,7 @@ fn extrema_along_an_orbit_are_exact() {
 /// `ẍ + cẋ − x + x³ = γ cos ωt`, slowly forced: the orbit on the hilltop `x ≈ 0` is a
 /// saddle with `μ ≈ e^{0.97·T}`, `T = 2π/ω`.
 fn double_well(c: f64, gamma: f64, omega: f64) -> impl Dynamics<f64, 2> + Clone {
-    Mechanical::<f64, 1, 2>::with_masses([1.0])
+    Mechanical::with_masses([1.0])
         .unwrap()
         .with_elements(
             Element::on_dof(

@@ -207,7 +207,7 @@ type Transitions = Vec<(f64, SlipMode)>;
 /// transitions with the default stepper options, the worst violation of the static limit
 /// (stuck) and of the slip direction (slipping) between step ends, and the reference.
 fn den_hartog(ratio: f64, w: f64, periods: f64) -> (Transitions, Transitions, f64, usize) {
-    let model = Mechanical::<f64, 1, 2>::with_masses([1.0])
+    let model = Mechanical::with_masses([1.0])
         .unwrap()
         .with_elements(Element::on_dof(0, LinearSpring::new(1.0).unwrap()).unwrap())
         .with_loads(Load::on_dof(0, Harmonic::cosine(1.0, w).unwrap()).unwrap());
@@ -332,7 +332,7 @@ fn belt_with_forced_speed_matches_the_exact_flow() {
         omega: 0.7,
     };
     let (fs, fk) = (1.0, 0.8);
-    let model = Mechanical::<f64, 1, 2>::with_masses([1.0])
+    let model = Mechanical::with_masses([1.0])
         .unwrap()
         .with_elements(Element::on_dof(0, LinearSpring::new(1.0).unwrap()).unwrap());
     let friction = Coulomb::new(Coordinate::dof(0).unwrap(), belt, fs, fk).unwrap();
@@ -408,7 +408,7 @@ type StopRun = (
 /// (`cos ωt ≥ d`) between step ends.
 fn impact_oscillator(w: f64, d: f64, e: f64, periods: f64) -> StopRun {
     let zeta = 0.05;
-    let model = Mechanical::<f64, 1, 2>::with_masses([1.0])
+    let model = Mechanical::with_masses([1.0])
         .unwrap()
         .with_elements((
             Element::on_dof(0, LinearSpring::new(1.0).unwrap()).unwrap(),
@@ -513,7 +513,7 @@ proptest! {
     ) {
         prop_assume!((w - 1.0).abs() > 0.05);
         let fs = fraction * amplitude;
-        let model = Mechanical::<f64, 1, 2>::with_masses([1.0]).unwrap()
+        let model = Mechanical::with_masses([1.0]).unwrap()
             .with_elements(Element::on_dof(0, LinearSpring::new(1.0).unwrap()).unwrap())
             .with_loads(Load::on_dof(0, Harmonic::cosine(amplitude, w).unwrap()).unwrap());
         let friction = Coulomb::new(Coordinate::dof(0).unwrap(), Constant::new(0.0).unwrap(), fs, kinetic * fs).unwrap();
@@ -543,8 +543,8 @@ proptest! {
 // ---------------------------------------------------------------------------------------
 // Starts and long runs.
 
-fn block() -> Mechanical<f64, 1, 2, Element<f64, 1, LinearSpring<f64>>> {
-    Mechanical::<f64, 1, 2>::with_masses([1.0])
+fn block() -> Mechanical<f64, 1, Element<f64, 1, LinearSpring<f64>>> {
+    Mechanical::with_masses([1.0])
         .unwrap()
         .with_elements(Element::on_dof(0, LinearSpring::new(80.0).unwrap()).unwrap())
 }
@@ -621,7 +621,7 @@ fn a_start_mode_that_contradicts_the_state_is_an_error() {
 fn a_block_stuck_exactly_at_the_static_limit_leaves_it() {
     // Dragged by a belt at 0.5 m/s: k x = F_s exactly at the start, the spring force
     // growing; it must slip at once, as it does from 1e-9 below the limit.
-    let model = Mechanical::<f64, 1, 2>::with_masses([1.0])
+    let model = Mechanical::with_masses([1.0])
         .unwrap()
         .with_elements(Element::on_dof(0, LinearSpring::new(1.0).unwrap()).unwrap());
     let friction = Coulomb::new(

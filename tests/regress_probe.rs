@@ -322,12 +322,12 @@ fn deserialized_hertz_contact_recomputes_its_cached_exponent() {
 #[test]
 fn mass_matrices_at_extreme_scales() {
     // A lumped mass whose inverse overflows.
-    let e = Mechanical::<f64, 2, 4>::with_masses([5e-324, 1.0]).unwrap_err();
+    let e = Mechanical::with_masses([5e-324, 1.0]).unwrap_err();
     assert_eq!((e.name, e.value), ("mass", 5e-324), "{e}");
     // Tiny and huge well-conditioned matrices: accepted, with the right finite inverse.
     for s in [1e-170, 1e-300, 1e300] {
         let mass = Matrix2::new(2.0, 0.5, 0.5, 1.0) * s;
-        let model = Mechanical::<f64, 2, 4>::with_mass_matrix(mass)
+        let model = Mechanical::<f64, 2>::with_mass_matrix(mass)
             .unwrap_or_else(|e| panic!("scale {s:e}: {e}"));
         let inv = model.inverse_mass_matrix();
         assert!(inv.iter().all(|v| v.is_finite()), "scale {s:e}: {inv}");
@@ -339,7 +339,7 @@ fn mass_matrices_at_extreme_scales() {
             );
         }
         let diag =
-            Mechanical::<f64, 2, 4>::with_mass_matrix(Matrix2::from_diagonal(&Vector2::new(s, s)))
+            Mechanical::<f64, 2>::with_mass_matrix(Matrix2::from_diagonal(&Vector2::new(s, s)))
                 .unwrap();
         let inv = diag.inverse_mass_matrix()[(1, 1)];
         assert!(
@@ -349,7 +349,7 @@ fn mass_matrices_at_extreme_scales() {
     }
     // A positive-definite matrix whose inverse is beyond the range: an error naming it.
     let tiny = Matrix2::from_diagonal(&Vector2::new(1e-310, 1.0));
-    match Mechanical::<f64, 2, 4>::with_mass_matrix(tiny) {
+    match Mechanical::<f64, 2>::with_mass_matrix(tiny) {
         Err(e @ ModelError::MassInverseOverflow { smallest_mass }) => {
             assert_eq!(smallest_mass, 1e-310);
             assert!(e.to_string().contains("1e-310"), "{e}");
@@ -358,9 +358,9 @@ fn mass_matrices_at_extreme_scales() {
     }
     // The ordinary case is unchanged to the bit.
     let m = Matrix2::new(2.0, 0.3, 0.3, 1.5);
-    let model = Mechanical::<f64, 2, 4>::with_mass_matrix(m).unwrap();
+    let model = Mechanical::<f64, 2>::with_mass_matrix(m).unwrap();
     assert_eq!(*model.inverse_mass_matrix(), m.try_inverse().unwrap());
-    assert_eq!(Mechanical::<f64, 2, 4>::MAX_DOFS, 64);
+    assert_eq!(Mechanical::<f64, 2>::MAX_DOFS, 64);
 }
 
 /// Defect 7, size limit: a chain of `MAX_DOFS` masses is built and run with an implicit
@@ -381,7 +381,7 @@ fn largest_mechanical_system_runs_on_a_two_mib_stack() {
                 Element::between(i, i - 1, law).unwrap()
             }
         });
-        let model = Mechanical::<f64, N, { 2 * N }>::with_masses([1.0; N])
+        let model = Mechanical::<f64, N>::with_masses([1.0; N])
             .unwrap()
             .with_elements(elements)
             .with_loads(Load::on_dof(N - 1, Harmonic::new(1.0, 1.0, 0.0).unwrap()).unwrap());
@@ -410,12 +410,11 @@ fn continuation_rejects_a_nan_grazing_level() {
     type Model = Mechanical<
         f64,
         1,
-        2,
         Element<f64, 1, (LinearSpring<f64>, ViscousDamper<f64>)>,
         Load<f64, 1, Harmonic<f64>>,
     >;
     let model = |w: f64| -> nonsmooth::Result<Model> {
-        Ok(Mechanical::<f64, 1, 2>::with_masses([1.0])?
+        Ok(Mechanical::with_masses([1.0])?
             .with_elements(Element::on_dof(
                 0,
                 (LinearSpring::new(1.0)?, ViscousDamper::new(0.1)?),
@@ -463,7 +462,15 @@ fn continuation_rejects_a_nan_grazing_level() {
         level: -100.0,
         extremum: Extremum::Min,
     };
-    let branch = follow(build, period, 0.0, 0.5, SVector::zeros(), &settings(far)).unwrap();
+    let branch = follow(
+        build,
+        period,
+        0.0,
+        0.5,
+        SVector::<f64, 2>::zeros(),
+        &settings(far),
+    )
+    .unwrap();
     assert!(branch.bifurcations.is_empty(), "{:?}", branch.bifurcations);
     assert!(
         branch

@@ -40,7 +40,7 @@ fn exact_transitions(t_end: f64) -> Vec<(f64, SlipMode)> {
 }
 
 fn run(t_end: f64) -> ModeRun<f64, 2, SlipMode> {
-    let model = Mechanical::<f64, 1, 2>::with_masses([M])
+    let model = Mechanical::with_masses([M])
         .unwrap()
         .with_elements(Element::on_dof(0, LinearSpring::new(K).unwrap()).unwrap());
     let friction = Coulomb::new(

@@ -35,7 +35,7 @@
 //! use nonsmooth::integrate::{Dopri5, Tolerances};
 //! use nonsmooth::model::{Coordinate, Element, Mechanical};
 //!
-//! let model = Mechanical::<f64, 1, 2>::with_masses([1.0])?
+//! let model = Mechanical::with_masses([1.0_f64])?
 //!     .with_elements(Element::on_dof(0, LinearSpring::new(1.0)?)?);
 //! let friction = Coulomb::new(Coordinate::dof(0)?, Constant::new(0.5)?, 1.0, 0.6)?;
 //! let tol = Tolerances::new(1e-10, 1e-12)?;
@@ -155,7 +155,7 @@ struct Metric<T: Real, const N: usize> {
 /// The right-hand side of one mode: slip with a friction force `force`, or stick.
 #[derive(Debug)]
 struct ModeRhs<'a, T: Real, const N: usize, const M: usize, El, Ld, U> {
-    model: &'a Mechanical<T, N, M, El, Ld>,
+    model: &'a Mechanical<T, N, El, Ld>,
     friction: &'a Coulomb<T, N, U>,
     metric: Metric<T, N>,
     /// `Some(F)`: slipping with friction force `F`; `None`: stuck.
@@ -263,7 +263,7 @@ where
 /// A [`Mechanical`] system with a set-valued [`Coulomb`] contact as a
 /// [`ModeSystem`] (see the [module docs](self)).
 pub struct StickSlip<'a, T: Real, const N: usize, const M: usize, El, Ld, U, F> {
-    model: &'a Mechanical<T, N, M, El, Ld>,
+    model: &'a Mechanical<T, N, El, Ld>,
     friction: Coulomb<T, N, U>,
     metric: Metric<T, N>,
     alpha: T,
@@ -283,7 +283,7 @@ where
     /// segment. The stick mode damps the drift of `v_r` at rate `α = 1/s`
     /// ([`with_drift_rate`](Self::with_drift_rate)).
     pub fn new(
-        model: &'a Mechanical<T, N, M, El, Ld>,
+        model: &'a Mechanical<T, N, El, Ld>,
         friction: Coulomb<T, N, U>,
         stepper: F,
     ) -> Self {

@@ -37,7 +37,7 @@ use crate::{Dynamics, Real};
 /// The motion of a [`Mechanical`] system constrained to a [`Gap`] surface (`g = 0`).
 #[derive(Debug)]
 pub struct Constrained<'a, T: Real, const N: usize, const M: usize, El, Ld, S> {
-    model: &'a Mechanical<T, N, M, El, Ld>,
+    model: &'a Mechanical<T, N, El, Ld>,
     gap: &'a Gap<T, N, S>,
     /// `M⁻¹w`.
     m_w: SVector<T, N>,
@@ -68,7 +68,7 @@ where
     S: Excitation<T>,
 {
     /// The constrained motion of `model` on `gap`.
-    pub fn new(model: &'a Mechanical<T, N, M, El, Ld>, gap: &'a Gap<T, N, S>) -> Self {
+    pub fn new(model: &'a Mechanical<T, N, El, Ld>, gap: &'a Gap<T, N, S>) -> Self {
         let (m_w, w_m_w) = model.mobility(gap.coordinate().weights());
         // Drift of the constraint (integration error) decays at rate α: four surface
         // radians per radian, or 1/s for a fixed surface.
@@ -276,7 +276,7 @@ where
 
 /// The free mode's simulation: the model with its impact event.
 type FreeFlight<T, const N: usize, const M: usize, El, Ld, S, St> =
-    Simulation<T, M, Mechanical<T, N, M, El, Ld>, St, Event<Gap<T, N, S>, NewtonImpact<T, N, S>>>;
+    Simulation<T, M, Mechanical<T, N, El, Ld>, St, Event<Gap<T, N, S>, NewtonImpact<T, N, S>>>;
 
 /// The sticking mode's simulation: the constrained motion with its release event.
 type Sticking<'a, T, const N: usize, const M: usize, El, Ld, S, St> = Simulation<
@@ -298,7 +298,7 @@ where
     /// `model` with rigid impacts `impact` on `gap` (the impact's gap), each mode with a
     /// stepper made by `stepper()`.
     pub fn new<F: Fn() -> St>(
-        model: &'a Mechanical<T, N, M, El, Ld>,
+        model: &'a Mechanical<T, N, El, Ld>,
         gap: &'a Gap<T, N, S>,
         impact: &NewtonImpact<T, N, S>,
         stepper: F,
@@ -460,7 +460,7 @@ where
 /// handles; [`EventError::Zeno`] if `max_segments` is exhausted.
 #[allow(clippy::too_many_arguments)]
 pub fn run_with_sticking<T, const N: usize, const M: usize, El, Ld, S, St, F, O>(
-    model: &Mechanical<T, N, M, El, Ld>,
+    model: &Mechanical<T, N, El, Ld>,
     impact: &NewtonImpact<T, N, S>,
     stepper: F,
     t0: T,

@@ -583,11 +583,11 @@ load_tuple!(A 0, B 1, C 2, D 3, E 4, F 5, G 6, H 7);
 /// does not, and 400 masses overflow even the 8 MiB main thread.
 /// ```compile_fail
 /// # use nonsmooth::model::Mechanical;
-/// let none = Mechanical::<f64, 0, 0>::with_masses([]); // no degrees of freedom
+/// let none = Mechanical::<f64, 0>::with_masses([]); // no degrees of freedom
 /// ```
 /// ```compile_fail
 /// # use nonsmooth::model::Mechanical;
-/// let chain = Mechanical::<f64, 400, 800>::with_masses([1.0; 400]); // beyond MAX_DOFS
+/// let chain = Mechanical::<f64, 400>::with_masses([1.0; 400]); // beyond MAX_DOFS
 /// ```
 ///
 /// # Examples
@@ -616,35 +616,47 @@ load_tuple!(A 0, B 1, C 2, D 3, E 4, F 5, G 6, H 7);
 /// # Ok::<(), nonsmooth::Error>(())
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Mechanical<T: Real, const N: usize, const M: usize, El = (), Ld = ()> {
+pub struct Mechanical<T: Real, const N: usize, El = (), Ld = ()> {
     mass: SMatrix<T, N, N>,
     inv_mass: SMatrix<T, N, N>,
     diagonal: bool,
     stiffness: Option<SMatrix<T, N, N>>,
     damping: Option<SMatrix<T, N, N>>,
-    /// `[K | C]` (an absent matrix as zeros) if either is given: one test on the hot path.
-    linear: Option<SMatrix<T, N, M>>,
+    /// `[K, C]` (an absent matrix as zeros) if either is given: one test on the hot path.
+    linear: Option<[SMatrix<T, N, N>; 2]>,
     elements: El,
     loads: Ld,
+}
+
+/// The state of `N` degrees of freedom is `(q, q̇)`, `M = 2N` components: checked when the
+/// code is compiled (a mismatch does not build), so the type names `N` only and `M` is
+/// inferred from the state a run starts from.
+#[inline(always)]
+pub(crate) const fn state_size<const N: usize, const M: usize>() {
+    const {
+        assert!(
+            M == 2 * N,
+            "the state of a Mechanical system of N DOFs has M = 2N components"
+        )
+    };
 }
 
 /// The largest number of degrees of freedom of a [`Mechanical`] system (see its size limit).
 const MAX_DOFS: usize = 64;
 
-impl<T: Real, const N: usize, const M: usize, El, Ld> Mechanical<T, N, M, El, Ld> {
+impl<T: Real, const N: usize, El, Ld> Mechanical<T, N, El, Ld> {
     /// The largest number of degrees of freedom `N` (64): the constructors do not compile
     /// for larger `N`, nor for `N = 0` (see the type's size limit).
     pub const MAX_DOFS: usize = MAX_DOFS;
 }
 
-impl<T: Real, const N: usize, const M: usize> Mechanical<T, N, M, (), ()> {
+impl<T: Real, const N: usize> Mechanical<T, N, (), ()> {
     /// A system of `N` lumped masses (diagonal mass matrix), no elements, no loads.
     ///
     /// # Errors
     /// [`ParameterError`] unless every mass is finite and > 0 with a finite inverse
     /// (`mass ≥ 5.6·10⁻³⁰⁹` for `f64`).
     pub fn with_masses(masses: [T; N]) -> Result<Self, ParameterError> {
-        const { assert!(M == 2 * N, "the state dimension M must be 2N") };
         const {
             assert!(
                 N >= 1 && N <= MAX_DOFS,
@@ -690,7 +702,6 @@ impl<T: Real, const N: usize, const M: usize> Mechanical<T, N, M, (), ()> {
     /// its largest entry) or not positive definite (Cholesky fails), and
     /// [`ModelError::MassInverseOverflow`] if its inverse is not finite.
     pub fn with_mass_matrix(mass: SMatrix<T, N, N>) -> Result<Self, ModelError> {
-        const { assert!(M == 2 * N, "the state dimension M must be 2N") };
         const {
             assert!(
                 N >= 1 && N <= MAX_DOFS,
@@ -773,9 +784,9 @@ fn check_finite<T: Real, const N: usize>(
     Ok(())
 }
 
-impl<T: Real, const N: usize, const M: usize, El, Ld> Mechanical<T, N, M, El, Ld> {
+impl<T: Real, const N: usize, El, Ld> Mechanical<T, N, El, Ld> {
     /// Replaces the elements (a tuple or array of [`Element`]s).
-    pub fn with_elements<El2: Elements<T, N>>(self, elements: El2) -> Mechanical<T, N, M, El2, Ld> {
+    pub fn with_elements<El2: Elements<T, N>>(self, elements: El2) -> Mechanical<T, N, El2, Ld> {
         Mechanical {
             mass: self.mass,
             inv_mass: self.inv_mass,
@@ -789,7 +800,7 @@ impl<T: Real, const N: usize, const M: usize, El, Ld> Mechanical<T, N, M, El, Ld
     }
 
     /// Replaces the loads (a tuple or array of [`Load`]s).
-    pub fn with_loads<Ld2: Loads<T, N>>(self, loads: Ld2) -> Mechanical<T, N, M, El, Ld2> {
+    pub fn with_loads<Ld2: Loads<T, N>>(self, loads: Ld2) -> Mechanical<T, N, El, Ld2> {
         Mechanical {
             mass: self.mass,
             inv_mass: self.inv_mass,
@@ -802,20 +813,12 @@ impl<T: Real, const N: usize, const M: usize, El, Ld> Mechanical<T, N, M, El, Ld
         }
     }
 
-    /// `[K | C]`, an absent matrix as zeros.
-    fn linear_part(&self) -> SMatrix<T, N, M> {
-        let mut kc = SMatrix::<T, N, M>::zeros();
-        for i in 0..N {
-            for j in 0..N {
-                if let Some(k) = &self.stiffness {
-                    kc[(i, j)] = k[(i, j)];
-                }
-                if let Some(c) = &self.damping {
-                    kc[(i, N + j)] = c[(i, j)];
-                }
-            }
-        }
-        kc
+    /// `[K, C]`, an absent matrix as zeros.
+    fn linear_part(&self) -> [SMatrix<T, N, N>; 2] {
+        [
+            self.stiffness.unwrap_or_else(SMatrix::zeros),
+            self.damping.unwrap_or_else(SMatrix::zeros),
+        ]
     }
 
     /// Sets the linear stiffness matrix `K` (not required to be symmetric: follower forces
@@ -862,9 +865,7 @@ impl<T: Real, const N: usize, const M: usize, El, Ld> Mechanical<T, N, M, El, Ld
     }
 }
 
-impl<T: Real, const N: usize, const M: usize, El: Elements<T, N>, Ld: Loads<T, N>>
-    Mechanical<T, N, M, El, Ld>
-{
+impl<T: Real, const N: usize, El: Elements<T, N>, Ld: Loads<T, N>> Mechanical<T, N, El, Ld> {
     /// The generalized force `f(t) − Kq − Cq̇ − Σ w F` (the right-hand side before `M⁻¹`).
     #[inline(always)]
     pub fn generalized_force(&self, t: T, q: &[T], qd: &[T]) -> SVector<T, N> {
@@ -878,21 +879,23 @@ impl<T: Real, const N: usize, const M: usize, El: Elements<T, N>, Ld: Loads<T, N
         let mut r = SVector::<T, N>::repeat(-T::zero());
         self.elements.add_forces(q, qd, &mut r);
         // K q then C q̇, each summed in index order (an absent matrix adds zeros).
-        if let Some(kc) = &self.linear {
+        if let Some([k, c]) = &self.linear {
             for i in 0..N {
                 for j in 0..N {
-                    r[i] += kc[(i, j)] * q[j];
+                    r[i] += k[(i, j)] * q[j];
                 }
                 for j in 0..N {
-                    r[i] += kc[(i, N + j)] * qd[j];
+                    r[i] += c[(i, j)] * qd[j];
                 }
             }
         }
         load - r
     }
 
-    /// The unconstrained acceleration `q̈ = M⁻¹ f(t, q, q̇)` at the state `y = (q, q̇)`.
-    pub fn acceleration(&self, t: T, y: &SVector<T, M>) -> SVector<T, N> {
+    /// The unconstrained acceleration `q̈ = M⁻¹ f(t, q, q̇)` at the state `y = (q, q̇)`
+    /// (`M = 2N`, checked at compile time).
+    pub fn acceleration<const M: usize>(&self, t: T, y: &SVector<T, M>) -> SVector<T, N> {
+        state_size::<N, M>();
         let (q, qd) = y.as_slice().split_at(N);
         self.inv_mass * self.generalized_force(t, q, qd)
     }
@@ -990,10 +993,11 @@ impl<T: Real, const N: usize, const M: usize, El: Elements<T, N>, Ld: Loads<T, N
 }
 
 impl<T: Real, const N: usize, const M: usize, El: Elements<T, N>, Ld: Loads<T, N>> Dynamics<T, M>
-    for Mechanical<T, N, M, El, Ld>
+    for Mechanical<T, N, El, Ld>
 {
     #[inline(always)]
     fn rhs(&self, t: T, y: &SVector<T, M>, dy: &mut SVector<T, M>) {
+        state_size::<N, M>();
         let (q, qd) = y.as_slice().split_at(N);
         let f = self.generalized_force(t, q, qd);
         for i in 0..N {
@@ -1012,6 +1016,7 @@ impl<T: Real, const N: usize, const M: usize, El: Elements<T, N>, Ld: Loads<T, N
     }
 
     fn jacobian(&self, _t: T, y: &SVector<T, M>) -> Option<SMatrix<T, M, M>> {
+        state_size::<N, M>();
         let (q, qd) = y.as_slice().split_at(N);
         let (k, c) = self.tangent(q, qd);
         let ak = -(self.inv_mass * k);
@@ -1028,6 +1033,7 @@ impl<T: Real, const N: usize, const M: usize, El: Elements<T, N>, Ld: Loads<T, N
     }
 
     fn time_derivative(&self, t: T, _y: &SVector<T, M>) -> Option<SVector<T, M>> {
+        state_size::<N, M>();
         let mut fd = SVector::<T, N>::zeros();
         self.loads.add_rates(t, &mut fd);
         let a = self.inv_mass * fd;
@@ -1121,7 +1127,7 @@ mod tests {
 
     #[test]
     fn jacobian_matches_finite_differences() {
-        let model = Mechanical::<f64, 2, 4>::with_masses([1.5, 0.5])
+        let model = Mechanical::with_masses([1.5, 0.5])
             .unwrap()
             .with_elements((
                 Element::on_dof(
@@ -1174,14 +1180,13 @@ mod tests {
 
     #[test]
     fn full_mass_matrix_equals_lumped_when_diagonal() {
-        let lumped = Mechanical::<f64, 2, 4>::with_masses([2.0, 3.0])
+        let lumped = Mechanical::with_masses([2.0, 3.0])
             .unwrap()
             .with_elements(Element::between(0, 1, LinearSpring::new(5.0).unwrap()).unwrap());
-        let full = Mechanical::<f64, 2, 4>::with_mass_matrix(SMatrix::<f64, 2, 2>::new(
-            2.0, 0.0, 0.0, 3.0,
-        ))
-        .unwrap()
-        .with_elements(Element::between(0, 1, LinearSpring::new(5.0).unwrap()).unwrap());
+        let full =
+            Mechanical::<f64, 2>::with_mass_matrix(SMatrix::<f64, 2, 2>::new(2.0, 0.0, 0.0, 3.0))
+                .unwrap()
+                .with_elements(Element::between(0, 1, LinearSpring::new(5.0).unwrap()).unwrap());
         let y = SVector::<f64, 4>::new(0.1, -0.2, 0.3, 0.4);
         let (mut a, mut b) = (SVector::zeros(), SVector::zeros());
         lumped.rhs(0.0, &y, &mut a);
@@ -1189,7 +1194,7 @@ mod tests {
         assert_eq!(a, b);
         // Coupled mass matrix: M·ÿ must equal the force.
         let m = SMatrix::<f64, 2, 2>::new(2.0, 0.5, 0.5, 3.0);
-        let coupled = Mechanical::<f64, 2, 4>::with_mass_matrix(m)
+        let coupled = Mechanical::<f64, 2>::with_mass_matrix(m)
             .unwrap()
             .with_elements(Element::between(0, 1, LinearSpring::new(5.0).unwrap()).unwrap());
         coupled.rhs(0.0, &y, &mut b);
@@ -1197,18 +1202,14 @@ mod tests {
         let force = nalgebra::Vector2::new(-5.0 * 0.3, 5.0 * 0.3);
         assert!((m * acc - force).amax() < 1e-15);
         assert!(
-            Mechanical::<f64, 2, 4>::with_mass_matrix(SMatrix::<f64, 2, 2>::new(
-                1.0, 2.0, 2.0, 1.0
-            ))
-            .is_err()
+            Mechanical::<f64, 2>::with_mass_matrix(SMatrix::<f64, 2, 2>::new(1.0, 2.0, 2.0, 1.0))
+                .is_err()
         );
         assert!(
-            Mechanical::<f64, 2, 4>::with_mass_matrix(SMatrix::<f64, 2, 2>::new(
-                1.0, 0.1, 0.0, 1.0
-            ))
-            .is_err()
+            Mechanical::<f64, 2>::with_mass_matrix(SMatrix::<f64, 2, 2>::new(1.0, 0.1, 0.0, 1.0))
+                .is_err()
         );
-        assert!(Mechanical::<f64, 2, 4>::with_masses([1.0, 0.0]).is_err());
+        assert!(Mechanical::with_masses([1.0, 0.0]).is_err());
     }
 
     #[test]
@@ -1216,12 +1217,10 @@ mod tests {
         // Wall — k1 — m1 — k2 — m2, weights w1, w2 pulling along +q: exact q1 = (w1+w2)/k1,
         // q2 = q1 + w2/k2.
         let (k1, k2, w1, w2) = (100.0, 50.0, 3.0, 2.0);
-        let model = Mechanical::<f64, 2, 4>::with_masses([1.0, 1.0])
-            .unwrap()
-            .with_elements((
-                Element::on_dof(0, LinearSpring::new(k1).unwrap()).unwrap(),
-                Element::between(1, 0, LinearSpring::new(k2).unwrap()).unwrap(),
-            ));
+        let model = Mechanical::with_masses([1.0, 1.0]).unwrap().with_elements((
+            Element::on_dof(0, LinearSpring::new(k1).unwrap()).unwrap(),
+            Element::between(1, 0, LinearSpring::new(k2).unwrap()).unwrap(),
+        ));
         let q = model
             .static_equilibrium(SVector::zeros(), SVector::<f64, 2>::new(w1, w2))
             .unwrap();
@@ -1229,7 +1228,7 @@ mod tests {
         assert!((q[0] - q1).abs() < 1e-15);
         assert!((q[1] - (q1 + w2 / k2)).abs() < 1e-15);
         // Nonlinear: a Hertz stop pressed by a weight: k_c·δ^{3/2} = w.
-        let stop = Mechanical::<f64, 1, 2>::with_masses([1.0])
+        let stop = Mechanical::with_masses([1.0])
             .unwrap()
             .with_elements(Element::on_dof(0, HertzContact::new(0.0, 1e6).unwrap()).unwrap());
         let q = stop
@@ -1237,7 +1236,7 @@ mod tests {
             .unwrap();
         assert!((q[0] - (10.0f64 / 1e6).powf(2.0 / 3.0)).abs() < 1e-15);
         // A free mass has no equilibrium under a load: singular stiffness.
-        let free = Mechanical::<f64, 1, 2>::with_masses([1.0]).unwrap();
+        let free = Mechanical::with_masses([1.0]).unwrap();
         assert!(matches!(
             free.static_equilibrium(SVector::zeros(), SVector::from([1.0])),
             Err(ModelError::SingularStiffness { .. })

@@ -42,7 +42,7 @@ pub struct Oscillator<T: Real, L, E> {
 }
 
 /// The one-DOF mechanical system behind an [`Oscillator`].
-type OneDof<T, L, E> = Mechanical<T, 1, 2, Element<T, 1, L>, Load<T, 1, E>>;
+type OneDof<T, L, E> = Mechanical<T, 1, Element<T, 1, L>, Load<T, 1, E>>;
 
 impl<T: Real, L: ForceLaw<T>, E: Excitation<T>> Oscillator<T, L, E> {
     /// Assembles the oscillator.

@@ -42,14 +42,14 @@
 //! let zeta = 0.1;
 //! let tol = Tolerances::new(1e-10, 1e-12)?;
 //! let build = |w: f64| {
-//!     let model = Mechanical::<f64, 1, 2>::with_masses([1.0])?
+//!     let model = Mechanical::with_masses([1.0])?
 //!         .with_elements(Element::on_dof(0, (LinearSpring::new(1.0)?, ViscousDamper::new(2.0 * zeta)?))?)
 //!         .with_loads(Load::on_dof(0, Harmonic::cosine(1.0, w)?)?);
 //!     Ok(Shooting::new(model, (), tangent_tolerances::<f64, 2, 2, 6>(&tol, 1e-10, 1e-12)?))
 //! };
 //! let period = |w: f64| std::f64::consts::TAU / w;
 //! let settings = ContinuationSettings::new(0.5, 0.9, 0.05)?;
-//! let branch = follow(build, period, 0.0, 0.5, SVector::zeros(), &settings)?;
+//! let branch = follow(build, period, 0.0, 0.5, SVector::<f64, 2>::zeros(), &settings)?;
 //! assert!(branch.points.len() > 3 && branch.bifurcations.is_empty());
 //! for q in &branch.points {
 //!     let d = (1.0 - q.p * q.p).powi(2) + (2.0 * zeta * q.p).powi(2);

@@ -39,7 +39,7 @@
 //! use nonsmooth::orbit::Shooting;
 //!
 //! let (zeta, omega) = (0.05, 1.3);
-//! let model = Mechanical::<f64, 1, 2>::with_masses([1.0])?
+//! let model = Mechanical::with_masses([1.0])?
 //!     .with_elements(Element::on_dof(0, (LinearSpring::new(1.0)?, ViscousDamper::new(2.0 * zeta)?))?)
 //!     .with_loads(Load::on_dof(0, Harmonic::cosine(1.0, omega)?)?);
 //! let tol = Tolerances::new(1e-11, 1e-13)?;

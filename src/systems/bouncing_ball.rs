@@ -39,7 +39,7 @@ impl<T: Real> Excitation<T> for Constant<T> {
 }
 
 /// The ball in flight: state `(y, ẏ)`.
-pub type BallModel<T> = Mechanical<T, 1, 2, (), Load<T, 1, Constant<T>>>;
+pub type BallModel<T> = Mechanical<T, 1, (), Load<T, 1, Constant<T>>>;
 
 /// The table as a contact surface (penetration `s(t) − y`).
 pub type Table<T> = Gap<T, 1, Harmonic<T>>;

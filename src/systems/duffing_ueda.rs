@@ -25,7 +25,7 @@ use crate::validate::{finite, non_negative, positive};
 pub type DuffingUedaElements<T> = Element<T, 1, (CubicSpring<T>, ViscousDamper<T>)>;
 
 /// The assembled model: state `(x, ẋ)`.
-pub type DuffingUedaModel<T> = Mechanical<T, 1, 2, DuffingUedaElements<T>, Load<T, 1, Harmonic<T>>>;
+pub type DuffingUedaModel<T> = Mechanical<T, 1, DuffingUedaElements<T>, Load<T, 1, Harmonic<T>>>;
 
 /// The parameters of the Duffing–Ueda oscillator `ẍ + kẋ + x³ = B cos ωt`.
 ///

@@ -34,7 +34,7 @@ pub type PaperOscillator<T> = Oscillator<T, PaperLaws<T>, UnbalancedRotor<T>>;
 /// The paper's model as a 1-DOF [`Mechanical`] system (the same right-hand side as
 /// [`PaperOscillator`], bit for bit; the form to extend with further degrees of freedom).
 pub type PaperMechanical<T> =
-    Mechanical<T, 1, 2, Element<T, 1, PaperLaws<T>>, Load<T, 1, UnbalancedRotor<T>>>;
+    Mechanical<T, 1, Element<T, 1, PaperLaws<T>>, Load<T, 1, UnbalancedRotor<T>>>;
 
 /// The paper's oscillator with a linearly ramped forcing frequency (the experiment's sweep).
 pub type RampedPaperOscillator<T> = Oscillator<T, PaperLaws<T>, RampedRotor<T>>;

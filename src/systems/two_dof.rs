@@ -37,7 +37,7 @@ pub type TwoDofElements<T> = (
 );
 
 /// The assembled model: state `(q_1, q_2, q̇_1, q̇_2)`.
-pub type TwoDofImpactModel<T> = Mechanical<T, 2, 4, TwoDofElements<T>, Load<T, 2, Harmonic<T>>>;
+pub type TwoDofImpactModel<T> = Mechanical<T, 2, TwoDofElements<T>, Load<T, 2, Harmonic<T>>>;
 
 /// The parameters of the 2-DOF impact oscillator (nondimensional).
 ///
