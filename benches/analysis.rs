@@ -6,7 +6,8 @@ use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use nonsmooth::analysis::{
-    AmplitudePhase, LinearizedResponse, Spectrum, SpectrumAnalyzer, TurningPoint, fit_harmonics,
+    AmplitudePhase, AmplitudeSpectrum, LinearizedResponse, SpectrumAnalyzer, TurningPoint,
+    fit_harmonics,
 };
 use nonsmooth::systems::paper::PAPER;
 
@@ -49,7 +50,7 @@ fn harmonic_analysis(c: &mut Criterion) {
         })
     });
     c.bench_function("spectrum_4096_one_off", |b| {
-        b.iter(|| Spectrum::new(black_box(&t), black_box(&x), OMEGA).unwrap())
+        b.iter(|| AmplitudeSpectrum::new(black_box(&t), black_box(&x), OMEGA).unwrap())
     });
 }
 

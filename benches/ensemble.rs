@@ -14,14 +14,14 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use nalgebra::Vector2;
 use nonsmooth::drive::Simulation;
 use nonsmooth::ensemble::{
-    Ensemble, F64x4, F64x8, F64x16, LaneMath, Lanes, Member, Simd, Trajectory,
+    Ensemble, F64x4, F64x8, F64x16, LaneMath, Lanes, Member, MemberRun, Simd,
 };
 use nonsmooth::event::{Direction, Event, Stop};
 use nonsmooth::integrate::{Dopri5, Tolerances};
 use nonsmooth::systems::paper::PAPER;
 
 struct Setup {
-    jobs: Vec<Trajectory>,
+    jobs: Vec<MemberRun>,
     tol: Tolerances<f64, 2>,
     impact: Event<Stop<f64>>,
 }
@@ -35,7 +35,7 @@ fn setup() -> Setup {
     let jobs = (0..64)
         .map(|i| {
             let w = 17.5 + 7.5 * i as f64 / 63.0;
-            Trajectory::periods(Member::paper(w).unwrap(), y0, 20.0).unwrap()
+            MemberRun::periods(Member::paper(w).unwrap(), y0, 20.0).unwrap()
         })
         .collect();
     let impact = Event::new(

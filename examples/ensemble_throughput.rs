@@ -27,7 +27,7 @@ use std::time::Instant;
 use nalgebra::Vector2;
 use nonsmooth::drive::{Control, EventRecord, Observer, Simulation, StepView};
 use nonsmooth::ensemble::{
-    Ensemble, F64x2, F64x4, F64x8, F64x16, LaneMath, Lanes, Member, Simd, Trajectory,
+    Ensemble, F64x2, F64x4, F64x8, F64x16, LaneMath, Lanes, Member, MemberRun, Simd,
 };
 use nonsmooth::event::{Direction, Event, Stop};
 use nonsmooth::integrate::{DenseOutput, Dopri5, Tolerances};
@@ -87,10 +87,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         },
         Direction::Rising,
     );
-    let jobs: Vec<Trajectory> = (0..n)
+    let jobs: Vec<MemberRun> = (0..n)
         .map(|i| {
             let w = 17.5 + 7.5 * i as f64 / (n - 1) as f64;
-            Trajectory::periods(Member::paper(w)?, y0, periods)
+            MemberRun::periods(Member::paper(w)?, y0, periods)
         })
         .collect::<nonsmooth::Result<_>>()?;
     let observers = || -> Vec<Collect> {
@@ -129,7 +129,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     fn lanes<V: Lanes>(
         e: &Ensemble<Stop<f64>>,
-        jobs: &[Trajectory],
+        jobs: &[MemberRun],
         obs: &mut [Collect],
     ) -> nonsmooth::Result<()> {
         for r in e.run::<V, _>(jobs, obs)? {

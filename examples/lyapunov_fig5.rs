@@ -16,7 +16,7 @@ use std::time::Instant;
 use nalgebra::Vector2;
 use nonsmooth::integrate::{Dopri5, Tolerances};
 use nonsmooth::lyapunov::{
-    Branch, DiagramPoint, DiagramSettings, IntervalRule, Norm, PAPER_D0, pair_tolerances,
+    DiagramDirection, DiagramPoint, DiagramSettings, IntervalRule, Norm, PAPER_D0, pair_tolerances,
     tle_diagram,
 };
 use nonsmooth::systems::paper::PAPER;
@@ -135,7 +135,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let mut w = csv::Writer::from_path(&args.out)?;
     w.write_record(["omega_rad_s", "direction", "tle_per_s", "spread_per_s"])?;
-    for branch in [Branch::Increasing, Branch::Decreasing] {
+    for branch in [DiagramDirection::Increasing, DiagramDirection::Decreasing] {
         for p in d.branch(branch) {
             w.write_record([
                 format!("{:.6}", p.parameter),
@@ -147,7 +147,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     w.flush()?;
 
-    for branch in [Branch::Increasing, Branch::Decreasing] {
+    for branch in [DiagramDirection::Increasing, DiagramDirection::Decreasing] {
         let pts = d.branch(branch);
         let pos = pts.iter().filter(|p| p.exponent > 0.0).count();
         let max = pts

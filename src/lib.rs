@@ -22,6 +22,9 @@
 //! | analysis | spectra, harmonic fits, the paper's approximations, first grazing | [`analysis`] |
 //! | measured data | time series, filter, threshold impacts, identification | [`signal`], [`identify`] |
 //!
+//! `use nonsmooth::prelude::*` imports the types to build, run and record a system
+//! ([`prelude`]).
+//!
 //! ## Quick start
 //! ```
 //! use nonsmooth::systems::paper::PAPER;
@@ -61,6 +64,7 @@ pub mod lyapunov;
 pub mod model;
 pub mod orbit;
 pub mod output;
+pub mod prelude;
 pub mod roots;
 pub mod sample;
 pub mod scalar;

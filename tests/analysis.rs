@@ -9,8 +9,9 @@ use std::f64::consts::TAU;
 
 use nonsmooth::ForceLaw;
 use nonsmooth::analysis::{
-    AmplitudePhase, AnalysisError, DOMINANCE_THRESHOLD, Forcing, ForcingAmplitude, HarmonicFit,
-    LinearizedResponse, Spectrum, SpectrumAnalyzer, TurningPoint, fit_harmonics,
+    AmplitudeLaw, AmplitudePhase, AmplitudeSpectrum, AnalysisError, DOMINANCE_THRESHOLD,
+    ForcingAmplitude, HarmonicFit, LinearizedResponse, SpectrumAnalyzer, TurningPoint,
+    fit_harmonics,
 };
 use nonsmooth::force::LinearSpring;
 use nonsmooth::model::Oscillator;
@@ -108,7 +109,7 @@ fn check_spectrum(s: &Signal, rel_tol: f64, abs_tol: f64) {
     ] {
         let t = grid(n, periods, s.omega, t0);
         let x = s.sample(&t);
-        let sp = Spectrum::new(&t, &x, s.omega).unwrap();
+        let sp = AmplitudeSpectrum::new(&t, &x, s.omega).unwrap();
         assert_eq!(sp.periods(), periods);
         assert_eq!(sp.len(), n);
         assert!(
@@ -168,7 +169,10 @@ fn spectrum_of_a_sine_has_phase_minus_half_pi() {
     let omega = 20.465;
     let t = grid(128, 2, omega, 0.0);
     let x: Vec<f64> = t.iter().map(|&t| 0.25 * (3.0 * omega * t).sin()).collect();
-    let h = Spectrum::new(&t, &x, omega).unwrap().harmonic(3).unwrap();
+    let h = AmplitudeSpectrum::new(&t, &x, omega)
+        .unwrap()
+        .harmonic(3)
+        .unwrap();
     assert!((h.phase + std::f64::consts::FRAC_PI_2).abs() < 1e-13);
     assert!((h.sin - 0.25).abs() < 1e-14 && h.cos.abs() < 1e-14);
 }
@@ -187,7 +191,7 @@ fn dominant_harmonics_and_energy_fraction() {
         ],
     };
     let t = grid(400, 2, omega, 0.0);
-    let sp = Spectrum::new(&t, &sig.sample(&t), omega).unwrap();
+    let sp = AmplitudeSpectrum::new(&t, &sig.sample(&t), omega).unwrap();
     assert_eq!(sp.dominant_harmonic_count(DOMINANCE_THRESHOLD).unwrap(), 2);
     assert_eq!(sp.dominant_harmonic_count(1e-3).unwrap(), 3);
     assert_eq!(sp.dominant_harmonic_count(1e-4).unwrap(), 4);
@@ -205,7 +209,7 @@ fn dominant_harmonics_and_energy_fraction() {
         Err(AnalysisError::Parameter(_))
     ));
     // A constant signal: nothing dominates, nothing is missed.
-    let sp = Spectrum::new(&t, &vec![3.0; t.len()], omega).unwrap();
+    let sp = AmplitudeSpectrum::new(&t, &vec![3.0; t.len()], omega).unwrap();
     assert_eq!(sp.dominant_harmonic_count(DOMINANCE_THRESHOLD).unwrap(), 0);
     assert_eq!(sp.energy_fraction(1), 1.0);
 }
@@ -220,7 +224,7 @@ fn subharmonic_energy_is_not_counted_as_harmonic() {
         .iter()
         .map(|&t| (omega * t).sin() + 0.5 * (0.5 * omega * t).cos())
         .collect();
-    let sp = Spectrum::new(&t, &x, omega).unwrap();
+    let sp = AmplitudeSpectrum::new(&t, &x, omega).unwrap();
     assert!(rel(sp.amplitudes()[1], 0.5) < 1e-12);
     assert!((sp.bin_frequency(1) - omega / 2.0).abs() < 1e-14);
     let expect = 0.5 / (0.5 + 0.125);
@@ -288,7 +292,7 @@ fn fit_recovers_paper_like_coefficients_and_agrees_with_spectrum() {
     assert!((fit.condition - 2f64.sqrt()).abs() < 1e-9);
 
     // Two independent methods agree: least squares and the FFT.
-    let sp = Spectrum::new(&t, &x, omega).unwrap();
+    let sp = AmplitudeSpectrum::new(&t, &x, omega).unwrap();
     for k in 1..=3 {
         let h = sp.harmonic(k).unwrap();
         assert!((h.cos - fit.a[k - 1]).abs() < tol, "a{k}");
@@ -309,7 +313,7 @@ fn fit_recovers_paper_like_coefficients_and_agrees_with_spectrum() {
 
 #[test]
 fn fit_on_a_partial_period_nonuniform_grid() {
-    // Spectrum cannot do this one; the fit can.
+    // AmplitudeSpectrum cannot do this one; the fit can.
     let omega = 17.5;
     let t: Vec<f64> = (0..150).map(|i| 0.001 * (i as f64).powf(1.3)).collect();
     let sig = Signal {
@@ -329,7 +333,7 @@ fn fit_on_a_partial_period_nonuniform_grid() {
         );
         assert!((fit.b[j - 1] - s).abs() < tol, "b{j}");
     }
-    assert!(Spectrum::new(&t, &x, omega).is_err());
+    assert!(AmplitudeSpectrum::new(&t, &x, omega).is_err());
 }
 
 // ---------------------------------------------------------------------------------------
@@ -530,11 +534,12 @@ fn forcing_laws() {
     let rotor = *PAPER.oscillator::<f64>(3.0).unwrap().excitation();
     // The rotor's law ignores the speed it was built with.
     assert!(rel(rotor.amplitude_at(14.0), PAPER.m0e * 196.0) < 1e-15);
-    assert_eq!(Forcing::Constant(2.0).amplitude_at(14.0), 2.0);
+    assert_eq!(AmplitudeLaw::Constant(2.0).amplitude_at(14.0), 2.0);
     // A custom law through from_parts: the static limit of a constant force is F0/k.
-    let lin = LinearizedResponse::from_parts(1.0, 4.0, 0.1, 0.5, Forcing::Constant(2.0)).unwrap();
+    let lin =
+        LinearizedResponse::from_parts(1.0, 4.0, 0.1, 0.5, AmplitudeLaw::Constant(2.0)).unwrap();
     assert!(rel(lin.amplitude(1e-8), 0.5) < 1e-12);
-    assert_eq!(lin.forcing(), &Forcing::Constant(2.0));
+    assert_eq!(lin.forcing(), &AmplitudeLaw::Constant(2.0));
 }
 
 // ---------------------------------------------------------------------------------------
@@ -546,19 +551,19 @@ fn spectrum_rejects_bad_input() {
     let t = grid(64, 2, omega, 0.0);
     let x: Vec<f64> = t.iter().map(|&t| (omega * t).sin()).collect();
     assert!(matches!(
-        Spectrum::new(&t, &x[..63], omega),
+        AmplitudeSpectrum::new(&t, &x[..63], omega),
         Err(AnalysisError::LengthMismatch { t: 64, x: 63 })
     ));
     for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
         assert!(matches!(
-            Spectrum::new(&t, &x, bad),
+            AmplitudeSpectrum::new(&t, &x, bad),
             Err(AnalysisError::InvalidFrequency { .. })
         ));
     }
     let mut xn = x.clone();
     xn[7] = f64::NAN;
     assert_eq!(
-        Spectrum::new(&t, &xn, omega),
+        AmplitudeSpectrum::new(&t, &xn, omega),
         Err(AnalysisError::NonFinite {
             what: "value",
             index: 7
@@ -567,7 +572,7 @@ fn spectrum_rejects_bad_input() {
     let mut tn = t.clone();
     tn[3] = f64::INFINITY;
     assert!(matches!(
-        Spectrum::new(&tn, &x, omega),
+        AmplitudeSpectrum::new(&tn, &x, omega),
         Err(AnalysisError::NonFinite {
             what: "time",
             index: 3
@@ -576,18 +581,18 @@ fn spectrum_rejects_bad_input() {
     let mut tj = t.clone();
     tj[10] += 1e-3 * (t[1] - t[0]);
     assert!(matches!(
-        Spectrum::new(&tj, &x, omega),
+        AmplitudeSpectrum::new(&tj, &x, omega),
         Err(AnalysisError::NonUniformSampling { index: 10, .. })
     ));
     let mut tr = t.clone();
     tr.reverse();
     assert!(matches!(
-        Spectrum::new(&tr, &x, omega),
+        AmplitudeSpectrum::new(&tr, &x, omega),
         Err(AnalysisError::NonUniformSampling { .. })
     ));
     // 2.5 periods.
     let t25 = grid(64, 5, 2.0 * omega, 0.0);
-    match Spectrum::new(&t25, &x, omega) {
+    match AmplitudeSpectrum::new(&t25, &x, omega) {
         Err(AnalysisError::NotWholePeriods { periods, hint, .. }) => {
             assert!((periods - 2.5).abs() < 1e-12);
             assert!(hint.is_empty());
@@ -598,30 +603,30 @@ fn spectrum_rejects_bad_input() {
     let dt = 2.0 * TAU / omega / 64.0;
     let t_end: Vec<f64> = (0..=64).map(|i| i as f64 * dt).collect();
     let x_end: Vec<f64> = t_end.iter().map(|&t| (omega * t).sin()).collect();
-    match Spectrum::new(&t_end, &x_end, omega) {
+    match AmplitudeSpectrum::new(&t_end, &x_end, omega) {
         Err(AnalysisError::NotWholePeriods { hint, .. }) => assert!(hint.contains("drop")),
         other => panic!("{other:?}"),
     }
     // Less than one period.
     let t_short = grid(64, 1, 2.0 * omega, 0.0);
     assert!(matches!(
-        Spectrum::new(&t_short, &x, omega),
+        AmplitudeSpectrum::new(&t_short, &x, omega),
         Err(AnalysisError::NotWholePeriods { .. })
     ));
     // 4 periods in 8 samples: the first harmonic is at the Nyquist bin.
     let t8 = grid(8, 4, omega, 0.0);
     assert_eq!(
-        Spectrum::new(&t8, &[0.0; 8], omega),
+        AmplitudeSpectrum::new(&t8, &[0.0; 8], omega),
         Err(AnalysisError::TooFewSamples {
             samples: 8,
             required: 9
         })
     );
     assert!(matches!(
-        Spectrum::new(&t[..2], &x[..2], omega),
+        AmplitudeSpectrum::new(&t[..2], &x[..2], omega),
         Err(AnalysisError::TooFewSamples { .. })
     ));
-    let sp = Spectrum::new(&t, &x, omega).unwrap();
+    let sp = AmplitudeSpectrum::new(&t, &x, omega).unwrap();
     assert_eq!(sp.max_harmonic(), 15);
     assert_eq!(
         sp.harmonic(16),
@@ -732,7 +737,7 @@ fn approximations_reject_bad_input() {
 #[test]
 fn public_types_are_send_sync_clone() {
     fn check<T: Send + Sync + Clone>() {}
-    check::<Spectrum>();
+    check::<AmplitudeSpectrum>();
     check::<SpectrumAnalyzer>();
     check::<HarmonicFit<f64>>();
     check::<LinearizedResponse<f64>>();

@@ -2,7 +2,7 @@
 //! spectra, and the exact first grazing.
 
 use nalgebra::Vector2;
-use nonsmooth::analysis::{Spectrum, first_grazing, fit_harmonics, steady_samples};
+use nonsmooth::analysis::{AmplitudeSpectrum, first_grazing, fit_harmonics, steady_samples};
 use nonsmooth::integrate::{Dopri5, Tolerances};
 use nonsmooth::systems::paper::PAPER;
 
@@ -28,7 +28,7 @@ fn steady(w: f64) -> (Vec<f64>, Vec<f64>) {
 }
 
 /// Harmonics whose amplitude is at least `frac` of the largest.
-fn dominant(sp: &Spectrum, frac: f64) -> usize {
+fn dominant(sp: &AmplitudeSpectrum, frac: f64) -> usize {
     let amps: Vec<f64> = (1..=sp.max_harmonic())
         .map(|j| sp.harmonic_amplitude(j).unwrap())
         .collect();
@@ -66,11 +66,11 @@ fn dominant_harmonics_along_the_low_frequency_regime() {
     // default 1 % threshold the counts are larger (13 at ω = 14: the harmonics j ≥ 3 are
     // 1.4–3.4 % of the first).
     let (t, x) = steady(14.0);
-    let sp = Spectrum::new(&t, &x, 14.0).unwrap();
+    let sp = AmplitudeSpectrum::new(&t, &x, 14.0).unwrap();
     assert_eq!(dominant(&sp, 0.1), 2);
     for w in [15.0, 16.0] {
         let (t, x) = steady(w);
-        let sp = Spectrum::new(&t, &x, w).unwrap();
+        let sp = AmplitudeSpectrum::new(&t, &x, w).unwrap();
         let n = dominant(&sp, 0.1);
         assert!((4..=5).contains(&n), "ω = {w}: {n} dominant harmonics");
     }

@@ -6,7 +6,7 @@
 use nalgebra::Vector2;
 use nonsmooth::drive::{Control, EventRecord, Observer, Simulation};
 use nonsmooth::ensemble::{
-    Ensemble, F64x2, F64x4, F64x8, F64x16, LaneMath, Lanes, Member, Trajectory, math,
+    Ensemble, F64x2, F64x4, F64x8, F64x16, LaneMath, Lanes, Member, MemberRun, math,
 };
 use nonsmooth::event::{Direction, Event, Level, Stop};
 use nonsmooth::integrate::{Dopri5, Stats, Tolerances};
@@ -71,7 +71,7 @@ fn rest() -> Vector2<f64> {
 }
 
 /// The scalar path: `Simulation` + `Dopri5`, steps landing on the sections.
-fn scalar(job: &Trajectory, tol: Tolerances<f64, 2>, event: bool) -> (Record, Stats, Vector2<f64>) {
+fn scalar(job: &MemberRun, tol: Tolerances<f64, 2>, event: bool) -> (Record, Stats, Vector2<f64>) {
     let mut rec = Record::new(job.member.period());
     let sim = Simulation::new(*job.member.scalar(), Dopri5::new(tol))
         .landing_grid(job.grid)
@@ -89,7 +89,7 @@ fn scalar(job: &Trajectory, tol: Tolerances<f64, 2>, event: bool) -> (Record, St
 
 /// The ensemble path in lanes of `V`.
 fn lanes<V: Lanes>(
-    jobs: &[Trajectory],
+    jobs: &[MemberRun],
     tol: Tolerances<f64, 2>,
     math: LaneMath,
 ) -> Vec<(Record, Stats, Vector2<f64>)> {
@@ -112,10 +112,10 @@ fn lanes<V: Lanes>(
         .collect()
 }
 
-fn paper_jobs(omegas: &[f64], periods: f64) -> Vec<Trajectory> {
+fn paper_jobs(omegas: &[f64], periods: f64) -> Vec<MemberRun> {
     omegas
         .iter()
-        .map(|&w| Trajectory::periods(Member::paper(w).unwrap(), rest(), periods).unwrap())
+        .map(|&w| MemberRun::periods(Member::paper(w).unwrap(), rest(), periods).unwrap())
         .collect()
 }
 
@@ -146,11 +146,11 @@ fn lanes_reproduce_the_scalar_paper_model_to_the_bit() {
 #[test]
 fn tail_compaction_keeps_every_trajectory() {
     let omegas = [17.0, 18.0, 19.0, 20.465, 22.0, 25.0, 15.7];
-    let jobs: Vec<Trajectory> = omegas
+    let jobs: Vec<MemberRun> = omegas
         .iter()
         .enumerate()
         .map(|(k, &w)| {
-            Trajectory::periods(Member::paper(w).unwrap(), rest(), 3.0 + k as f64).unwrap()
+            MemberRun::periods(Member::paper(w).unwrap(), rest(), 3.0 + k as f64).unwrap()
         })
         .collect();
     let tol = tol(1e-8);
@@ -276,9 +276,9 @@ impl Linear {
 fn smooth_reference_closed_form() {
     let omegas = [6.0, 9.0, 12.7, 15.0, 20.0, 31.0];
     let y0 = Vector2::new(1e-3, -2e-2);
-    let jobs: Vec<Trajectory> = omegas
+    let jobs: Vec<MemberRun> = omegas
         .iter()
-        .map(|&w| Trajectory::periods(Member::new(Linear::params(), w).unwrap(), y0, 30.0).unwrap())
+        .map(|&w| MemberRun::periods(Member::new(Linear::params(), w).unwrap(), y0, 30.0).unwrap())
         .collect();
     let tol = Tolerances::per_component(1e-9, [1e-13, 1e-11]).unwrap();
     for math in [LaneMath::Exact, LaneMath::Vector] {
@@ -324,10 +324,10 @@ fn events_in_lanes_are_located_like_the_scalar_ones() {
     let tol = Tolerances::per_component(1e-9, [1e-13, 1e-11]).unwrap();
     let ev = Event::new(Level::new(0, level).unwrap(), Direction::Either);
     for math in [LaneMath::Exact, LaneMath::Vector] {
-        let jobs: Vec<Trajectory> = omegas
+        let jobs: Vec<MemberRun> = omegas
             .iter()
             .map(|&w| {
-                Trajectory::periods(Member::new(Linear::params(), w).unwrap(), y0, 20.0).unwrap()
+                MemberRun::periods(Member::new(Linear::params(), w).unwrap(), y0, 20.0).unwrap()
             })
             .collect();
         let mut recs: Vec<Record> = jobs
@@ -402,7 +402,7 @@ fn results_do_not_depend_on_lanes_order_or_threads() {
         assert_eq!(summary(&lanes::<F64x8>(&jobs, tol, math)), base);
         assert_eq!(summary(&lanes::<F64x16>(&jobs, tol, math)), base);
         // Reversed batch: the same per trajectory.
-        let rev: Vec<Trajectory> = jobs.iter().rev().copied().collect();
+        let rev: Vec<MemberRun> = jobs.iter().rev().copied().collect();
         let mut r = summary(&lanes::<F64x4>(&rev, tol, math));
         r.reverse();
         assert_eq!(r, base);
@@ -605,11 +605,11 @@ fn invalid_input_is_an_error() {
     let m = Member::paper(20.0).unwrap();
     assert!(Member::paper(f64::NAN).is_err());
     assert!(Member::paper(-1.0).is_err());
-    assert!(Trajectory::new(m, 0.0, rest(), 0.0).is_err());
-    assert!(Trajectory::new(m, 0.0, Vector2::new(f64::NAN, 0.0), 1.0).is_err());
-    assert!(Trajectory::periods(m, rest(), 0.0).is_err());
+    assert!(MemberRun::new(m, 0.0, rest(), 0.0).is_err());
+    assert!(MemberRun::new(m, 0.0, Vector2::new(f64::NAN, 0.0), 1.0).is_err());
+    assert!(MemberRun::periods(m, rest(), 0.0).is_err());
     assert!(
-        Trajectory::new(m, 0.0, rest(), 1.0)
+        MemberRun::new(m, 0.0, rest(), 1.0)
             .unwrap()
             .with_grid(0.0, -1.0)
             .is_err()
@@ -623,7 +623,7 @@ fn invalid_input_is_an_error() {
     assert!(ens.clone().max_steps(0).is_err());
     // A step cap too small for a trajectory fails that trajectory only.
     let capped = ens.max_steps(50).unwrap();
-    let short = [Trajectory::new(m, 0.0, rest(), 2e-5).unwrap(), jobs[0]];
+    let short = [MemberRun::new(m, 0.0, rest(), 2e-5).unwrap(), jobs[0]];
     let mut obs = vec![(); 2];
     let out = capped.run::<F64x4, _>(&jobs, &mut obs).unwrap();
     assert!(out.iter().all(|o| o.is_err()));
@@ -644,7 +644,7 @@ fn within<T: Send + 'static>(secs: u64, f: impl FnOnce() -> T + Send + 'static) 
 
 /// The ensemble's results with `Record` observers: per trajectory its summary or the error
 /// message.
-fn run_records(jobs: Vec<Trajectory>) -> Vec<Result<Summary, String>> {
+fn run_records(jobs: Vec<MemberRun>) -> Vec<Result<Summary, String>> {
     within(120, move || {
         let mut recs: Vec<Record> = jobs
             .iter()

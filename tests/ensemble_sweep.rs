@@ -4,7 +4,7 @@
 
 use nalgebra::Vector2;
 use nonsmooth::ensemble::{
-    Ensemble, F64x2, F64x4, F64x8, IndependentSweep, LaneMath, Member, Simd, Trajectory,
+    Ensemble, F64x2, F64x4, F64x8, IndependentSweep, LaneMath, Member, MemberRun, Simd,
     sweep_independent,
 };
 use nonsmooth::event::{Direction, Event, Stop};
@@ -131,9 +131,9 @@ fn independent_sweep_errors() {
 #[test]
 fn every_instruction_set_gives_the_same_bits() {
     let y0 = rest();
-    let jobs: Vec<Trajectory> = [17.6, 18.0, 19.0, 20.465, 21.3]
+    let jobs: Vec<MemberRun> = [17.6, 18.0, 19.0, 20.465, 21.3]
         .iter()
-        .map(|&w| Trajectory::periods(Member::paper(w).unwrap(), y0, 30.0).unwrap())
+        .map(|&w| MemberRun::periods(Member::paper(w).unwrap(), y0, 30.0).unwrap())
         .collect();
     let impact = Event::new(stop(), Direction::Rising);
     let available = Simd::available();

@@ -5,7 +5,7 @@ use nonsmooth::ForceLaw;
 use nonsmooth::force::{DryFriction, HertzContact, LinearSpring, Side, ViscousDamper};
 use nonsmooth::systems::paper::PAPER;
 use nonsmooth::testing::{
-    Axis, CheckConfig, CheckReport, ContactClaim, LawSpec, LawViolation, Property, Variable,
+    CheckConfig, CheckReport, ContactClaim, GridAxis, LawSpec, LawViolation, Property, Variable,
     check_law, points_in,
 };
 use proptest::prelude::*;
@@ -32,17 +32,17 @@ fn paper_contact(side: Side, eta: f64) -> HertzContact<f64> {
 }
 
 /// Around the stop: separations and penetrations 1 nm … 0.1 mm (and the stop itself).
-fn x_near(stop: f64) -> Axis {
-    Axis::log_around(stop, 1e-9, 1e-4).unwrap()
+fn x_near(stop: f64) -> GridAxis {
+    GridAxis::log_around(stop, 1e-9, 1e-4).unwrap()
 }
 
 /// Velocities ±10 nm/s … 1 m/s, and 0.
-fn v_axis() -> Axis {
-    Axis::log_around(0.0, 1e-8, 1.0).unwrap()
+fn v_axis() -> GridAxis {
+    GridAxis::log_around(0.0, 1e-8, 1.0).unwrap()
 }
 
-fn x_wide() -> Axis {
-    Axis::linear(-1e-2, 1e-2).unwrap()
+fn x_wide() -> GridAxis {
+    GridAxis::linear(-1e-2, 1e-2).unwrap()
 }
 
 fn contact_config(side: Side, stop: f64, kink_at_zero_rate: bool) -> CheckConfig {
@@ -78,7 +78,7 @@ fn reject<L: ForceLaw<f64>>(law: &L, config: &CheckConfig) -> LawViolation {
 #[test]
 fn checker_types_are_send_sync_clone() {
     fn check<T: Send + Sync + Clone + 'static>() {}
-    check::<Axis>();
+    check::<GridAxis>();
     check::<LawSpec>();
     check::<ContactClaim>();
     check::<CheckConfig>();
@@ -128,7 +128,7 @@ fn dry_friction_sqrt_and_tanh_pass_as_dissipative() {
     // Velocities down to 1e-10 m/s, well inside the regularization ε = 1e-6 m/s.
     let cfg = CheckConfig::new(
         x_wide(),
-        Axis::log_around(0.0, 1e-10, 1.0).unwrap(),
+        GridAxis::log_around(0.0, 1e-10, 1.0).unwrap(),
         LawSpec::new().dissipative().analytic_partials(),
     )
     .unwrap();
@@ -214,15 +214,15 @@ fn tuple_of_the_four_paper_laws_passes() {
     pass(&PAPER.laws::<f64>().unwrap(), &cfg);
     // On a wide linear domain too.
     let spec = LawSpec::new().analytic_partials().kink_x(X_I).kink_v(0.0);
-    let cfg = CheckConfig::new(Axis::linear(-5e-3, 1e-3).unwrap(), v_axis(), spec).unwrap();
+    let cfg = CheckConfig::new(GridAxis::linear(-5e-3, 1e-3).unwrap(), v_axis(), spec).unwrap();
     pass(&exact, &cfg);
 }
 
 #[test]
 fn f32_laws_pass() {
     let cfg = CheckConfig::new(
-        Axis::linear(-1e-2, 1e-2).unwrap(),
-        Axis::log_around(0.0, 1e-6, 1.0).unwrap(),
+        GridAxis::linear(-1e-2, 1e-2).unwrap(),
+        GridAxis::log_around(0.0, 1e-6, 1.0).unwrap(),
         LawSpec::new().dissipative().analytic_partials(),
     )
     .unwrap();
@@ -238,8 +238,8 @@ fn f32_laws_pass() {
         .kink_v(0.0);
     // f32 resolves ~2e-10 m next to the stop: penetrations from 1e-6 m.
     let cfg = CheckConfig::new(
-        Axis::log_around(X_I, 1e-6, 1e-4).unwrap(),
-        Axis::log_around(0.0, 1e-5, 1.0).unwrap(),
+        GridAxis::log_around(X_I, 1e-6, 1e-4).unwrap(),
+        GridAxis::log_around(0.0, 1e-5, 1.0).unwrap(),
         spec,
     )
     .unwrap();

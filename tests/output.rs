@@ -11,7 +11,7 @@ use nonsmooth::output::csv::{
 };
 use nonsmooth::sample::{Impact, Regime, SectionPoint};
 use nonsmooth::sweep::{
-    Branch, RampImpact, RampRecord, RampSection, SweepDirection, SweepPoint, SweepResult,
+    RampImpact, RampRecord, RampSection, SweepBranch, SweepDirection, SweepPoint, SweepResult,
 };
 
 /// A fresh scratch directory for one test.
@@ -59,7 +59,7 @@ fn point(
 
 /// Two branches, three values each, with known contents.
 fn sample_result() -> SweepResult<2> {
-    let up = Branch {
+    let up = SweepBranch {
         direction: SweepDirection::Up,
         points: vec![
             point(

@@ -130,7 +130,7 @@ fn problem_types_are_send_sync_copy() {
     check::<BouncingBall<f64>>();
     check::<nonsmooth::testing::BallDrop<f64>>();
     check::<HarmonicZeroCrossings<f64>>();
-    check::<nonsmooth::testing::Crossing<f64>>();
+    check::<nonsmooth::testing::ZeroCrossing<f64>>();
     check::<NearGrazing<f64>>();
     check::<nonsmooth::testing::ConvergenceFit>();
 }

@@ -15,7 +15,7 @@ use serde::{Deserialize, Serialize};
 use serde_json::{Value, json};
 
 use nonsmooth::ParameterError;
-use nonsmooth::analysis::{Forcing, LinearizedResponse};
+use nonsmooth::analysis::{AmplitudeLaw, LinearizedResponse};
 use nonsmooth::event::{Direction, Level, Restitution};
 use nonsmooth::excite::{Harmonic, RampedRotor, UnbalancedRotor};
 use nonsmooth::force::{
@@ -429,7 +429,7 @@ fn linearized_response() {
         1500.0,
         6.6511,
         -2.08e-3,
-        Forcing::Unbalance(0.01805),
+        AmplitudeLaw::Unbalance(0.01805),
     )
     .unwrap();
     round_trip(&lin);
@@ -437,7 +437,8 @@ fn linearized_response() {
         &lin,
         "/mass",
         json!(0.0),
-        LinearizedResponse::from_parts(0.0, 1.0, 1.0, 0.0, Forcing::Constant(1.0)).unwrap_err(),
+        LinearizedResponse::from_parts(0.0, 1.0, 1.0, 0.0, AmplitudeLaw::Constant(1.0))
+            .unwrap_err(),
     );
     rejects(&lin, "/damping", json!(-1.0), "`damping`");
 }

@@ -5,8 +5,8 @@ use nalgebra::Vector2;
 use nonsmooth::integrate::{Dopri5, Tolerances};
 use nonsmooth::sample::Regime;
 use nonsmooth::sweep::{
-    Branch, Stop, SweepConfig, SweepDirection, SweepError, SweepPoint, SweepResult, SweepSystem,
-    hysteresis, run_point, sweep, transitions,
+    Stop, SweepBranch, SweepConfig, SweepDirection, SweepError, SweepPoint, SweepResult,
+    SweepSystem, hysteresis, run_point, sweep, transitions,
 };
 use nonsmooth::systems::paper::{PAPER, PaperOscillator};
 
@@ -193,7 +193,7 @@ fn point(param: f64, regime: Regime, ipp: f64, x: f64) -> SweepPoint<2> {
 #[test]
 fn hysteresis_and_transitions_on_constructed_branches() {
     let p1 = Regime::Periodic(1);
-    let up = Branch {
+    let up = SweepBranch {
         direction: SweepDirection::Up,
         points: vec![
             point(1.0, p1, 1.0, 1.0),
@@ -202,7 +202,7 @@ fn hysteresis_and_transitions_on_constructed_branches() {
             point(4.0, p1, 2.0, 2.0),
         ],
     };
-    let down = Branch {
+    let down = SweepBranch {
         direction: SweepDirection::Down,
         points: vec![
             point(4.0, p1, 2.0, 2.0),

@@ -14,8 +14,8 @@ use nonsmooth::sample::{
     Impact, ImpactSequence, Regime, SectionPoint, Stroboscopic, Trajectory, detect_period,
 };
 use nonsmooth::sweep::{
-    Branch, Stop, SweepConfig, SweepDirection, SweepPoint, SweepResult, SweepSystem, Transition,
-    hysteresis, run_point, transitions,
+    Stop, SweepBranch, SweepConfig, SweepDirection, SweepPoint, SweepResult, SweepSystem,
+    Transition, hysteresis, run_point, transitions,
 };
 use nonsmooth::systems::paper::{PAPER, PaperOscillator};
 
@@ -138,7 +138,7 @@ fn branch(
     dir: SweepDirection,
     y0: Vector2<f64>,
     pb: &ProgressBar,
-) -> nonsmooth::Result<Branch<2>> {
+) -> nonsmooth::Result<SweepBranch<2>> {
     let mut vals = config.values().to_vec();
     if dir == SweepDirection::Down {
         vals.reverse();
@@ -154,7 +154,7 @@ fn branch(
         points.push(p);
     }
     pb.finish();
-    Ok(Branch {
+    Ok(SweepBranch {
         direction: dir,
         points,
     })
@@ -171,7 +171,7 @@ pub fn run_sweep(
     let multi = MultiProgress::new();
     let n = config.values().len();
     let start = Instant::now();
-    let branches: Vec<nonsmooth::Result<Branch<2>>> = std::thread::scope(|s| {
+    let branches: Vec<nonsmooth::Result<SweepBranch<2>>> = std::thread::scope(|s| {
         let handles: Vec<_> = directions
             .iter()
             .map(|&d| {
@@ -284,7 +284,7 @@ pub fn normalize(result: &SweepResult<2>) -> SweepResult<2> {
 /// Prints the transitions of a branch (steps where the impacts per orbit period or the
 /// period change), leaving out changes of the window average between two non-periodic
 /// (chaotic) points, which are noise; returns the transitions printed.
-pub fn print_transitions(branch: &Branch<2>) -> Vec<Transition> {
+pub fn print_transitions(branch: &SweepBranch<2>) -> Vec<Transition> {
     let all = transitions(branch);
     let (kept, noise): (Vec<Transition>, Vec<Transition>) = all.into_iter().partition(|t| {
         !(t.regime_before == Regime::NotPeriodic && t.regime_after == Regime::NotPeriodic)
@@ -349,7 +349,7 @@ pub fn print_hysteresis(result: &SweepResult<2>, tol: f64) -> Vec<(f64, f64)> {
 }
 
 /// The point of a branch nearest to `w`.
-pub fn nearest(branch: &Branch<2>, w: f64) -> Option<&SweepPoint<2>> {
+pub fn nearest(branch: &SweepBranch<2>, w: f64) -> Option<&SweepPoint<2>> {
     branch.points.iter().min_by(|a, b| {
         (a.param - w)
             .abs()

@@ -5,8 +5,8 @@
 
 use nalgebra::Vector2;
 use nonsmooth::analysis::{
-    AmplitudePhase, LinearizedResponse, Spectrum, TurningPoint, first_grazing, fit_harmonics,
-    steady_samples,
+    AmplitudePhase, AmplitudeSpectrum, LinearizedResponse, TurningPoint, first_grazing,
+    fit_harmonics, steady_samples,
 };
 use nonsmooth::entropy::{
     EntropyIndex, Histogram, HistogramEstimate, QRange, entropy_index, redundancy_curve,
@@ -104,7 +104,7 @@ pub fn steady(omega: f64, rtol: f64) -> Res<Steady> {
     let x = s.component(0);
     let v = s.component(1);
     let f = fit_harmonics(&s.t, &x, omega, 2)?;
-    let sp = Spectrum::new(&s.t, &x, omega)?;
+    let sp = AmplitudeSpectrum::new(&s.t, &x, omega)?;
     let harmonics = (1..=12)
         .map(|j| sp.harmonic_amplitude(j))
         .collect::<Result<Vec<_>, _>>()?;

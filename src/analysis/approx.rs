@@ -43,22 +43,22 @@ impl<T: Real, F: ForcingAmplitude<T> + ?Sized> ForcingAmplitude<T> for &F {
     }
 }
 
-/// Forcing amplitude laws for [`LinearizedResponse::from_parts`].
+/// AmplitudeLaw amplitude laws for [`LinearizedResponse::from_parts`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-pub enum Forcing<T> {
+pub enum AmplitudeLaw<T> {
     /// `F0(ω) = F0`, independent of the frequency (N).
     Constant(T),
     /// `F0(ω) = m0e·ω²`, an unbalanced rotor with unbalance `m0e` (kg·m).
     Unbalance(T),
 }
 
-impl<T: Real> ForcingAmplitude<T> for Forcing<T> {
+impl<T: Real> ForcingAmplitude<T> for AmplitudeLaw<T> {
     #[inline]
     fn amplitude_at(&self, omega: T) -> T {
         match *self {
-            Forcing::Constant(f0) => f0,
-            Forcing::Unbalance(m0e) => m0e * omega * omega,
+            AmplitudeLaw::Constant(f0) => f0,
+            AmplitudeLaw::Unbalance(m0e) => m0e * omega * omega,
         }
     }
 }
@@ -169,7 +169,7 @@ fn equilibrium<T: Real, L: ForceLaw<T>, E: Excitation<T>>(
 /// The paper's Sect. 5, eq. (4) and the grazing estimate that follows it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
-pub struct LinearizedResponse<T, F = Forcing<T>> {
+pub struct LinearizedResponse<T, F = AmplitudeLaw<T>> {
     mass: T,
     stiffness: T,
     damping: T,
@@ -727,20 +727,22 @@ mod tests {
     #[test]
     fn from_parts_validation_and_forcing_laws() {
         assert!(
-            LinearizedResponse::from_parts(0.0, 1.0, 0.1, 0.0, Forcing::Constant(1.0)).is_err()
-        );
-        assert!(
-            LinearizedResponse::from_parts(1.0, 1.0, -0.1, 0.0, Forcing::Constant(1.0)).is_err()
-        );
-        assert!(
-            LinearizedResponse::from_parts(1.0, f64::NAN, 0.1, 0.0, Forcing::Constant(1.0))
+            LinearizedResponse::from_parts(0.0, 1.0, 0.1, 0.0, AmplitudeLaw::Constant(1.0))
                 .is_err()
         );
-        let l =
-            LinearizedResponse::from_parts(1.0_f64, 1.0, 0.0, 0.0, Forcing::Constant(2.0)).unwrap();
+        assert!(
+            LinearizedResponse::from_parts(1.0, 1.0, -0.1, 0.0, AmplitudeLaw::Constant(1.0))
+                .is_err()
+        );
+        assert!(
+            LinearizedResponse::from_parts(1.0, f64::NAN, 0.1, 0.0, AmplitudeLaw::Constant(1.0))
+                .is_err()
+        );
+        let l = LinearizedResponse::from_parts(1.0_f64, 1.0, 0.0, 0.0, AmplitudeLaw::Constant(2.0))
+            .unwrap();
         // Static limit: amplitude F0/k.
         assert!((l.amplitude(1e-9) - 2.0).abs() < 1e-12);
-        assert_eq!(Forcing::Unbalance(0.5).amplitude_at(2.0), 2.0);
+        assert_eq!(AmplitudeLaw::Unbalance(0.5).amplitude_at(2.0), 2.0);
         // A Harmonic excitation has no amplitude law: use from_parts.
         let _ = Harmonic::new(1.0, 1.0, 0.0).unwrap();
     }

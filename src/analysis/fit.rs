@@ -66,7 +66,7 @@ impl<T: Real> HarmonicFit<T> {
 ///
 /// The time stamps need not be uniform nor cover whole periods; when they do (a uniform grid
 /// over whole periods), the basis is orthogonal and the fit agrees with the
-/// [`Spectrum`](super::Spectrum)'s harmonics. Measure `t` from a Poincaré section
+/// [`AmplitudeSpectrum`](super::AmplitudeSpectrum)'s harmonics. Measure `t` from a Poincaré section
 /// `t = 2πi/ω` to get the coefficients in the paper's time origin; any time counted from the
 /// start of a constant-frequency simulation is such an origin.
 ///

@@ -3,7 +3,7 @@
 //!
 //! | tool | what | paper |
 //! |---|---|---|
-//! | [`Spectrum`], [`SpectrumAnalyzer`] | one-sided amplitude spectrum of a uniformly sampled signal covering a whole number of forcing periods; harmonic amplitudes and phases; how many harmonics dominate | Fig. 9b |
+//! | [`AmplitudeSpectrum`], [`SpectrumAnalyzer`] | one-sided amplitude spectrum of a uniformly sampled signal covering a whole number of forcing periods; harmonic amplitudes and phases; how many harmonics dominate | Fig. 9b |
 //! | [`fit_harmonics`] → [`HarmonicFit`] | least-squares truncated Fourier series $a_0 + \sum_k (a_k\cos k\omega t + b_k \sin k\omega t)$ | eq. (3) |
 //! | [`LinearizedResponse`] | the linearization about the static equilibrium $X_0$ and its grazing estimate | eq. (4), $\omega = 15.657$ |
 //! | [`steady_samples`], [`first_grazing`] | steady response sampled over whole periods from a simulation; the exact first grazing by a bracketing search in ω | eq. (3), Fig. 9, ω ≈ 14 |
@@ -31,12 +31,12 @@ mod spectrum;
 mod steady;
 
 pub use approx::{
-    AmplitudePhase, AmplitudePhaseSolution, Forcing, ForcingAmplitude, LinearizedResponse,
+    AmplitudeLaw, AmplitudePhase, AmplitudePhaseSolution, ForcingAmplitude, LinearizedResponse,
     TurningPoint,
 };
 pub use fit::{HarmonicFit, fit_harmonics};
 pub use spectrum::{
-    DOMINANCE_THRESHOLD, HarmonicComponent, PERIOD_TOLERANCE, SPACING_TOLERANCE, Spectrum,
+    AmplitudeSpectrum, DOMINANCE_THRESHOLD, HarmonicComponent, PERIOD_TOLERANCE, SPACING_TOLERANCE,
     SpectrumAnalyzer,
 };
 pub use steady::{SteadySamples, first_grazing, steady_min_gap, steady_samples};

@@ -20,7 +20,7 @@ pub const PERIOD_TOLERANCE: f64 = 1e-6;
 /// `|t_i − (t_0 + i·dt)| ≤ 10⁻⁶·dt`.
 pub const SPACING_TOLERANCE: f64 = 1e-6;
 
-/// Default relative amplitude threshold of [`Spectrum::dominant_harmonic_count`]: 1 % of the
+/// Default relative amplitude threshold of [`AmplitudeSpectrum::dominant_harmonic_count`]: 1 % of the
 /// largest non-DC harmonic.
 ///
 /// Why 1 %: a harmonic at 1 % of the largest amplitude (−40 dB) carries 10⁻⁴ of its energy, so
@@ -32,7 +32,7 @@ pub const SPACING_TOLERANCE: f64 = 1e-6;
 /// count is 2, as the paper states ("only two dominant frequencies, ω and 2ω").
 pub const DOMINANCE_THRESHOLD: f64 = 0.01;
 
-/// One harmonic `j` of a [`Spectrum`]:
+/// One harmonic `j` of a [`AmplitudeSpectrum`]:
 /// `x_j(t) = amplitude·cos(jωt + phase) = cos·cos(jωt) + sin·sin(jωt)`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -67,7 +67,7 @@ pub struct HarmonicComponent {
 ///
 /// # Examples
 /// ```
-/// use nonsmooth::analysis::Spectrum;
+/// use nonsmooth::analysis::AmplitudeSpectrum;
 /// let omega = 14.0_f64;
 /// let (n, periods) = (256, 4);
 /// let dt = periods as f64 * std::f64::consts::TAU / omega / n as f64;
@@ -75,7 +75,7 @@ pub struct HarmonicComponent {
 /// let x: Vec<f64> = t.iter()
 ///     .map(|&t| 0.5 + 3.0 * (omega * t).sin() - 0.7 * (2.0 * omega * t).cos())
 ///     .collect();
-/// let s = Spectrum::new(&t, &x, omega)?;
+/// let s = AmplitudeSpectrum::new(&t, &x, omega)?;
 /// assert_eq!(s.periods(), 4);
 /// let h1 = s.harmonic(1)?;
 /// assert!((h1.amplitude - 3.0).abs() < 1e-12 && (h1.sin - 3.0).abs() < 1e-12);
@@ -84,7 +84,7 @@ pub struct HarmonicComponent {
 /// # Ok::<(), nonsmooth::analysis::AnalysisError>(())
 /// ```
 #[derive(Debug, Clone, PartialEq)]
-pub struct Spectrum {
+pub struct AmplitudeSpectrum {
     omega: f64,
     periods: usize,
     t0: f64,
@@ -96,7 +96,7 @@ pub struct Spectrum {
 
 /// A planned FFT of a fixed length, reused over many signals (e.g. one per frequency of a
 /// sweep). [`analyze_into`](SpectrumAnalyzer::analyze_into) allocates nothing once the
-/// output [`Spectrum`] has been created.
+/// output [`AmplitudeSpectrum`] has been created.
 #[derive(Clone)]
 pub struct SpectrumAnalyzer {
     n: usize,
@@ -168,8 +168,13 @@ impl SpectrumAnalyzer {
     ///
     /// # Errors
     /// As [`analyze_into`](Self::analyze_into).
-    pub fn analyze(&mut self, t: &[f64], x: &[f64], omega: f64) -> Result<Spectrum, AnalysisError> {
-        let mut out = Spectrum {
+    pub fn analyze(
+        &mut self,
+        t: &[f64],
+        x: &[f64],
+        omega: f64,
+    ) -> Result<AmplitudeSpectrum, AnalysisError> {
+        let mut out = AmplitudeSpectrum {
             omega,
             periods: 0,
             t0: 0.0,
@@ -202,7 +207,7 @@ impl SpectrumAnalyzer {
         t: &[f64],
         x: &[f64],
         omega: f64,
-        out: &mut Spectrum,
+        out: &mut AmplitudeSpectrum,
     ) -> Result<(), AnalysisError> {
         if t.len() != self.n {
             return Err(AnalysisError::PlanLengthMismatch {
@@ -335,7 +340,7 @@ pub(super) fn check_finite<T: crate::Real>(t: &[T], x: &[T]) -> Result<(), Analy
     Ok(())
 }
 
-impl Spectrum {
+impl AmplitudeSpectrum {
     /// The spectrum of `x` sampled at the uniform time stamps `t`, which must cover a whole
     /// number `P` of forcing periods `2π/omega`: `n·dt = P·2π/ω` (the grid
     /// `t_i = t_0 + i·dt`, `i < n`, stops one step short of `t_0 + P·2π/ω`). Plans a
@@ -540,7 +545,7 @@ mod tests {
         let omega = 3.0;
         let t = grid(64, 3, omega, 0.0);
         let x: Vec<f64> = t.iter().map(|&t| 2.5 * (2.0 * omega * t).cos()).collect();
-        let s = Spectrum::new(&t, &x, omega).unwrap();
+        let s = AmplitudeSpectrum::new(&t, &x, omega).unwrap();
         assert_eq!(s.periods(), 3);
         assert_eq!(s.max_harmonic(), 10);
         for (m, &a) in s.amplitudes().iter().enumerate() {
@@ -561,7 +566,7 @@ mod tests {
         let x: Vec<f64> = (0..n)
             .map(|i| if i % 2 == 0 { 0.3 } else { -0.3 })
             .collect();
-        let s = Spectrum::new(&t, &x, omega).unwrap();
+        let s = AmplitudeSpectrum::new(&t, &x, omega).unwrap();
         assert!((s.amplitudes()[4] - 0.3).abs() < 1e-15);
         assert_eq!(s.max_harmonic(), 3);
         // Parseval: the variance 0.09 is all in the Nyquist bin, which is not a resolved

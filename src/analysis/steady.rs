@@ -31,7 +31,7 @@ impl<const N: usize> SteadySamples<N> {
 /// Runs `system` from `y0` for `transient` forcing periods of length `period`, then samples
 /// `periods` periods at `per_period` points each (times `k·period/per_period` from the
 /// start of the window, the window's end excluded, so the samples cover exactly
-/// `periods` periods as [`Spectrum`](super::Spectrum) requires).
+/// `periods` periods as [`AmplitudeSpectrum`](super::AmplitudeSpectrum) requires).
 ///
 /// # Errors
 /// [`AnalysisError::Simulation`] if the run fails, [`AnalysisError::TooFewSamples`] for

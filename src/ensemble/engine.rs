@@ -19,7 +19,7 @@ use crate::validate::ParameterError;
 /// run starts ([`check`](Self::check)), and an invalid trajectory is an error in its own
 /// result slot of [`Ensemble::run`].
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Trajectory {
+pub struct MemberRun {
     /// The model.
     pub member: Member,
     /// Start time.
@@ -32,7 +32,7 @@ pub struct Trajectory {
     pub grid: Option<(f64, f64)>,
 }
 
-impl Trajectory {
+impl MemberRun {
     /// From `(t0, y0)` to `t_end`, without a landing grid.
     ///
     /// # Errors
@@ -228,7 +228,7 @@ impl<G: EventFunction<f64, 2>> Ensemble<G> {
     /// the next one in order; the result of each trajectory does not depend on `V`, on the
     /// order of the slice or on what runs in the other lanes.
     ///
-    /// Every trajectory is checked ([`Trajectory::check`]) before the lanes start: an
+    /// Every trajectory is checked ([`MemberRun::check`]) before the lanes start: an
     /// invalid one (fields set directly to a reversed time span, a non-finite state, a
     /// landing grid with `dt ≤ 0`) never enters a lane; its result is the error, and the
     /// others run as they would without it.
@@ -237,10 +237,10 @@ impl<G: EventFunction<f64, 2>> Ensemble<G> {
     /// The outer error: [`ParameterError`] if `observers` and `trajectories` differ in
     /// length. Each trajectory's own result is an element of the vector: its
     /// [`Outcome`], or the error that stopped it (the scalar driver's errors, or that of
-    /// [`Trajectory::check`]).
+    /// [`MemberRun::check`]).
     pub fn run<V: Lanes, O: Observer<f64, 2>>(
         &self,
-        trajectories: &[Trajectory],
+        trajectories: &[MemberRun],
         observers: &mut [O],
     ) -> Result<Vec<Result<Outcome<f64, 2>>>> {
         if observers.len() != trajectories.len() {
@@ -280,7 +280,7 @@ impl<G: EventFunction<f64, 2>> Ensemble<G> {
     #[cfg(feature = "parallel")]
     pub fn run_parallel<V: Lanes, O: Observer<f64, 2> + Send>(
         &self,
-        trajectories: &[Trajectory],
+        trajectories: &[MemberRun],
         observers: &mut [O],
         chunk: usize,
     ) -> Result<Vec<Result<Outcome<f64, 2>>>>
@@ -378,8 +378,8 @@ impl Slot {
 /// The lanes and their scalar bookkeeping.
 struct Engine<'a, V: Lanes, G> {
     cfg: &'a Ensemble<G>,
-    jobs: &'a [Trajectory],
-    /// The indices of the valid trajectories, in order ([`Trajectory::check`]).
+    jobs: &'a [MemberRun],
+    /// The indices of the valid trajectories, in order ([`MemberRun::check`]).
     queue: &'a [usize],
     /// The next position in `queue`.
     next: usize,
@@ -418,9 +418,9 @@ fn lanes_of(mut mask: u32) -> impl Iterator<Item = usize> {
 impl<'a, V: Lanes, G: EventFunction<f64, 2>> Engine<'a, V, G> {
     fn new(
         cfg: &'a Ensemble<G>,
-        jobs: &'a [Trajectory],
+        jobs: &'a [MemberRun],
         queue: &'a [usize],
-        first: &Trajectory,
+        first: &MemberRun,
     ) -> Self {
         let z = V::splat(0.0);
         let packed = Packed::splat(&first.member);
@@ -475,7 +475,7 @@ impl<'a, V: Lanes, G: EventFunction<f64, 2>> Engine<'a, V, G> {
     fn start<O: Observer<f64, 2>>(&mut self, i: usize, j: usize, obs: &mut O) -> Result<()> {
         let job = &self.jobs[j];
         let cfg = self.cfg;
-        // The time span, state and grid were checked before the run (`Trajectory::check`).
+        // The time span, state and grid were checked before the run (`MemberRun::check`).
         let (t0, y0, t_end) = (job.t0, job.y0, job.t_end);
         cfg.opts
             .validate()

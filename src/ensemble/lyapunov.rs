@@ -2,7 +2,7 @@
 
 use nalgebra::SVector;
 
-use super::{Ensemble, Lanes, Member, Trajectory};
+use super::{Ensemble, Lanes, Member, MemberRun};
 use crate::drive::Outcome;
 use crate::error::Result;
 use crate::integrate::Stats;
@@ -85,7 +85,7 @@ fn estimate(
     d0: f64,
     norm: Norm<f64, 2>,
     settings: &DiagramSettings<f64>,
-    run: impl Fn(&[Trajectory]) -> Result<Vec<Result<Outcome<f64, 2>>>>,
+    run: impl Fn(&[MemberRun]) -> Result<Vec<Result<Outcome<f64, 2>>>>,
 ) -> Result<Vec<DiagramPoint<f64>>> {
     if members.is_empty() {
         return Err(LyapunovError::NoParameters.into());
@@ -149,8 +149,8 @@ fn estimate(
                 t0
             };
             let (t_a, t_b) = (grid(start, p.tau, j), grid(start, p.tau, j + 1));
-            jobs.push(Trajectory::new(p.member, t_a, p.a, t_b)?);
-            jobs.push(Trajectory::new(p.member, t_a, p.b, t_b)?);
+            jobs.push(MemberRun::new(p.member, t_a, p.a, t_b)?);
+            jobs.push(MemberRun::new(p.member, t_a, p.b, t_b)?);
         }
         let out = run(&jobs)?;
         let mut out = out.into_iter();

@@ -91,15 +91,15 @@
 //! ```
 //! use nalgebra::Vector2;
 //! use nonsmooth::drive::Simulation;
-//! use nonsmooth::ensemble::{Ensemble, F64x4, Member, Trajectory};
+//! use nonsmooth::ensemble::{Ensemble, F64x4, Member, MemberRun};
 //! use nonsmooth::integrate::{Dopri5, Tolerances};
 //! use nonsmooth::systems::paper::PAPER;
 //!
 //! let tol = Tolerances::per_component(1e-8, [1e-12, 1e-10])?;
 //! let y0 = Vector2::new(PAPER.static_equilibrium()?, 0.0);
 //! // Eight forcing frequencies, 5 periods each, in lanes of four.
-//! let jobs: Vec<Trajectory> = (0..8)
-//!     .map(|i| Trajectory::periods(Member::paper(17.5 + i as f64)?, y0, 5.0))
+//! let jobs: Vec<MemberRun> = (0..8)
+//!     .map(|i| MemberRun::periods(Member::paper(17.5 + i as f64)?, y0, 5.0))
 //!     .collect::<nonsmooth::Result<_>>()?;
 //! let mut observers = vec![(); jobs.len()];
 //! let out = Ensemble::new(tol)?.run::<F64x4, _>(&jobs, &mut observers)?;
@@ -121,7 +121,7 @@ mod model;
 mod simd;
 mod sweep;
 
-pub use engine::{Ensemble, LaneDense, Trajectory};
+pub use engine::{Ensemble, LaneDense, MemberRun};
 pub use lanes::{F64x2, F64x4, F64x8, F64x16, Lanes};
 pub use lyapunov::tle_independent;
 #[cfg(feature = "parallel")]

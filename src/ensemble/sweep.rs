@@ -3,7 +3,7 @@
 
 use nalgebra::SVector;
 
-use super::{Ensemble, Lanes, Member, Trajectory};
+use super::{Ensemble, Lanes, Member, MemberRun};
 use crate::drive::Outcome;
 use crate::event::{Direction, Event, Stop};
 use crate::sample::{ImpactSequence, PeriodSummary, Periodic, Stroboscopic, detect_period};
@@ -300,7 +300,7 @@ fn run_starts<V: Lanes>(
     let mut results: Vec<Option<crate::Result<SweepPoint<2>>>> = Vec::with_capacity(starts.len());
     let (mut jobs, mut obs, mut slot) = (Vec::new(), Vec::new(), Vec::new());
     for (k, (m, y0)) in starts.iter().enumerate() {
-        match Trajectory::periods(*m, *y0, periods) {
+        match MemberRun::periods(*m, *y0, periods) {
             Ok(j) => {
                 obs.push(observers(m, settings, stop)?);
                 jobs.push(j);

@@ -14,19 +14,19 @@ use crate::{Dynamics, Real};
 /// The direction of a continuation branch.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-pub enum Branch {
+pub enum DiagramDirection {
     /// The parameter values in the given order (the paper's red line).
     Increasing,
     /// The parameter values in reverse order (the paper's green line).
     Decreasing,
 }
 
-impl Branch {
+impl DiagramDirection {
     /// `"increasing"` or `"decreasing"` (for tidy output).
     pub fn as_str(&self) -> &'static str {
         match self {
-            Branch::Increasing => "increasing",
-            Branch::Decreasing => "decreasing",
+            DiagramDirection::Increasing => "increasing",
+            DiagramDirection::Decreasing => "decreasing",
         }
     }
 }
@@ -179,10 +179,10 @@ pub struct Diagram<T> {
 
 impl<T> Diagram<T> {
     /// The points of one branch.
-    pub fn branch(&self, branch: Branch) -> &[DiagramPoint<T>] {
+    pub fn branch(&self, branch: DiagramDirection) -> &[DiagramPoint<T>] {
         match branch {
-            Branch::Increasing => &self.increasing,
-            Branch::Decreasing => &self.decreasing,
+            DiagramDirection::Increasing => &self.increasing,
+            DiagramDirection::Decreasing => &self.decreasing,
         }
     }
 }
@@ -273,13 +273,13 @@ where
     // Validate everything that can be validated before spending time on a branch.
     super::two_trajectory::check_pair_settings::<T, N, M>(d0, &norm)?;
 
-    let branch = |dir: Branch| -> Result<Vec<DiagramPoint<T>>> {
+    let branch = |dir: DiagramDirection| -> Result<Vec<DiagramPoint<T>>> {
         let mut out = Vec::with_capacity(values.len());
         let mut est: Option<TwoTrajectory<T, N, M, S, St>> = None;
         for i in 0..values.len() {
             let p = match dir {
-                Branch::Increasing => values[i],
-                Branch::Decreasing => values[values.len() - 1 - i],
+                DiagramDirection::Increasing => values[i],
+                DiagramDirection::Decreasing => values[values.len() - 1 - i],
             };
             let system = make(p)?;
             let tau = settings.interval.interval(p)?;
@@ -314,9 +314,15 @@ where
         Ok(out)
     };
     #[cfg(feature = "parallel")]
-    let (up, down) = rayon::join(|| branch(Branch::Increasing), || branch(Branch::Decreasing));
+    let (up, down) = rayon::join(
+        || branch(DiagramDirection::Increasing),
+        || branch(DiagramDirection::Decreasing),
+    );
     #[cfg(not(feature = "parallel"))]
-    let (up, down) = (branch(Branch::Increasing), branch(Branch::Decreasing));
+    let (up, down) = (
+        branch(DiagramDirection::Increasing),
+        branch(DiagramDirection::Decreasing),
+    );
     Ok(Diagram {
         increasing: up?,
         decreasing: down?,
@@ -334,7 +340,7 @@ mod tests {
         let t = IntervalRule::ForcingPeriod.interval(20.0_f64).unwrap();
         assert!((t - std::f64::consts::TAU / 20.0).abs() < 1e-16);
         assert!(IntervalRule::<f64>::ForcingPeriod.interval(0.0).is_err());
-        assert_eq!(Branch::Decreasing.as_str(), "decreasing");
+        assert_eq!(DiagramDirection::Decreasing.as_str(), "decreasing");
         let p = DiagramSettings::<f64>::paper();
         assert_eq!(
             (p.first_transient, p.step_transient, p.intervals),

@@ -129,7 +129,9 @@ pub mod hybrid;
 mod tangent;
 mod two_trajectory;
 
-pub use diagram::{Branch, Diagram, DiagramPoint, DiagramSettings, IntervalRule, tle_diagram};
+pub use diagram::{
+    Diagram, DiagramDirection, DiagramPoint, DiagramSettings, IntervalRule, tle_diagram,
+};
 pub use hybrid::{HybridTangentSpace, HybridTwoTrajectory, Saltation};
 pub use tangent::{Spectrum, TangentSpace, Variational, tangent_tolerances};
 pub use two_trajectory::{

@@ -361,7 +361,7 @@ pub struct SweepPoint<const N: usize> {
 
 /// One direction of a sweep.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Branch<const N: usize> {
+pub struct SweepBranch<const N: usize> {
     /// [`SweepDirection::Up`] or [`SweepDirection::Down`] (or `Both`'s parts); for
     /// independent starts, `Up`.
     pub direction: SweepDirection,
@@ -373,7 +373,7 @@ pub struct Branch<const N: usize> {
 #[derive(Debug, Clone, PartialEq)]
 pub struct SweepResult<const N: usize> {
     /// The branches (one, or up then down).
-    pub branches: Vec<Branch<N>>,
+    pub branches: Vec<SweepBranch<N>>,
 }
 
 /// An event function that is either a surface's penetration or never zero.
@@ -572,7 +572,7 @@ where
     G: Fn() -> St + Sync,
     Sf: Surface<f64, N> + Clone + Send,
 {
-    let branch = |dir: SweepDirection| -> Result<Branch<N>, SweepError> {
+    let branch = |dir: SweepDirection| -> Result<SweepBranch<N>, SweepError> {
         let mut vals: Vec<f64> = config.values.clone();
         if dir == SweepDirection::Down {
             vals.reverse();
@@ -591,7 +591,7 @@ where
                 y = pt.end_state;
                 points.push(pt);
             }
-            Ok(Branch {
+            Ok(SweepBranch {
                 direction: dir,
                 points,
             })
@@ -607,7 +607,7 @@ where
             };
             #[cfg(not(feature = "parallel"))]
             let points: Result<Vec<_>, _> = vals.iter().map(one).collect();
-            Ok(Branch {
+            Ok(SweepBranch {
                 direction: dir,
                 points: points?,
             })
@@ -725,7 +725,7 @@ pub struct Transition {
 /// The steps along a branch where the number of impacts per period (rounded to 1/100) or
 /// the regime changes: grazing bifurcations add or remove impacts; period doublings and
 /// transitions to chaos change the regime.
-pub fn transitions<const N: usize>(branch: &Branch<N>) -> Vec<Transition> {
+pub fn transitions<const N: usize>(branch: &SweepBranch<N>) -> Vec<Transition> {
     branch
         .points
         .windows(2)

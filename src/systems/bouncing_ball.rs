@@ -17,26 +17,11 @@
 
 use crate::Real;
 use crate::event::{Gap, NewtonImpact};
-use crate::excite::{Excitation, Harmonic};
+use crate::excite::{Constant, Harmonic};
 use crate::model::{Coordinate, Load, Mechanical};
 use crate::scalar::lit;
 use crate::validate::ParameterError;
 use crate::validate::positive;
-
-/// A constant force (gravity on a unit mass: `−g`).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Constant<T>(pub T);
-
-impl<T: Real> Excitation<T> for Constant<T> {
-    #[inline(always)]
-    fn force(&self, _t: T) -> T {
-        self.0
-    }
-    #[inline(always)]
-    fn force_rate(&self, _t: T) -> T {
-        T::zero()
-    }
-}
 
 /// The ball in flight: state `(y, ẏ)`.
 pub type BallModel<T> = Mechanical<T, 1, (), Load<T, 1, Constant<T>>>;
@@ -113,7 +98,7 @@ impl BouncingBallTable {
     pub fn model<T: Real>(&self) -> crate::Result<BallModel<T>> {
         self.validate()?;
         Ok(Mechanical::with_masses([T::one()])?
-            .with_loads(Load::on_dof(0, Constant(-lit::<T>(self.g)))?))
+            .with_loads(Load::on_dof(0, Constant::new(-lit::<T>(self.g))?)?))
     }
 
     /// The table surface `s(t) = A sin ωt` (the ball must stay above it).

@@ -223,7 +223,7 @@ impl<T: Real> BallDrop<T> {
 
 /// A zero crossing of a signal.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Crossing<T> {
+pub struct ZeroCrossing<T> {
     /// The crossing time.
     pub t: T,
     /// `true` if the signal goes from negative to positive.
@@ -296,16 +296,16 @@ impl<T: Real> HarmonicZeroCrossings<T> {
     }
 
     /// The crossing with index `k` (see the model).
-    pub fn crossing(&self, k: i64) -> Crossing<T> {
+    pub fn crossing(&self, k: i64) -> ZeroCrossing<T> {
         let pi = T::pi();
-        Crossing {
+        ZeroCrossing {
             t: (pi * lit::<T>(0.5) + lit::<T>(k as f64) * pi - self.phase) / self.omega,
             rising: k.rem_euclid(2) == 1,
         }
     }
 
     /// All crossings with `t0 ≤ t ≤ t1`, in order (empty unless `t0 ≤ t1`, both finite).
-    pub fn crossings_in(&self, t0: T, t1: T) -> Vec<Crossing<T>> {
+    pub fn crossings_in(&self, t0: T, t1: T) -> Vec<ZeroCrossing<T>> {
         let mut out = Vec::new();
         if !(t0.is_finite() && t1.is_finite() && t0 <= t1) {
             return out;

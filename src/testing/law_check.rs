@@ -13,7 +13,7 @@ use crate::scalar::{epsilon, lit, to_f64};
 use crate::validate::ParameterError;
 use crate::{ForceLaw, Real};
 
-/// Which way a [`Axis::log_around`] axis extends from its centre.
+/// Which way a [`GridAxis::log_around`] axis extends from its centre.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Sides {
     /// Both `centre − offset` and `centre + offset`, and the centre itself.
@@ -41,19 +41,19 @@ enum AxisKind {
 /// The range of one coordinate (`x` or `v`) over which a law is checked.
 ///
 /// Two shapes:
-/// - [`Axis::linear`]: `[lo, hi]`, sampled uniformly;
-/// - [`Axis::log_around`]: `centre ± 10^s` for `s` uniform in `[log₁₀ min, log₁₀ max]`, plus
+/// - [`GridAxis::linear`]: `[lo, hi]`, sampled uniformly;
+/// - [`GridAxis::log_around`]: `centre ± 10^s` for `s` uniform in `[log₁₀ min, log₁₀ max]`, plus
 ///   the centre itself — for tiny penetrations around a stop (`x_I ± 10⁻⁹…10⁻⁴ m`) or
 ///   velocities around a reversal (`0 ± 10⁻⁸…1 m/s`), where a linear grid would never land.
 ///
 /// Grids always contain the special points of the axis: its ends, the centre of a
 /// logarithmic axis (unless one-sided) and `0` if a linear axis contains it.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Axis {
+pub struct GridAxis {
     kind: AxisKind,
 }
 
-impl Axis {
+impl GridAxis {
     /// The interval `[lo, hi]`, sampled uniformly.
     ///
     /// # Errors
@@ -317,8 +317,8 @@ impl LawSpec {
 /// the `with_*` methods; the defaults are listed on each.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CheckConfig {
-    x: Axis,
-    v: Axis,
+    x: GridAxis,
+    v: GridAxis,
     spec: LawSpec,
     grid: usize,
     random: usize,
@@ -349,7 +349,7 @@ impl CheckConfig {
     ///
     /// # Errors
     /// [`ParameterError`] if a contact stop or a declared kink is not finite.
-    pub fn new(x: Axis, v: Axis, spec: LawSpec) -> Result<Self, ParameterError> {
+    pub fn new(x: GridAxis, v: GridAxis, spec: LawSpec) -> Result<Self, ParameterError> {
         if let Some(c) = &spec.contact {
             if !c.stop.is_finite() {
                 return Err(ParameterError::new("contact.stop", c.stop, "finite"));
@@ -376,7 +376,7 @@ impl CheckConfig {
     }
 
     /// Grid points per axis (default [`DEFAULT_GRID`](Self::DEFAULT_GRID)); the grid is the
-    /// Cartesian product of the two axes' [grids](Axis::grid).
+    /// Cartesian product of the two axes' [grids](GridAxis::grid).
     pub fn with_grid(mut self, n: usize) -> Self {
         self.grid = n;
         self
@@ -442,12 +442,12 @@ impl CheckConfig {
     }
 
     /// The position axis.
-    pub fn x(&self) -> &Axis {
+    pub fn x(&self) -> &GridAxis {
         &self.x
     }
 
     /// The velocity axis.
-    pub fn v(&self) -> &Axis {
+    pub fn v(&self) -> &GridAxis {
         &self.v
     }
 
@@ -737,17 +737,17 @@ pub fn check_law<T: Real, L: ForceLaw<T> + ?Sized>(
 }
 
 /// A proptest strategy over the points `(x, v)` of the configured domain: log-uniform on
-/// logarithmic axes, with the axes' [special points](Axis::special_points) drawn one time in
+/// logarithmic axes, with the axes' [special points](GridAxis::special_points) drawn one time in
 /// eight. Use it to write your own property tests of a law.
 ///
 /// ```
-/// use nonsmooth::testing::{Axis, CheckConfig, LawSpec, points_in};
+/// use nonsmooth::testing::{GridAxis, CheckConfig, LawSpec, points_in};
 /// use proptest::strategy::{Strategy, ValueTree};
 /// use proptest::test_runner::TestRunner;
 ///
 /// let cfg = CheckConfig::new(
-///     Axis::linear(-1.0, 1.0)?,
-///     Axis::log_around(0.0, 1e-8, 1.0)?,
+///     GridAxis::linear(-1.0, 1.0)?,
+///     GridAxis::log_around(0.0, 1e-8, 1.0)?,
 ///     LawSpec::new(),
 /// )?;
 /// let mut runner = TestRunner::deterministic();
@@ -760,7 +760,7 @@ pub fn points_in(config: &CheckConfig) -> impl Strategy<Value = (f64, f64)> + Cl
 }
 
 /// A proptest strategy over one axis (see [`points_in`]).
-pub fn axis_values(axis: &Axis) -> impl Strategy<Value = f64> + Clone + use<> {
+pub fn axis_values(axis: &GridAxis) -> impl Strategy<Value = f64> + Clone + use<> {
     let a = *axis;
     let specials = a.special_points();
     prop_oneof![
@@ -799,7 +799,7 @@ impl<T: Real, L: ForceLaw<T> + ?Sized> Checker<'_, T, L> {
     }
 
     /// Distance (in `T`) from `p` to the nearest kink, and the skip margin for that kink.
-    fn kink_distance(&self, p: T, kinks: &[f64], axis: &Axis) -> (T, bool) {
+    fn kink_distance(&self, p: T, kinks: &[f64], axis: &GridAxis) -> (T, bool) {
         let mut best = T::max_value().unwrap_or(T::one());
         let mut near = false;
         let margin = lit::<T>(self.config.kink_margin).max(lit::<T>(4.0) * epsilon::<T>());
@@ -1034,34 +1034,34 @@ mod tests {
 
     #[test]
     fn axes_map_and_grid() {
-        let a = Axis::log_around(-2e-3, 1e-9, 1e-4).unwrap();
+        let a = GridAxis::log_around(-2e-3, 1e-9, 1e-4).unwrap();
         assert_eq!(a.at(0.0), -2e-3 - 1e-4);
         assert_eq!(a.at(1.0), -2e-3 + 1e-4);
         assert!((a.at(0.75) - (-2e-3 + 1e-9 * 1e5_f64.powf(0.5))).abs() < 1e-18);
         let g = a.grid(9);
         assert!(g.contains(&-2e-3));
         assert!(g.windows(2).all(|w| w[0] < w[1]));
-        let above = Axis::log_around(0.0, 1e-8, 1.0)
+        let above = GridAxis::log_around(0.0, 1e-8, 1.0)
             .unwrap()
             .with_sides(Sides::Above);
         assert_eq!(above.bounds(), (1e-8, 1.0));
         assert!(above.grid(5).iter().all(|&v| v > 0.0));
-        let below = Axis::log_around(0.0, 1e-8, 1.0)
+        let below = GridAxis::log_around(0.0, 1e-8, 1.0)
             .unwrap()
             .with_sides(Sides::Below);
         assert!(below.grid(5).iter().all(|&v| v < 0.0));
-        let l = Axis::linear(-1.0, 3.0).unwrap();
+        let l = GridAxis::linear(-1.0, 3.0).unwrap();
         assert_eq!(l.grid(5), vec![-1.0, 0.0, 1.0, 2.0, 3.0]);
         assert_eq!(l.scale(), 3.0);
-        assert!(Axis::linear(1.0, 1.0).is_err());
-        assert!(Axis::linear(f64::NAN, 1.0).is_err());
-        assert!(Axis::log_around(0.0, 0.0, 1.0).is_err());
-        assert!(Axis::log_around(0.0, 2.0, 1.0).is_err());
+        assert!(GridAxis::linear(1.0, 1.0).is_err());
+        assert!(GridAxis::linear(f64::NAN, 1.0).is_err());
+        assert!(GridAxis::log_around(0.0, 0.0, 1.0).is_err());
+        assert!(GridAxis::log_around(0.0, 2.0, 1.0).is_err());
     }
 
     #[test]
     fn config_validation() {
-        let x = Axis::linear(-1.0, 1.0).unwrap();
+        let x = GridAxis::linear(-1.0, 1.0).unwrap();
         let spec = LawSpec::new().contact(ContactClaim::new(f64::NAN, Side::Upper));
         assert!(CheckConfig::new(x, x, spec).is_err());
         assert!(CheckConfig::new(x, x, LawSpec::new().kink_v(f64::INFINITY)).is_err());

@@ -3,7 +3,7 @@
 //!
 //! # Checking your own force law
 //! [`check_law`] evaluates a [`ForceLaw`](crate::ForceLaw) on a rectangle
-//! `x ∈ X`, `v ∈ V` ([`Axis`]: linear, or logarithmic around a centre for tiny penetrations
+//! `x ∈ X`, `v ∈ V` ([`GridAxis`]: linear, or logarithmic around a centre for tiny penetrations
 //! and velocities) — a deterministic grid, a probe of the contact onset, then pseudo-random
 //! points (SplitMix64, fixed seed) — and verifies what the law claims in its [`LawSpec`]:
 //!
@@ -59,7 +59,7 @@
 //! ```
 //! use nonsmooth::ForceLaw;
 //! use nonsmooth::force::Side;
-//! use nonsmooth::testing::{Axis, CheckConfig, ContactClaim, LawSpec, Property, check_law};
+//! use nonsmooth::testing::{GridAxis, CheckConfig, ContactClaim, LawSpec, Property, check_law};
 //!
 //! /// Hunt–Crossley contact `F = k·δ^{3/2}·(1 + α·v)`, `δ = x − x_I > 0`, clamped at 0
 //! /// (a contact pushes, it never pulls) unless `clamped` is false.
@@ -88,8 +88,8 @@
 //!     .analytic_partials()
 //!     .kink_v(-1.0 / 1.5); // where the clamp switches
 //! let config = CheckConfig::new(
-//!     Axis::log_around(-2e-3, 1e-9, 1e-4)?, // x_I ± 1 nm … 0.1 mm, and x_I itself
-//!     Axis::log_around(0.0, 1e-8, 2.0)?,    // v = ±10 nm/s … 2 m/s, and 0
+//!     GridAxis::log_around(-2e-3, 1e-9, 1e-4)?, // x_I ± 1 nm … 0.1 mm, and x_I itself
+//!     GridAxis::log_around(0.0, 1e-8, 2.0)?,    // v = ±10 nm/s … 2 m/s, and 0
 //!     spec,
 //! )?;
 //! let report = check_law(&law, &config).expect("a correct law passes");
@@ -136,10 +136,10 @@ mod problems;
 pub use ball_table::{BallOnTableExact, TableImpact};
 pub use convergence::{ConvergenceFit, convergence_fit, convergence_order};
 pub use hand_written::{DuffingUedaByHand, TwoDofImpactByHand};
-pub use impacts::{BallDrop, BouncingBall, Crossing, HarmonicZeroCrossings, NearGrazing};
+pub use impacts::{BallDrop, BouncingBall, HarmonicZeroCrossings, NearGrazing, ZeroCrossing};
 pub use law_check::{
-    Axis, CheckConfig, CheckReport, ContactClaim, LawSpec, LawViolation, Property, Sides, Variable,
-    axis_values, check_law, points_in,
+    CheckConfig, CheckReport, ContactClaim, GridAxis, LawSpec, LawViolation, Property, Sides,
+    Variable, axis_values, check_law, points_in,
 };
 pub use problems::{
     DampedOscillator, ExactSolution, ExponentialDecay, ForcedOscillator, HarmonicOscillator,
