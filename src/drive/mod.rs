@@ -348,7 +348,7 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
     /// Caps the number of accepted steps per run.
     ///
     /// # Errors
-    /// [`ParameterError`](crate::ParameterError) if `max_steps == 0`.
+    /// [`ParameterError`] if `max_steps == 0`.
     pub fn max_steps(mut self, max_steps: usize) -> Result<Self, ParameterError> {
         if max_steps == 0 {
             return Err(ParameterError::new("max_steps", 0.0, "> 0"));
@@ -360,7 +360,7 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
     /// Sets the absolute event-time tolerance.
     ///
     /// # Errors
-    /// [`ParameterError`](crate::ParameterError) unless `tol` is finite and > 0.
+    /// [`ParameterError`] unless `tol` is finite and > 0.
     pub fn event_tolerance(mut self, tol: T) -> Result<Self, ParameterError> {
         self.event_tol = crate::validate::positive("event_tol", tol)?;
         Ok(self)
@@ -376,7 +376,7 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
     /// the grid is computed from `i`, never accumulated). `None` removes the grid.
     ///
     /// # Errors
-    /// [`ParameterError`](crate::ParameterError) unless `dt` is finite and > 0.
+    /// [`ParameterError`] unless `dt` is finite and > 0.
     pub fn landing_grid(mut self, grid: Option<(T, T)>) -> Result<Self, ParameterError> {
         if let Some((o, dt)) = grid {
             crate::validate::finite("origin", o)?;
