@@ -30,7 +30,7 @@ fn signal() -> (Vec<f64>, Vec<f64>) {
 
 fn pipeline(c: &mut Criterion) {
     let (t, x) = signal();
-    let filter = LowPass::paper();
+    let filter: LowPass<f64> = nonsmooth::systems::paper::low_pass().unwrap();
     let detector = ThresholdCrossing::new(0.8e-3)
         .unwrap()
         .with_hysteresis(1e-5)

@@ -38,11 +38,11 @@ use std::time::Instant;
 use nalgebra::Vector2;
 use nonsmooth::Dynamics;
 use nonsmooth::integrate::{Dopri5, Tolerances};
-use nonsmooth::signal::{
-    Forcing, LowPass, PhaseSection, SyntheticExperiment, ThresholdCrossing, section_frequencies,
-};
+use nonsmooth::signal::{PhaseSection, section_frequencies};
 use nonsmooth::sweep::{Stop, ramp};
-use nonsmooth::systems::paper::PAPER;
+use nonsmooth::systems::paper::{
+    FILTER_THETA, Forcing, IMPACT_OFFSET, PAPER, SyntheticExperiment, impact_detector, low_pass,
+};
 
 struct Args {
     from: f64,
@@ -137,15 +137,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     );
 
     // 2. The measured-data pipeline.
-    let (h, theta, offset): (f64, f64, f64) = (1e-3, 1e-3, nonsmooth::signal::PAPER_IMPACT_OFFSET);
+    let (h, theta, offset): (f64, f64, f64) = (1e-3, FILTER_THETA, IMPACT_OFFSET);
     let a = (-h / theta).exp();
     let delay = h / (1.0 - a);
     let sigma_f = args.noise * ((1.0 - a) / (1.0 + a)).sqrt();
     let w = std::f64::consts::TAU * args.hum_frequency * h;
     let hum_f = args.hum * (1.0 - a) / ((1.0 - a * w.cos()).powi(2) + (a * w.sin()).powi(2)).sqrt();
     let eta = 5.0 * sigma_f + hum_f;
-    let filtered = record.measured.filtered(&LowPass::paper())?;
-    let detector = ThresholdCrossing::paper_impacts(PAPER.x_i)?.with_hysteresis(eta)?;
+    let filtered = record.measured.filtered(&low_pass()?)?;
+    let detector = impact_detector(PAPER.x_i)?.with_hysteresis(eta)?;
     let detected = filtered.crossings(&detector)?;
     let section = filtered.poincare(&PhaseSection::new())?;
     let omegas = section_frequencies(&section)?;

@@ -35,12 +35,12 @@ use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use nonsmooth::identify::{
-    Forcing, M2_TO_MM2, NelderMeadOptions, PAPER_FIT_PARAMETERS, PaperFit, paper_parameter,
+use nonsmooth::identify::{M2_TO_MM2, NelderMeadOptions};
+use nonsmooth::signal::{CsvOptions, TimeSeries};
+use nonsmooth::systems::paper::{
+    Forcing, PAPER, PAPER_FIT_PARAMETERS, PaperFit, SyntheticExperiment, paper_parameter,
     set_paper_parameter,
 };
-use nonsmooth::signal::{CsvOptions, SyntheticExperiment, TimeSeries};
-use nonsmooth::systems::paper::PAPER;
 
 struct Args {
     omega: f64,
@@ -178,7 +178,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let wall = Instant::now();
     for (stage, &t2) in stages.iter().enumerate() {
         let subset: &[&str] = if stage == 0 && stages.len() > 1 {
-            &["k", "c", "T"]
+            &["k", "c", "t"]
         } else {
             &PAPER_FIT_PARAMETERS
         };

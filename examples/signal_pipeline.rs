@@ -10,11 +10,8 @@
 use std::f64::consts::PI;
 use std::path::PathBuf;
 
-use nonsmooth::signal::{
-    CsvOptions, LowPass, PhaseSection, ThresholdCrossing, TimeSeries, intervals,
-    section_frequencies,
-};
-use nonsmooth::systems::paper::PAPER;
+use nonsmooth::signal::{CsvOptions, PhaseSection, TimeSeries, intervals, section_frequencies};
+use nonsmooth::systems::paper::{PAPER, impact_detector, low_pass};
 
 /// SplitMix64 (Steele, Lea & Flood 2014): a tiny deterministic generator for pseudo-noise.
 struct SplitMix64(u64);
@@ -75,11 +72,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     );
 
     // 3. Smooth with the paper's filter, θ = 1 ms.
-    let smooth = series.filtered(&LowPass::paper())?;
+    let smooth = series.filtered(&low_pass()?)?;
 
     // 4. Impacts: upward crossings of x_I − 0.01 mm, debounced by a 2 µm hysteresis.
-    let detector = ThresholdCrossing::paper_impacts(x_stop)?.with_hysteresis(2e-6)?;
-    let raw_impacts = series.crossings(&ThresholdCrossing::paper_impacts(x_stop)?)?;
+    let detector = impact_detector(x_stop)?.with_hysteresis(2e-6)?;
+    let raw_impacts = series.crossings(&impact_detector(x_stop)?)?;
     let impacts = smooth.crossings(&detector)?;
     let intervals = intervals(&impacts);
     println!(

@@ -48,10 +48,10 @@ pub enum Error {
     Analysis(#[from] crate::analysis::AnalysisError),
     /// Measured data could not be read or processed.
     #[error(transparent)]
-    Signal(#[from] crate::signal::SignalError),
+    Signal(crate::signal::SignalError),
     /// Parameter identification failed.
     #[error(transparent)]
-    Identify(#[from] crate::identify::IdentifyError),
+    Identify(crate::identify::IdentifyError),
     /// Writing output failed.
     #[error("output error: {0}")]
     Output(String),
@@ -69,6 +69,48 @@ impl From<crate::drive::RunError> for Error {
             RunError::Integrate(e) => Error::Integrate(e),
             RunError::Event(e) => Error::Event(e),
             RunError::Mode(e) => Error::Mode(e),
+        }
+    }
+}
+
+impl From<crate::signal::SignalError> for Error {
+    /// A simulation's error keeps its kind (`SignalError::Run(e)` becomes `Error::from(e)`,
+    /// e.g. [`Error::Integrate`]); the others become [`Error::Signal`].
+    fn from(e: crate::signal::SignalError) -> Self {
+        use crate::signal::SignalError;
+        match e {
+            SignalError::Run(e) => e.into(),
+            e => Error::Signal(e),
+        }
+    }
+}
+
+impl From<crate::identify::IdentifyError> for Error {
+    /// A simulation's error keeps its kind (`IdentifyError::Run(e)` becomes
+    /// `Error::from(e)`, e.g. [`Error::Integrate`]); the others become [`Error::Identify`].
+    fn from(e: crate::identify::IdentifyError) -> Self {
+        use crate::identify::IdentifyError;
+        match e {
+            IdentifyError::Run(e) => e.into(),
+            e => Error::Identify(e),
+        }
+    }
+}
+
+impl From<Error> for crate::identify::IdentifyError {
+    /// For model builders ([`ModelFit`](crate::identify::ModelFit)) that use the crate's
+    /// constructors: the module error inside `e` (a run's kinds as
+    /// [`IdentifyError::Run`](crate::identify::IdentifyError::Run)), or the message of an
+    /// error without a variant there ([`IdentifyError::Other`](crate::identify::IdentifyError::Other)).
+    fn from(e: Error) -> Self {
+        use crate::drive::RunError;
+        use crate::identify::IdentifyError;
+        match e.into_run() {
+            Ok(RunError::Parameter(e)) => IdentifyError::Parameter(e),
+            Ok(e) => IdentifyError::Run(e),
+            Err(Error::Signal(e)) => e.into(),
+            Err(Error::Identify(e)) => e,
+            Err(other) => IdentifyError::Other(other.to_string()),
         }
     }
 }

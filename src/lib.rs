@@ -20,7 +20,7 @@
 //! | sweeps | up/down continuation, hysteresis, transitions, ramps | [`sweep`] |
 //! | chaos measures | top Lyapunov exponents (two-trajectory and QR), Tsallis entropy index | [`lyapunov`], [`entropy`] |
 //! | analysis | spectra, harmonic fits, the paper's approximations, first grazing | [`analysis`] |
-//! | measured data | time series, filter, threshold impacts, identification | [`signal`], [`identify`] |
+//! | measured data | time series, filter, threshold impacts, synthetic records, identification (the paper's configuration in [`systems::paper`]) | [`signal`], [`identify`] |
 //!
 //! `use nonsmooth::prelude::*` imports the types to build, run and record a system
 //! ([`prelude`]).

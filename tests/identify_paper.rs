@@ -13,15 +13,13 @@
 
 use nalgebra::{DMatrix, DVector, Vector2};
 use nonsmooth::Dynamics;
-use nonsmooth::identify::{
-    Forcing, IdentifyError, M2_TO_MM2, PaperFit, Parameter, paper_parameter, set_paper_parameter,
-};
+use nonsmooth::identify::{IdentifyError, M2_TO_MM2, Parameter};
 use nonsmooth::integrate::IntegrateError;
-use nonsmooth::signal::{
-    CsvOptions, LowPass, PAPER_IMPACT_OFFSET, SyntheticExperiment, SyntheticRecord,
-    ThresholdCrossing, TimeSeries,
+use nonsmooth::signal::{CsvOptions, TimeSeries};
+use nonsmooth::systems::paper::{
+    FILTER_THETA, Forcing, IMPACT_OFFSET, PAPER, PaperFit, PaperParameters, SyntheticExperiment,
+    SyntheticRecord, impact_detector, low_pass, paper_parameter, set_paper_parameter,
 };
-use nonsmooth::systems::paper::{PAPER, PaperParameters};
 
 const OMEGA: f64 = 17.0;
 const DURATION: f64 = 1.0;
@@ -394,7 +392,7 @@ fn impacts_detected_in_the_noisy_measurement_match_the_simulation() {
         .unwrap();
     let t = data.measured.t();
     let h: f64 = 1e-3;
-    let theta = LowPass::<f64>::paper().theta();
+    let theta = FILTER_THETA;
     // The discrete filter y_{n+1} = a·y_n + (1 − a)·u_n, a = e^{−h/θ}, follows a ramp
     // with the delay D = h/(1 − a) (1.58 ms at h = θ = 1 ms: θ plus the zero-order hold);
     // it scales white noise by √((1 − a)/(1 + a)) and a sine of frequency f by
@@ -408,11 +406,11 @@ fn impacts_detected_in_the_noisy_measurement_match_the_simulation() {
     // puts re-arming by noise inside one contact out of reach (a 5σ excursion of the
     // filtered noise on top of the full filtered hum).
     let eta = 5.0 * sigma_f + hum_f;
-    let detector = ThresholdCrossing::paper_impacts(PAPER.x_i)
+    let detector = impact_detector(PAPER.x_i)
         .unwrap()
         .with_hysteresis(eta)
         .unwrap();
-    let filtered = LowPass::paper().filter(t, data.measured.x()).unwrap();
+    let filtered = low_pass().unwrap().filter(t, data.measured.x()).unwrap();
     let detected = detector.times(t, &filtered).unwrap();
     let sim = &data.impacts;
     assert!(sim.len() >= 10, "{} impacts", sim.len());
@@ -430,8 +428,7 @@ fn impacts_detected_in_the_noisy_measurement_match_the_simulation() {
         let mut dy = Vector2::zeros();
         model.rhs(imp.t, &Vector2::new(PAPER.x_i, imp.velocity), &mut dy);
         let (v, acc) = (imp.velocity, dy[1]);
-        let tau =
-            2.0 * PAPER_IMPACT_OFFSET / (v + (v * v - 2.0 * acc * PAPER_IMPACT_OFFSET).sqrt());
+        let tau = 2.0 * IMPACT_OFFSET / (v + (v * v - 2.0 * acc * IMPACT_OFFSET).sqrt());
         let expected = imp.t - tau + delay;
         let tol = (3.0 * sigma_f + hum_f) / v + acc.abs() * (tau + delay).powi(2) / (2.0 * v);
         let err = td - expected;

@@ -481,14 +481,14 @@ fn low_pass() {
         .unwrap()
         .with_initial(InitialState::Value(0.25));
     round_trip(&f);
-    round_trip(&LowPass::<f64>::paper());
+    round_trip(&nonsmooth::systems::paper::low_pass::<f64>().unwrap());
     rejects(&f, "/theta", json!(0.0), LowPass::new(0.0).unwrap_err());
     rejects(&f, "/theta", json!(-1e-3), "`theta`");
 }
 
 #[test]
 fn threshold_crossing() {
-    let c = ThresholdCrossing::paper_impacts(-2.086e-3)
+    let c = nonsmooth::systems::paper::impact_detector(-2.086e-3)
         .unwrap()
         .with_direction(Direction::Either)
         .with_hysteresis(1e-6)

@@ -3,10 +3,10 @@
 use std::f64::consts::PI;
 
 use nonsmooth::signal::{
-    Column, CsvOptions, Direction, InitialState, Location, LowPass, PAPER_IMPACT_OFFSET,
-    PhaseInput, PhaseSection, SignalError, ThresholdCrossing, TimeSeries, intervals,
-    section_frequencies, unwrap_phase,
+    Column, CsvOptions, Direction, InitialState, Location, LowPass, PhaseInput, PhaseSection,
+    SignalError, ThresholdCrossing, TimeSeries, intervals, section_frequencies, unwrap_phase,
 };
+use nonsmooth::systems::paper::{IMPACT_OFFSET, impact_detector, low_pass};
 
 /// SplitMix64: deterministic pseudo-noise in [-1, 1).
 struct SplitMix64(u64);
@@ -251,8 +251,8 @@ fn paper_impact_threshold() {
         .iter()
         .map(|&t| x_i - 1e-4 + bump(t, 0.2, 1.5e-4) + bump(t, 0.5, 0.5e-4) + bump(t, 0.8, 2e-4))
         .collect();
-    let det = ThresholdCrossing::paper_impacts(x_i).unwrap();
-    assert_eq!(det.level(), x_i - PAPER_IMPACT_OFFSET);
+    let det = impact_detector(x_i).unwrap();
+    assert_eq!(det.level(), x_i - IMPACT_OFFSET);
     let times = det.times(&t, &x).unwrap();
     assert_eq!(times.len(), 2);
     // Analytic crossing: bump = 0.9e-4 → (t − c) = −0.01·√ln(a/0.9e-4).
@@ -597,7 +597,7 @@ fn csv_columns_scales_and_delimiters() {
 fn filtered_series_and_crossings() {
     let (t, x) = noisy_sine(11, 0.0);
     let s = TimeSeries::new(t, x, None).unwrap();
-    let f = s.filtered(&LowPass::paper()).unwrap();
+    let f = s.filtered(&low_pass().unwrap()).unwrap();
     assert_eq!(f.t(), s.t());
     // The filter delays a 5 Hz sine by atan(ωθ)/ω ≈ θ and scales it by 1/√(1+ω²θ²).
     let c = f.crossings(&ThresholdCrossing::new(0.0).unwrap()).unwrap();

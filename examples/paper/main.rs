@@ -489,9 +489,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     // Identification (Sect. 2): F0 of a fit to a synthetic measurement.
     let (dur, names): (f64, &[&str]) = if a.quick {
-        (1.0, &["k", "c", "T"])
+        (1.0, &["k", "c", "t"])
     } else {
-        (2.0, &["k", "c", "T", "k_i"])
+        (2.0, &["k", "c", "t", "k_i"])
     };
     let (f0, floor, rel, sims) = synthetic_fit(dur, names)?;
     println!(

@@ -327,8 +327,8 @@ pub fn tle_fig5(
 /// a guess 20 % off. Returns (F0 at the fit in mm², F0 of the true parameters in mm², the
 /// fitted values relative to the true ones, simulations).
 pub fn synthetic_fit(duration: f64, names: &[&str]) -> Res<(f64, f64, Vec<f64>, u64)> {
-    use nonsmooth::identify::{Forcing, M2_TO_MM2, NelderMeadOptions, PaperFit, paper_parameter};
-    use nonsmooth::signal::SyntheticExperiment;
+    use nonsmooth::identify::{M2_TO_MM2, NelderMeadOptions};
+    use nonsmooth::systems::paper::{Forcing, PaperFit, SyntheticExperiment, paper_parameter};
     let forcing = Forcing::constant(17.0);
     let rec = SyntheticExperiment::new(PAPER, forcing, duration)?
         .with_noise(2e-6, 7)?

@@ -1,10 +1,10 @@
-//! Parameter identification: the paper's objective `F0` and Nelder–Mead fitting over named,
-//! optionally bounded or log-transformed parameters.
+//! Parameter identification: the mean-squared-difference objective `F0` and Nelder–Mead
+//! fitting over named, optionally bounded or log-transformed parameters.
 //!
-//! The paper (Sect. 2) estimates `μ = (k, c, T, k_I, b, n₂, n₃)` by minimizing
+//! A model's parameters `μ` are estimated from a measured record by minimizing
 //! $$ F_0(\mu) = \frac{1}{t_2 - t_1}\int_{t_1}^{t_2}
 //!    \bigl(x_\mathrm{exp}(t) - x_\mathrm{sim}(t;\mu)\bigr)^2\,dt $$
-//! with the Nelder–Mead method (MATLAB `fminsearch`), reaching `F0 = 0.00997 mm²`.
+//! with the Nelder–Mead method (as the paper does with MATLAB's `fminsearch`).
 //! The pieces here are independent of the integrator:
 //!
 //! - [`ParameterSpace`] / [`Parameter`]: names, initial values, bounds and a
@@ -17,7 +17,12 @@
 //!   here because argmin's needs a feature the crate does not enable — see
 //!   [`fit_nelder_mead`]) in the unconstrained coordinates; failing simulations are bad points,
 //!   never crashes; a [`FitReport`] with the fitted values by name, evaluations,
-//!   iterations, convergence history and termination reason.
+//!   iterations, convergence history and termination reason;
+//! - [`ModelFit`]: the whole loop for any model given as a builder (simulate, compare on
+//!   the window, minimize).
+//!
+//! The paper's configuration (its model's parameter names and fit) is in
+//! [`systems::paper`](crate::systems::paper).
 //!
 //! # Example
 //! ```
@@ -40,17 +45,17 @@
 mod fit;
 mod model_fit;
 mod objective;
-mod paper;
 mod space;
 
 pub use fit::{FitReport, NelderMeadOptions, Termination, fit_nelder_mead};
 pub use model_fit::ModelFit;
+pub(crate) use model_fit::{simulate_at_nodes, window_nodes};
 pub use objective::{M2_TO_MM2, objective_f0, objective_f0_mm2};
-pub use paper::{
-    Forcing, PAPER_FIT_PARAMETERS, PaperFit, PaperFitReport, paper_parameter, set_paper_parameter,
-};
 pub use space::{ParamValues, Parameter, ParameterSpace, Transform};
 
+use crate::drive::RunError;
+use crate::model::ModelError;
+use crate::roots::RootError;
 use crate::signal::SignalError;
 use crate::validate::ParameterError;
 
@@ -63,7 +68,10 @@ pub enum IdentifyError {
     Parameter(#[from] ParameterError),
     /// Measured or simulated data are invalid.
     #[error(transparent)]
-    Signal(#[from] SignalError),
+    Signal(SignalError),
+    /// A simulation failed (the step cap, an accumulation of events, …).
+    #[error(transparent)]
+    Run(#[from] RunError),
     /// A parameter space needs at least one parameter.
     #[error("the parameter space is empty")]
     EmptySpace,
@@ -181,6 +189,35 @@ pub enum IdentifyError {
         /// The objective's error message.
         message: String,
     },
+    /// Any other error of a model builder (an error of the crate without a variant here,
+    /// see [`ModelFit`]), by its message.
+    #[error("{0}")]
+    Other(String),
+}
+
+impl From<SignalError> for IdentifyError {
+    /// A simulation's error inside a [`SignalError`] becomes [`IdentifyError::Run`].
+    fn from(e: SignalError) -> Self {
+        match e {
+            SignalError::Run(e) => Self::Run(e),
+            e => Self::Signal(e),
+        }
+    }
+}
+
+impl From<ModelError> for IdentifyError {
+    /// A model that could not be built: [`IdentifyError::Run`] with [`RunError::Model`].
+    fn from(e: ModelError) -> Self {
+        Self::Run(e.into())
+    }
+}
+
+impl From<RootError> for IdentifyError {
+    /// A failed root search (e.g. for an initial state): [`IdentifyError::Run`] with
+    /// [`RunError::Root`].
+    fn from(e: RootError) -> Self {
+        Self::Run(e.into())
+    }
 }
 
 #[cfg(test)]

@@ -74,7 +74,7 @@ pub(crate) fn simulate_at_nodes<S: Dynamics<f64, N>, const N: usize>(
     nodes: &[f64],
     component: usize,
     window: (f64, f64),
-) -> crate::Result<Vec<f64>> {
+) -> Result<Vec<f64>, IdentifyError> {
     let mut sampler = Stroboscopic::<f64, N, _>::new(Nodes(nodes), 0.0, nodes.len())?;
     let t_end = nodes[nodes.len() - 1];
     Simulation::new(system, Dopri5::new(tolerances))
@@ -90,15 +90,14 @@ pub(crate) fn simulate_at_nodes<S: Dynamics<f64, N>, const N: usize>(
             t2: window.1,
             start: points.first().map_or(f64::NAN, |p| p.t),
             end: points.last().map_or(f64::NAN, |p| p.t),
-        }
-        .into());
+        });
     }
     Ok(points.iter().map(|p| p.y[component]).collect())
 }
 
-/// Estimates named parameters of **any** model from a measured record of one state
-/// component by minimizing `F0` with Nelder–Mead — the method of [`PaperFit`](super::PaperFit)
-/// for a model given as a builder.
+/// Estimates named parameters of any model from a measured record of one state component
+/// by minimizing `F0` with Nelder–Mead, the model given as a builder. The paper's
+/// configuration is [`systems::paper::PaperFit`](crate::systems::paper::PaperFit).
 ///
 /// # Method
 /// For trial values `μ` of the fitted parameters, `build(μ)` returns the system and its
@@ -111,6 +110,9 @@ pub(crate) fn simulate_at_nodes<S: Dynamics<f64, N>, const N: usize>(
 /// is evaluated by [`objective_f0`] (trapezoidal rule on the measured samples). A trial
 /// whose build or simulation fails (an unknown name, a value outside the model's domain,
 /// the step cap) is a bad point: the optimizer gives it `+∞` and moves on.
+///
+/// The builder returns an [`IdentifyError`]; the crate's [`Error`](crate::Error) converts
+/// into it, so `?` works on the catalogue's constructors (as in the example).
 ///
 /// # Examples
 /// The damping of the Duffing–Ueda oscillator recovered from a synthetic record of `x`:
@@ -162,14 +164,14 @@ impl<F, S, const N: usize> std::fmt::Debug for ModelFit<F, S, N> {
 
 impl<F, S, const N: usize> ModelFit<F, S, N>
 where
-    F: Fn(&ParamValues) -> crate::Result<(S, SVector<f64, N>)>,
+    F: Fn(&ParamValues) -> Result<(S, SVector<f64, N>), IdentifyError>,
     S: Dynamics<f64, N>,
 {
     /// A fit of the model `build` to `measured` (a record of state component `component`)
     /// on the window `[t1, t2]`. No parameter is fitted yet: add them with
     /// [`fit_parameter`](Self::fit_parameter). Defaults: tolerances `rtol = 10⁻¹⁰`,
-    /// `atol = 10⁻¹²`, at most 10⁷ steps per simulation, the Nelder–Mead options of
-    /// [`PaperFit`](super::PaperFit).
+    /// `atol = 10⁻¹²`, at most 10⁷ steps per simulation, Nelder–Mead with
+    /// `x_tolerance = 10⁻⁴`, `f_tolerance = 10⁻⁶` and one restart.
     ///
     /// # Errors
     /// [`IdentifyError::InvalidWindow`] unless `0 ≤ t1 < t2` are finite;
@@ -269,8 +271,8 @@ where
     /// The simulated component at [`nodes`](Self::nodes) for the values `values`.
     ///
     /// # Errors
-    /// The builder's error, or a failed simulation.
-    pub fn simulate(&self, values: &ParamValues) -> crate::Result<Vec<f64>> {
+    /// The builder's error, or a failed simulation ([`IdentifyError::Run`]).
+    pub fn simulate(&self, values: &ParamValues) -> Result<Vec<f64>, IdentifyError> {
         let (system, y0) = (self.build)(values)?;
         simulate_at_nodes(
             system,
@@ -287,9 +289,9 @@ where
     ///
     /// # Errors
     /// As [`simulate`](Self::simulate), and [`objective_f0`]'s.
-    pub fn objective_at(&self, values: &ParamValues) -> crate::Result<f64> {
+    pub fn objective_at(&self, values: &ParamValues) -> Result<f64, IdentifyError> {
         let y = self.simulate(values)?;
-        Ok(objective_f0(&self.measured, &self.nodes, &y, self.window)?)
+        objective_f0(&self.measured, &self.nodes, &y, self.window)
     }
 
     /// Runs the fit.
@@ -301,5 +303,21 @@ where
     pub fn run(&self) -> Result<FitReport, IdentifyError> {
         let space = self.space()?;
         fit_nelder_mead(&space, |values| self.objective_at(values), &self.options)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn nodes_clock_reports_the_given_times() {
+        let t = [0.25, 0.5, 0.75];
+        let c = Nodes(&t);
+        assert_eq!(c.section_time(1), Some(0.5));
+        assert_eq!(c.section_time(3), None);
+        assert_eq!(c.first_index_from(0.0), 0);
+        assert_eq!(c.first_index_from(0.5), 1);
+        assert_eq!(c.first_index_from(0.6), 2);
     }
 }

@@ -1,4 +1,4 @@
-//! The paper's identification objective `F0`.
+//! The identification objective `F0` (the paper's, Sect. 2).
 
 use super::IdentifyError;
 use crate::signal::{TimeSeries, validate_samples};
@@ -20,8 +20,7 @@ pub const M2_TO_MM2: f64 = 1.0e6;
 /// piecewise-linear signals on a common grid the result is exact up to the trapezoidal rule's
 /// `O(h²)` error on the squared difference.
 ///
-/// The paper reports `F0 = 0.00997 mm²` for its fitted model; use [`objective_f0_mm2`] or
-/// multiply by [`M2_TO_MM2`] to compare.
+/// For positions in metres, [`objective_f0_mm2`] or a factor [`M2_TO_MM2`] gives mm².
 ///
 /// # Errors
 /// - [`IdentifyError::InvalidWindow`] if `t1`, `t2` are not finite or `t1 ≥ t2`;
@@ -106,7 +105,7 @@ pub fn objective_f0(
     Ok(sum / (t2 - t1))
 }
 
-/// [`objective_f0`] in mm² (for positions in metres), the unit the paper reports.
+/// [`objective_f0`] in mm² (for positions in metres).
 ///
 /// # Errors
 /// As [`objective_f0`].

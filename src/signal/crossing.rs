@@ -4,10 +4,6 @@ use super::{SignalError, validate_samples};
 use crate::Real;
 use crate::validate::{finite, non_negative};
 
-/// How far below the stop the paper puts its impact threshold: impacts are upward crossings
-/// of `x_I − 0.01 mm` (Sect. 3), i.e. `x_I − PAPER_IMPACT_OFFSET` in metres.
-pub const PAPER_IMPACT_OFFSET: f64 = 1.0e-5;
-
 pub use crate::event::Direction;
 
 /// One located crossing.
@@ -22,8 +18,9 @@ pub struct Crossing<T> {
     pub direction: Direction,
 }
 
-/// Detects crossings of a level in sampled data, e.g. impacts as the upward crossings of
-/// `x_I − 0.01 mm` ([`paper_impacts`](Self::paper_impacts)).
+/// Detects crossings of a level in sampled data, e.g. impacts as the upward crossings of a
+/// level slightly below the stop (the paper's detector is
+/// [`systems::paper::impact_detector`](crate::systems::paper::impact_detector)).
 ///
 /// Deserialization (feature `serde`) applies the constructor's and the builders' checks.
 ///
@@ -95,15 +92,6 @@ impl<T: Real> ThresholdCrossing<T> {
             hysteresis: T::zero(),
             min_separation: T::zero(),
         })
-    }
-
-    /// The paper's impact detector: rising crossings of `x_I − 0.01 mm`
-    /// ([`PAPER_IMPACT_OFFSET`]); `x_i` in metres.
-    ///
-    /// # Errors
-    /// [`SignalError::Parameter`] if `x_i` is not finite.
-    pub fn paper_impacts(x_i: T) -> Result<Self, SignalError> {
-        Self::new(finite("x_i", x_i)? - crate::scalar::lit(PAPER_IMPACT_OFFSET))
     }
 
     /// Sets the direction.
@@ -317,9 +305,9 @@ mod tests {
     }
 
     #[test]
-    fn paper_level_and_validation() {
-        let c = ThresholdCrossing::paper_impacts(-2.0e-3_f64).unwrap();
-        assert!((c.level() + 2.01e-3).abs() < 1e-18);
+    fn level_and_validation() {
+        let c = ThresholdCrossing::new(-2.01e-3_f64).unwrap();
+        assert_eq!(c.level(), -2.01e-3);
         assert!(ThresholdCrossing::new(f64::NAN).is_err());
         assert!(c.with_hysteresis(-1.0).is_err());
         assert!(c.with_min_separation(f64::INFINITY).is_err());

@@ -19,8 +19,9 @@ pub enum InitialState<T> {
     Value(T),
 }
 
-/// The first-order low-pass filter with transfer function `1/(θs + 1)`, the paper's smoothing
-/// of the measured cart position (`θ = 1 ms`, Sect. 3).
+/// The first-order low-pass filter with transfer function `1/(θs + 1)`, the smoothing of a
+/// measured position (the paper's choice of `θ` is
+/// [`systems::paper::low_pass`](crate::systems::paper::low_pass)).
 ///
 /// Deserialization (feature `serde`) applies the constructor's check of `θ`.
 ///
@@ -75,14 +76,6 @@ impl<T: Real> LowPass<T> {
             theta: positive("theta", theta)?,
             initial: InitialState::FirstSample,
         })
-    }
-
-    /// The paper's filter, `θ = 1 ms`.
-    pub fn paper() -> Self {
-        Self {
-            theta: crate::scalar::lit(1e-3),
-            initial: InitialState::FirstSample,
-        }
     }
 
     /// Sets the initial state.
@@ -245,7 +238,7 @@ mod tests {
         assert!(LowPass::new(0.0_f64).is_err());
         assert!(LowPass::new(-1.0_f64).is_err());
         assert!(LowPass::new(f64::NAN).is_err());
-        assert_eq!(LowPass::<f64>::paper().theta(), 1e-3);
+        assert_eq!(LowPass::new(1e-3_f64).unwrap().theta(), 1e-3);
     }
 
     #[test]

@@ -1,17 +1,18 @@
 //! Measured data: time series, CSV input/output, the first-order smoothing filter,
-//! threshold-crossing (impact) detection and encoder-phase Poincaré sampling.
+//! threshold-crossing (impact) detection, phase-triggered Poincaré sampling and synthetic
+//! records of any model.
 //!
-//! The experiment of the paper (Sect. 2–3) records the cart position `x(t)` with a Hall
-//! sensor and the disk angle `φ(t)` with an encoder. The processing chain rebuilt here is:
+//! The processing chain of an impact experiment that records a position `x(t)` and,
+//! optionally, an encoder phase `φ(t)`:
 //!
 //! 1. **Read** the record into a validated [`TimeSeries`] ([`TimeSeries::from_csv_path`],
 //!    [`CsvOptions`]); every malformed field is reported with its 1-based line number.
-//! 2. **Smooth** with the first-order filter `(θs + 1)^{-1}`, `θ = 1 ms` ([`LowPass`]).
+//! 2. **Smooth** with the first-order filter `(θs + 1)^{-1}` ([`LowPass`]).
 //!    Its exact zero-order-hold discretization for a step `h_n = t_{n+1} − t_n` is
 //!    $$ y_{n+1} = a_n\,y_n + (1 - a_n)\,u_n,\qquad a_n = e^{-h_n/\theta}, $$
 //!    so a unit step gives `y(t_n) = 1 − e^{−t_n/θ}` exactly at the samples.
-//! 3. **Detect impacts** as upward crossings of `x_I − 0.01 mm` ([`ThresholdCrossing`],
-//!    [`PAPER_IMPACT_OFFSET`]), the crossing time linearly interpolated inside the sample
+//! 3. **Detect impacts** as upward crossings of a level `L` slightly below the stop
+//!    ([`ThresholdCrossing`]), the crossing time linearly interpolated inside the sample
 //!    interval,
 //!    $$ t_c = t_n + \frac{L - x_n}{x_{n+1} - x_n}\,(t_{n+1} - t_n), $$
 //!    with a hysteresis band and a minimum separation as debounce; the inter-impact
@@ -19,11 +20,13 @@
 //! 4. **Sample the Poincaré section** `φ = 2πi` from the encoder phase
 //!    ([`PhaseSection`]): the phase is unwrapped, each level `2πi + φ_0` located by linear
 //!    interpolation of `φ`, and `x` interpolated with the same fraction; the forcing
-//!    frequency at each point follows from [`section_frequencies`] (exact for the paper's
-//!    linear ramp `ω̇ = 8.0905·10⁻³ rad/s²`, where `φ(t)` is quadratic).
+//!    frequency at each point follows from [`section_frequencies`] (exact for a constant
+//!    frequency or a linear ramp, where `φ(t)` is quadratic).
 //!
 //! Everything works on plain slices too (generic over [`Real`](crate::Real)), so simulated
-//! trajectories go through exactly the same code as measured ones.
+//! trajectories ([`ModelExperiment`]) go through exactly the same code as measured ones.
+//! The paper's configuration (its filter constant, impact threshold and synthetic
+//! experiment) is in [`systems::paper`](crate::systems::paper).
 //!
 //! # Example
 //! ```
@@ -49,19 +52,16 @@ mod phase;
 mod series;
 mod synthetic;
 
-pub use crossing::{
-    Crossing, Direction, PAPER_IMPACT_OFFSET, ThresholdCrossing, intervals, intervals_into,
-};
+pub use crossing::{Crossing, Direction, ThresholdCrossing, intervals, intervals_into};
 pub use filter::{InitialState, LowPass};
 pub use phase::{
     PhaseInput, PhaseSection, PoincarePoint, section_frequencies, unwrap_phase,
     unwrap_phase_inplace,
 };
 pub use series::{Column, CsvOptions, PhaseColumn, TimeSeries};
-pub use synthetic::{
-    Forcing, ModelExperiment, ModelRecord, NormalNoise, SyntheticExperiment, SyntheticRecord,
-};
+pub use synthetic::{ModelExperiment, ModelRecord, NormalNoise};
 
+use crate::drive::RunError;
 use crate::scalar::to_f64;
 use crate::validate::ParameterError;
 
@@ -90,6 +90,9 @@ pub enum SignalError {
     /// A configuration value was rejected.
     #[error(transparent)]
     Parameter(#[from] ParameterError),
+    /// The simulation of a synthetic record failed ([`ModelExperiment`]).
+    #[error(transparent)]
+    Run(#[from] RunError),
     /// A file could not be opened, read or written.
     #[error("I/O error on `{path}`: {message}")]
     Io {

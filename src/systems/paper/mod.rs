@@ -9,8 +9,32 @@
 //! [`Oscillator`] over the tuple of laws
 //! `(LinearSpring, ViscousDamper, DryFriction, HertzContact)` and an [`UnbalancedRotor`].
 //!
+//! Everything else that exists only for the paper is here too, as configurations of the
+//! generic instruments:
+//!
+//! - the experiment's processing: the smoothing filter ([`low_pass`], `θ =`
+//!   [`FILTER_THETA`]) and the impact detector ([`impact_detector`], `x_I −`
+//!   [`IMPACT_OFFSET`]) of [`signal`](crate::signal);
+//! - the synthetic experiment ([`SyntheticExperiment`] under a [`Forcing`]), a
+//!   configuration of [`ModelExperiment`](crate::signal::ModelExperiment);
+//! - the identification ([`PaperFit`] over [`PAPER_FIT_PARAMETERS`]), a configuration of
+//!   [`ModelFit`](crate::identify::ModelFit).
+//!
+//! Builders and single-layer helpers return that layer's error
+//! ([`SignalError`], [`IdentifyError`](crate::identify::IdentifyError)); what builds the
+//! model and runs it returns the crate's [`Result`].
+//!
 //! # References
-//! The paper's eq. (1) and the parameter set of its Sect. 2 ([`PAPER`]).
+//! The paper's eq. (1) and the parameter set of its Sect. 2 ([`PAPER`]); the processing and
+//! identification of its Sect. 2–3.
+
+mod experiment;
+mod fit;
+
+pub use experiment::{Forcing, SyntheticExperiment, SyntheticRecord};
+pub use fit::{
+    PAPER_FIT_PARAMETERS, PaperFit, PaperFitReport, paper_parameter, set_paper_parameter,
+};
 
 use crate::Real;
 use crate::error::Result;
@@ -18,7 +42,50 @@ use crate::excite::{Excitation, RampedRotor, UnbalancedRotor};
 use crate::force::{DryFriction, HertzContact, LinearSpring, ViscousDamper};
 use crate::model::{Element, Load, Mechanical, Oscillator};
 use crate::scalar::lit;
-use crate::validate::ParameterError;
+use crate::signal::{LowPass, SignalError, ThresholdCrossing};
+use crate::validate::{ParameterError, finite};
+
+/// The time constant `θ = 1 ms` (s) of the paper's smoothing filter `1/(θs + 1)` (Sect. 3).
+pub const FILTER_THETA: f64 = 1.0e-3;
+
+/// How far below the stop the paper puts its impact threshold (m): impacts are upward
+/// crossings of `x_I − 0.01 mm` (Sect. 3), i.e. `x_I − IMPACT_OFFSET`.
+pub const IMPACT_OFFSET: f64 = 1.0e-5;
+
+/// The paper's smoothing filter: [`LowPass`] with `θ =` [`FILTER_THETA`], starting at the
+/// first sample.
+///
+/// # Errors
+/// None for the scalar types of the crate (`θ` is positive and finite in `f32` and `f64`);
+/// the [`LowPass::new`] check is kept rather than assumed.
+///
+/// # Examples
+/// ```
+/// use nonsmooth::systems::paper::low_pass;
+/// assert_eq!(low_pass::<f64>()?.theta(), 1e-3);
+/// # Ok::<(), nonsmooth::signal::SignalError>(())
+/// ```
+pub fn low_pass<T: Real>() -> Result<LowPass<T>, SignalError> {
+    LowPass::new(lit(FILTER_THETA))
+}
+
+/// The paper's impact detector: rising crossings of `x_I − 0.01 mm` ([`IMPACT_OFFSET`]),
+/// `x_i` in metres (no hysteresis, no minimum separation: add them with the
+/// [`ThresholdCrossing`] builders).
+///
+/// # Errors
+/// [`SignalError::Parameter`] if `x_i` is not finite.
+///
+/// # Examples
+/// ```
+/// use nonsmooth::systems::paper::{PAPER, impact_detector};
+/// let detector = impact_detector(PAPER.x_i)?.with_hysteresis(1e-6)?;
+/// assert!((detector.level() - (-2.096e-3)).abs() < 1e-15);
+/// # Ok::<(), nonsmooth::signal::SignalError>(())
+/// ```
+pub fn impact_detector<T: Real>(x_i: T) -> Result<ThresholdCrossing<T>, SignalError> {
+    ThresholdCrossing::new(finite("x_i", x_i)? - lit(IMPACT_OFFSET))
+}
 
 /// The force laws of the paper's model, summed as a tuple.
 pub type PaperLaws<T> = (
@@ -217,6 +284,15 @@ pub fn omega_of<T: Real, E: Excitation<T>>(e: &E) -> Option<T> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn processing_constants() {
+        assert_eq!(low_pass::<f64>().unwrap().theta(), 1e-3);
+        assert_eq!(low_pass::<f32>().unwrap().theta(), 1e-3_f32);
+        let c = impact_detector(-2.0e-3_f64).unwrap();
+        assert!((c.level() + 2.01e-3).abs() < 1e-18);
+        assert!(impact_detector(f64::NAN).is_err());
+    }
 
     #[test]
     fn static_equilibrium_golden() {

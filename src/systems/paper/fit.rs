@@ -1,46 +1,59 @@
-//! Identification of the paper's model from a measured (or synthetic) position record.
+//! Identification of the paper's model from a measured (or synthetic) position record, a
+//! configuration of the generic [`ModelFit`].
 
 use std::cell::Cell;
 use std::time::{Duration, Instant};
 
 use nalgebra::Vector2;
 
-use super::model_fit::{simulate_at_nodes, window_nodes};
-use super::{
-    FitReport, IdentifyError, M2_TO_MM2, NelderMeadOptions, ParamValues, Parameter, ParameterSpace,
-    fit_nelder_mead, objective_f0,
+use super::{Forcing, PaperParameters};
+use crate::Dynamics;
+use crate::identify::{
+    FitReport, IdentifyError, M2_TO_MM2, ModelFit, NelderMeadOptions, ParamValues, Parameter,
+    ParameterSpace, objective_f0, simulate_at_nodes, window_nodes,
 };
 use crate::integrate::Tolerances;
 use crate::signal::TimeSeries;
-use crate::systems::paper::PaperParameters;
-
-pub use crate::signal::Forcing;
+use crate::validate::ParameterError;
 
 /// The names of the paper's estimated parameters `μ = (k, c, T, k_I, b, n₂, n₃)` (Sect. 2),
-/// as [`PaperFit`] knows them: `k` (N/m), `c` (N·s/m), `T` (N), `k_i` (N/m^{3/2}), `b`
+/// as [`PaperFit`] knows them: `k` (N/m), `c` (N·s/m), `t` (N), `k_i` (N/m^{3/2}), `b`
 /// (m^{−n₃}·s^{n₃}), `n2`, `n3` — the fields [`PaperParameters::k`], `c`, `t`, `k_i`, `b`,
-/// `n2`, `n3`.
-pub const PAPER_FIT_PARAMETERS: [&str; 7] = ["k", "c", "T", "k_i", "b", "n2", "n3"];
+/// `n2`, `n3`, spelled as the fields (and as a study file names them).
+///
+/// Where a name is read ([`paper_parameter`], [`set_paper_parameter`], [`PaperFit::fit`],
+/// [`PaperFitReport::value`]) the friction amplitude is also accepted as `T`, the paper's
+/// symbol.
+pub const PAPER_FIT_PARAMETERS: [&str; 7] = ["k", "c", "t", "k_i", "b", "n2", "n3"];
 
-/// The value of the estimated parameter `name` (one of [`PAPER_FIT_PARAMETERS`]) in `p`.
+/// The name of [`PAPER_FIT_PARAMETERS`] that `name` spells (`T` is `t`), if any.
+fn canonical(name: &str) -> Option<&'static str> {
+    match name {
+        "T" => Some("t"),
+        _ => PAPER_FIT_PARAMETERS.iter().copied().find(|&n| n == name),
+    }
+}
+
+/// The value of the estimated parameter `name` (one of [`PAPER_FIT_PARAMETERS`]; `T` is
+/// accepted for `t`) in `p`.
 ///
 /// # Errors
 /// [`IdentifyError::UnknownParameter`] for any other name.
 pub fn paper_parameter(p: &PaperParameters, name: &str) -> Result<f64, IdentifyError> {
-    Ok(match name {
-        "k" => p.k,
-        "c" => p.c,
-        "T" => p.t,
-        "k_i" => p.k_i,
-        "b" => p.b,
-        "n2" => p.n2,
-        "n3" => p.n3,
+    Ok(match canonical(name) {
+        Some("k") => p.k,
+        Some("c") => p.c,
+        Some("t") => p.t,
+        Some("k_i") => p.k_i,
+        Some("b") => p.b,
+        Some("n2") => p.n2,
+        Some("n3") => p.n3,
         _ => return Err(IdentifyError::UnknownParameter { name: name.into() }),
     })
 }
 
-/// Sets the estimated parameter `name` (one of [`PAPER_FIT_PARAMETERS`]) in `p` (no
-/// validation: the model's constructors validate).
+/// Sets the estimated parameter `name` (one of [`PAPER_FIT_PARAMETERS`]; `T` is accepted
+/// for `t`) in `p` (no validation: the model's constructors validate).
 ///
 /// # Errors
 /// [`IdentifyError::UnknownParameter`] for any other name.
@@ -49,14 +62,14 @@ pub fn set_paper_parameter(
     name: &str,
     value: f64,
 ) -> Result<(), IdentifyError> {
-    let slot = match name {
-        "k" => &mut p.k,
-        "c" => &mut p.c,
-        "T" => &mut p.t,
-        "k_i" => &mut p.k_i,
-        "b" => &mut p.b,
-        "n2" => &mut p.n2,
-        "n3" => &mut p.n3,
+    let slot = match canonical(name) {
+        Some("k") => &mut p.k,
+        Some("c") => &mut p.c,
+        Some("t") => &mut p.t,
+        Some("k_i") => &mut p.k_i,
+        Some("b") => &mut p.b,
+        Some("n2") => &mut p.n2,
+        Some("n3") => &mut p.n3,
         _ => return Err(IdentifyError::UnknownParameter { name: name.into() }),
     };
     *slot = value;
@@ -68,8 +81,8 @@ pub fn set_paper_parameter(
 /// (Sect. 2).
 ///
 /// # Method
-/// For trial parameters `μ` (the fitted ones from the optimizer, the others fixed at the
-/// base [`PaperParameters`]) the model is simulated from `t = 0` — the time origin of the
+/// A configuration of the generic [`ModelFit`]: for trial parameters `μ` (the fitted ones
+/// from the optimizer, the others fixed at the base [`PaperParameters`]) the model is simulated from `t = 0` — the time origin of the
 /// record and of the forcing phase — at rest in the static equilibrium `X0(μ)` **of the
 /// trial parameters** (the stand starts at rest pressed into the stop, and `X0` depends on
 /// `k` and `k_I`), with [`Dopri5`](crate::integrate::Dopri5) at the configured tolerances
@@ -78,8 +91,8 @@ pub fn set_paper_parameter(
 /// sampled exactly at the window ends and at every measured time inside the window, and
 /// $$ F_0(\mu) = \frac{1}{t_2 - t_1}\int_{t_1}^{t_2}
 ///    \bigl(x_\mathrm{exp}(t) - x_\mathrm{sim}(t;\mu)\bigr)^2\,dt $$
-/// is evaluated by [`objective_f0`] (trapezoidal rule on the measured samples, in m²;
-/// reported in mm² as the paper does).
+/// is evaluated by [`objective_f0`](crate::identify::objective_f0) (trapezoidal rule on the
+/// measured samples, in m²; reported in mm² as the paper does).
 ///
 /// The fitted parameters are [`Parameter::positive`] (log-transformed: every one of
 /// `k, c, T, k_I, b, n₂, n₃` is positive, the simplex moves in relative steps, and
@@ -103,13 +116,14 @@ pub fn set_paper_parameter(
 /// A trial whose simulation fails — invalid parameters, no static equilibrium, the step cap
 /// ([`with_max_steps`](Self::with_max_steps)) reached, the step size underflowing, an
 /// accumulation of events — is a bad point: the optimizer gives it `+∞` and moves on
-/// ([`fit_nelder_mead`]), and [`PaperFitReport::failed_simulations`] counts it.
+/// ([`fit_nelder_mead`](crate::identify::fit_nelder_mead)), and
+/// [`PaperFitReport::failed_simulations`] counts it.
+///
+/// The paper reaches `F0 = 0.00997 mm²` on its measured record.
 ///
 /// # Examples
 /// ```
-/// use nonsmooth::identify::{Forcing, PaperFit};
-/// use nonsmooth::systems::paper::PAPER;
-/// use nonsmooth::signal::SyntheticExperiment;
+/// use nonsmooth::systems::paper::{Forcing, PAPER, PaperFit, SyntheticExperiment};
 ///
 /// // Half a second "measured" at ω = 20.465 rad/s with the paper's parameters…
 /// let data = SyntheticExperiment::new(PAPER, Forcing::constant(20.465), 0.5)?.generate()?;
@@ -156,12 +170,23 @@ pub struct PaperFitReport {
 }
 
 impl PaperFitReport {
-    /// The fitted value of `name`.
+    /// The fitted value of `name` (as it was given to the fit; `T` and `t` name the same
+    /// parameter).
     ///
     /// # Errors
     /// [`IdentifyError::UnknownParameter`] if `name` was not fitted.
     pub fn value(&self, name: &str) -> Result<f64, IdentifyError> {
-        self.fit.values.get(name)
+        let wanted = canonical(name);
+        match self.fit.values.get(name) {
+            Err(e) if wanted.is_some() => self
+                .fit
+                .values
+                .iter()
+                .find(|&(n, _)| canonical(n) == wanted)
+                .map(|(_, v)| v)
+                .ok_or(e),
+            found => found,
+        }
     }
 }
 
@@ -203,8 +228,8 @@ impl PaperFit {
         })
     }
 
-    /// Fits `name` (one of [`PAPER_FIT_PARAMETERS`]) from the initial guess `initial`, as a
-    /// positive (log-transformed) parameter.
+    /// Fits `name` (one of [`PAPER_FIT_PARAMETERS`]; `T` is accepted for `t`) from the
+    /// initial guess `initial`, as a positive (log-transformed) parameter.
     ///
     /// # Errors
     /// As [`fit_parameter`](Self::fit_parameter).
@@ -226,16 +251,22 @@ impl PaperFit {
         self.fit_parameter(Parameter::positive(name, initial).with_bounds(lower, upper))
     }
 
-    /// Fits a parameter given in full (name, initial value, bounds, transform).
+    /// Fits a parameter given in full (name, initial value, bounds, transform). The
+    /// report and the fit's values use the name as given.
     ///
     /// # Errors
     /// [`IdentifyError::UnknownParameter`] unless the name is one of
-    /// [`PAPER_FIT_PARAMETERS`]; [`IdentifyError::DuplicateParameter`] if it is already
-    /// fitted; the [`ParameterSpace::new`] errors for an invalid initial value or bounds.
+    /// [`PAPER_FIT_PARAMETERS`] (or `T`); [`IdentifyError::DuplicateParameter`] if it is
+    /// already fitted (under either spelling); the [`ParameterSpace::new`] errors for an
+    /// invalid initial value or bounds.
     pub fn fit_parameter(mut self, parameter: Parameter) -> Result<Self, IdentifyError> {
         let name = parameter.name();
         paper_parameter(&self.base, name)?;
-        if self.fitted.iter().any(|p| p.name() == name) {
+        if self
+            .fitted
+            .iter()
+            .any(|p| canonical(p.name()) == canonical(name))
+        {
             return Err(IdentifyError::DuplicateParameter { name: name.into() });
         }
         ParameterSpace::new([parameter.clone()])?;
@@ -262,13 +293,13 @@ impl PaperFit {
     /// [`IdentifyError::Parameter`] if `max_steps == 0`.
     pub fn with_max_steps(mut self, max_steps: usize) -> Result<Self, IdentifyError> {
         if max_steps == 0 {
-            return Err(crate::ParameterError::new("max_steps", 0.0, "> 0").into());
+            return Err(ParameterError::new("max_steps", 0.0, "> 0").into());
         }
         self.max_steps = Some(max_steps);
         Ok(self)
     }
 
-    /// Sets the Nelder–Mead options (default: `x_tolerance = 10⁻⁶`, `f_tolerance = 10⁻⁹`,
+    /// Sets the Nelder–Mead options (default: `x_tolerance = 10⁻⁴`, `f_tolerance = 10⁻⁶`,
     /// one restart, the rest as [`NelderMeadOptions::default`]).
     #[must_use]
     pub fn with_options(mut self, options: NelderMeadOptions) -> Self {
@@ -347,7 +378,7 @@ impl PaperFit {
             self.max_steps(),
             self.window,
         );
-        match self.forcing {
+        Ok(match self.forcing {
             Forcing::Constant { omega } => {
                 simulate_at_nodes(params.oscillator::<f64>(omega)?, tol, cap, y0, nodes, 0, w)
             }
@@ -360,7 +391,7 @@ impl PaperFit {
                 0,
                 w,
             ),
-        }
+        }?)
     }
 
     /// `F0` (m²) of the parameter set `params` against the record on the window.
@@ -380,7 +411,9 @@ impl PaperFit {
         self.objective(&self.parameters(values)?)
     }
 
-    /// Runs the fit.
+    /// Runs the fit: the [`ModelFit`] of the oscillator under the forcing, built from the
+    /// base parameters with the trial values and started from rest in its static
+    /// equilibrium, on the position.
     ///
     /// # Errors
     /// [`IdentifyError::EmptySpace`] if nothing is fitted;
@@ -389,16 +422,15 @@ impl PaperFit {
     /// points are not errors (see the type's docs).
     pub fn run(&self) -> Result<PaperFitReport, IdentifyError> {
         let start = Instant::now();
-        let space = self.space()?;
         let simulations = Cell::new(0u64);
-        let fit = fit_nelder_mead(
-            &space,
-            |values| {
-                simulations.set(simulations.get() + 1);
-                self.objective_at(values)
-            },
-            &self.options,
-        )?;
+        let fit = match self.forcing {
+            Forcing::Constant { omega } => {
+                self.fit_with(&simulations, move |p| p.oscillator::<f64>(omega))
+            }
+            Forcing::Ramp { omega0, rate } => {
+                self.fit_with(&simulations, move |p| p.ramped::<f64>(omega0, rate))
+            }
+        }?;
         let parameters = self.parameters(&fit.values)?;
         Ok(PaperFitReport {
             parameters,
@@ -410,13 +442,34 @@ impl PaperFit {
             wall_time: start.elapsed(),
         })
     }
+
+    /// The [`ModelFit`] of `system(parameters)` from rest in the static equilibrium, run;
+    /// `simulations` counts the models built (one per objective evaluation).
+    fn fit_with<S: Dynamics<f64, 2>>(
+        &self,
+        simulations: &Cell<u64>,
+        system: impl Fn(&PaperParameters) -> Result<S, ParameterError>,
+    ) -> Result<FitReport, IdentifyError> {
+        let build = |values: &ParamValues| {
+            simulations.set(simulations.get() + 1);
+            let p = self.parameters(values)?;
+            let x0 = p.static_equilibrium()?;
+            Ok((system(&p)?, Vector2::new(x0, 0.0)))
+        };
+        let mut fit = ModelFit::new(self.measured.clone(), self.window, 0, build)?
+            .with_tolerances(self.tolerances)
+            .with_max_steps(self.max_steps())?
+            .with_options(self.options.clone());
+        for parameter in &self.fitted {
+            fit = fit.fit_parameter(parameter.clone())?;
+        }
+        fit.run()
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::identify::model_fit::Nodes;
-    use crate::sample::SectionClock;
     use crate::systems::paper::PAPER;
 
     #[test]
@@ -444,13 +497,23 @@ mod tests {
     }
 
     #[test]
-    fn nodes_clock_reports_the_given_times() {
-        let t = [0.25, 0.5, 0.75];
-        let c = Nodes(&t);
-        assert_eq!(c.section_time(1), Some(0.5));
-        assert_eq!(c.section_time(3), None);
-        assert_eq!(c.first_index_from(0.0), 0);
-        assert_eq!(c.first_index_from(0.5), 1);
-        assert_eq!(c.first_index_from(0.6), 2);
+    fn the_symbol_t_is_an_alias_of_the_field_name() {
+        let mut p = PAPER;
+        set_paper_parameter(&mut p, "T", 0.25).unwrap();
+        assert_eq!(p.t, 0.25);
+        assert_eq!(paper_parameter(&p, "T").unwrap(), 0.25);
+        assert!(paper_parameter(&p, "K").is_err());
+        let t: Vec<f64> = (0..=10).map(|i| 0.1 * i as f64).collect();
+        let record = TimeSeries::new(t, vec![0.0; 11], None).unwrap();
+        let fit = PaperFit::new(record, (0.0, 1.0), Forcing::constant(20.0), PAPER)
+            .unwrap()
+            .fit("T", 0.5)
+            .unwrap();
+        assert!(matches!(
+            fit.clone().fit("t", 0.5),
+            Err(IdentifyError::DuplicateParameter { .. })
+        ));
+        let values = fit.space().unwrap().initial_values();
+        assert_eq!(fit.parameters(&values).unwrap().t, 0.5);
     }
 }
