@@ -5,10 +5,9 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use nalgebra::Vector2;
 use nonsmooth::integrate::{Dopri5, Tolerances};
-use nonsmooth::lyapunov::{
-    Norm, PAPER_D0, TangentSpace, TwoTrajectory, pair_tolerances, tangent_tolerances,
-};
+use nonsmooth::lyapunov::{TangentSpace, TwoTrajectory, pair_tolerances, tangent_tolerances};
 use nonsmooth::systems::paper::PAPER;
+use nonsmooth::systems::paper::lyapunov::{D0 as PAPER_D0, norm as paper_norm};
 use std::hint::black_box;
 
 fn tle(c: &mut Criterion) {
@@ -23,7 +22,7 @@ fn tle(c: &mut Criterion) {
         osc,
         Dopri5::new(pair_tolerances::<f64, 2, 4>(&tol).unwrap()),
         PAPER_D0,
-        Norm::paper(),
+        paper_norm(),
     )
     .unwrap();
     tt.start(0.0, y0).unwrap();
@@ -31,7 +30,7 @@ fn tle(c: &mut Criterion) {
     let mut qr = TangentSpace::<f64, 2, 2, 6, _, _>::new(
         osc,
         Dopri5::new(tangent_tolerances::<f64, 2, 2, 6>(&tol, 1e-8, 1e-8).unwrap()),
-        Norm::paper(),
+        paper_norm(),
     )
     .unwrap();
     qr.start(0.0, y0).unwrap();

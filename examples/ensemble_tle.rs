@@ -15,10 +15,9 @@ use std::time::Instant;
 use nalgebra::Vector2;
 use nonsmooth::ensemble::{Ensemble, F64x8, F64x16, LaneMath, Member, Simd};
 use nonsmooth::integrate::{Dopri5, Tolerances};
-use nonsmooth::lyapunov::{
-    DiagramSettings, IntervalRule, Norm, PAPER_D0, TwoTrajectory, pair_tolerances,
-};
+use nonsmooth::lyapunov::{DiagramSettings, IntervalRule, TwoTrajectory, pair_tolerances};
 use nonsmooth::systems::paper::PAPER;
+use nonsmooth::systems::paper::lyapunov::{D0 as PAPER_D0, norm as paper_norm};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
@@ -56,7 +55,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     } else {
         nonsmooth::ensemble::tle_independent_parallel::<F64x8>
     };
-    let lanes = tle(&e, &members, y0, PAPER_D0, Norm::paper(), &settings, 64)?;
+    let lanes = tle(&e, &members, y0, PAPER_D0, paper_norm(), &settings, 64)?;
     let t_lanes = start.elapsed().as_secs_f64();
     println!(
         "independent starts, ensemble ({} lanes, vector math): {t_lanes:7.2} s",
@@ -75,7 +74,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     PAPER.oscillator::<f64>(w)?,
                     Dopri5::new(pair_tol),
                     PAPER_D0,
-                    Norm::paper(),
+                    paper_norm(),
                 )?;
                 est.start(0.0, y0)?;
                 let tau = std::f64::consts::TAU / w;

@@ -16,10 +16,10 @@ use std::time::Instant;
 use nalgebra::Vector2;
 use nonsmooth::integrate::{Dopri5, Tolerances};
 use nonsmooth::lyapunov::{
-    DiagramDirection, DiagramPoint, DiagramSettings, IntervalRule, Norm, PAPER_D0, pair_tolerances,
-    tle_diagram,
+    DiagramDirection, DiagramPoint, DiagramSettings, IntervalRule, pair_tolerances, tle_diagram,
 };
 use nonsmooth::systems::paper::PAPER;
+use nonsmooth::systems::paper::lyapunov::{D0 as PAPER_D0, norm as paper_norm};
 
 struct Args {
     from: f64,
@@ -123,7 +123,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         y0,
         &omegas,
         PAPER_D0,
-        Norm::paper(),
+        paper_norm(),
         &settings,
     )?;
     let wall = t.elapsed().as_secs_f64();

@@ -10,6 +10,7 @@ use nonsmooth::ensemble::{
 use nonsmooth::event::{Direction, Event, Stop};
 use nonsmooth::integrate::{Dopri5, Tolerances};
 use nonsmooth::sweep::{SweepPoint, SweepSystem, sweep};
+use nonsmooth::systems::paper::lyapunov::{D0 as PAPER_D0, norm as paper_norm};
 use nonsmooth::systems::paper::{PAPER, PaperOscillator};
 
 fn tol() -> Tolerances<f64, 2> {
@@ -178,11 +179,11 @@ fn every_instruction_set_gives_the_same_bits() {
 
 /// The scalar estimator from rest (the paper example's `tle`).
 fn scalar_tle(w: f64, transient: usize, intervals: usize) -> (f64, f64) {
-    use nonsmooth::lyapunov::{Norm, PAPER_D0, TwoTrajectory, pair_tolerances};
+    use nonsmooth::lyapunov::{TwoTrajectory, pair_tolerances};
     let tol = pair_tolerances::<f64, 2, 4>(&tol()).unwrap();
     let osc = PAPER.oscillator::<f64>(w).unwrap();
     let mut est =
-        TwoTrajectory::<f64, 2, 4, _, _>::new(osc, Dopri5::new(tol), PAPER_D0, Norm::paper())
+        TwoTrajectory::<f64, 2, 4, _, _>::new(osc, Dopri5::new(tol), PAPER_D0, paper_norm())
             .unwrap();
     est.start(0.0, rest()).unwrap();
     let tau = std::f64::consts::TAU / w;
@@ -194,7 +195,7 @@ fn scalar_tle(w: f64, transient: usize, intervals: usize) -> (f64, f64) {
 #[test]
 fn lane_tle_agrees_with_the_scalar_estimator_within_its_spread() {
     use nonsmooth::ensemble::tle_independent;
-    use nonsmooth::lyapunov::{DiagramSettings, IntervalRule, Norm, PAPER_D0};
+    use nonsmooth::lyapunov::{DiagramSettings, IntervalRule};
     let (transient, intervals) = (60, 300);
     let settings =
         DiagramSettings::new(IntervalRule::ForcingPeriod, transient, 0, intervals).unwrap();
@@ -203,7 +204,7 @@ fn lane_tle_agrees_with_the_scalar_estimator_within_its_spread() {
     let m: Vec<Member> = omegas.iter().map(|&w| Member::paper(w).unwrap()).collect();
     let e = Ensemble::new(tol()).unwrap();
     let lanes =
-        tle_independent::<F64x4>(&e, &m, rest(), PAPER_D0, Norm::paper(), &settings).unwrap();
+        tle_independent::<F64x4>(&e, &m, rest(), PAPER_D0, paper_norm(), &settings).unwrap();
     for (p, &w) in lanes.iter().zip(&omegas) {
         let (l, se) = scalar_tle(w, transient, intervals);
         assert_eq!(p.parameter, w);
@@ -227,7 +228,7 @@ fn lane_tle_agrees_with_the_scalar_estimator_within_its_spread() {
     }
     // The same bits on any lane count and thread count.
     let lanes8 =
-        tle_independent::<F64x8>(&e, &m, rest(), PAPER_D0, Norm::paper(), &settings).unwrap();
+        tle_independent::<F64x8>(&e, &m, rest(), PAPER_D0, paper_norm(), &settings).unwrap();
     assert_eq!(lanes8, lanes);
     #[cfg(feature = "parallel")]
     {
@@ -236,7 +237,7 @@ fn lane_tle_agrees_with_the_scalar_estimator_within_its_spread() {
             &m,
             rest(),
             PAPER_D0,
-            Norm::paper(),
+            paper_norm(),
             &settings,
             2,
         )
@@ -244,6 +245,6 @@ fn lane_tle_agrees_with_the_scalar_estimator_within_its_spread() {
         assert_eq!(par, lanes);
     }
     // Bad input.
-    assert!(tle_independent::<F64x4>(&e, &[], rest(), PAPER_D0, Norm::paper(), &settings).is_err());
-    assert!(tle_independent::<F64x4>(&e, &m, rest(), 0.0, Norm::paper(), &settings).is_err());
+    assert!(tle_independent::<F64x4>(&e, &[], rest(), PAPER_D0, paper_norm(), &settings).is_err());
+    assert!(tle_independent::<F64x4>(&e, &m, rest(), 0.0, paper_norm(), &settings).is_err());
 }

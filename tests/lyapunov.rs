@@ -7,10 +7,11 @@ use nonsmooth::Dynamics;
 use nonsmooth::drive::RunError;
 use nonsmooth::integrate::{Dopri5, Stepper, Tolerances};
 use nonsmooth::lyapunov::{
-    DiagramSettings, IntervalRule, LyapunovError, Norm, PAPER_D0, TangentSpace, TwoTrajectory,
-    decades, pair_tolerances, separation_study, tangent_tolerances, tle_diagram,
+    DiagramSettings, IntervalRule, LyapunovError, Norm, TangentSpace, TwoTrajectory, decades,
+    pair_tolerances, separation_study, tangent_tolerances, tle_diagram,
 };
 use nonsmooth::systems::paper::PAPER;
+use nonsmooth::systems::paper::lyapunov::{D0 as PAPER_D0, norm as paper_norm};
 use nonsmooth::testing::{DampedOscillator, Lorenz};
 
 const TAU: f64 = std::f64::consts::TAU;
@@ -228,7 +229,7 @@ fn paper_tle(
     let osc = PAPER.oscillator::<f64>(omega).unwrap();
     let tol = pair_tolerances::<f64, 2, 4>(&tol).unwrap();
     let mut est =
-        TwoTrajectory::<f64, 2, 4, _, _>::new(osc, Dopri5::new(tol), d0, Norm::paper()).unwrap();
+        TwoTrajectory::<f64, 2, 4, _, _>::new(osc, Dopri5::new(tol), d0, paper_norm()).unwrap();
     est.start(0.0, rest()).unwrap();
     let tau = TAU / omega;
     est.transient(tau, transient).unwrap();
@@ -247,7 +248,7 @@ fn paper_qr(
     let r = tol.rtol[0];
     let tol = tangent_tolerances::<f64, 2, 2, 6>(&tol, r, r).unwrap();
     let mut qr =
-        TangentSpace::<f64, 2, 2, 6, _, _>::new(osc, Dopri5::new(tol), Norm::paper()).unwrap();
+        TangentSpace::<f64, 2, 2, 6, _, _>::new(osc, Dopri5::new(tol), paper_norm()).unwrap();
     qr.start(0.0, rest()).unwrap();
     let tau = TAU / omega;
     qr.transient(tau, transient).unwrap();
@@ -316,7 +317,7 @@ fn exact_contact_law_needs_the_two_trajectory_method() {
     let y = *st.current().1;
     let tol6 = tangent_tolerances::<f64, 2, 2, 6>(&paper_tol(), 1e-8, 1e-8).unwrap();
     let mut qr =
-        TangentSpace::<f64, 2, 2, 6, _, _>::new(osc, Dopri5::new(tol6), Norm::paper()).unwrap();
+        TangentSpace::<f64, 2, 2, 6, _, _>::new(osc, Dopri5::new(tol6), paper_norm()).unwrap();
     qr.start(0.0, y).unwrap();
     let r = qr.transient(tau, 20).and_then(|_| qr.estimate(tau, 100));
     assert!(
@@ -325,7 +326,7 @@ fn exact_contact_law_needs_the_two_trajectory_method() {
     );
     let tol4 = pair_tolerances::<f64, 2, 4>(&paper_tol()).unwrap();
     let mut tt =
-        TwoTrajectory::<f64, 2, 4, _, _>::new(osc, Dopri5::new(tol4), PAPER_D0, Norm::paper())
+        TwoTrajectory::<f64, 2, 4, _, _>::new(osc, Dopri5::new(tol4), PAPER_D0, paper_norm())
             .unwrap();
     tt.start(0.0, y).unwrap();
     tt.transient(tau, 20).unwrap();
@@ -345,7 +346,7 @@ fn d0_study_is_flat_on_the_paper_model() {
         separation_study(
             &osc,
             &Dopri5::new(tol),
-            Norm::paper(),
+            paper_norm(),
             0.0,
             rest(),
             d0s,
@@ -418,7 +419,7 @@ fn diagram_is_a_continuation_in_both_directions() {
         rest(),
         &values,
         PAPER_D0,
-        Norm::paper(),
+        paper_norm(),
         &settings,
     )
     .unwrap();
@@ -436,7 +437,7 @@ fn diagram_is_a_continuation_in_both_directions() {
             PAPER.oscillator::<f64>(order[0]).unwrap(),
             Dopri5::new(tol),
             PAPER_D0,
-            Norm::paper(),
+            paper_norm(),
         )
         .unwrap();
         est.start(0.0, rest()).unwrap();
@@ -462,7 +463,7 @@ fn diagram_is_a_continuation_in_both_directions() {
         rest(),
         &values,
         PAPER_D0,
-        Norm::paper(),
+        paper_norm(),
         &settings,
     )
     .unwrap();
@@ -569,7 +570,7 @@ fn bad_input_gives_clear_errors() {
     let settings = DiagramSettings::new(IntervalRule::ForcingPeriod, 1, 1, 10).unwrap();
     let make = |w: f64| Ok(PAPER.oscillator::<f64>(w)?);
     let st = Dopri5::new(pair_tolerances::<f64, 2, 4>(&paper_tol()).unwrap());
-    let e = tle_diagram(make, &st, rest(), &[], PAPER_D0, Norm::paper(), &settings).unwrap_err();
+    let e = tle_diagram(make, &st, rest(), &[], PAPER_D0, paper_norm(), &settings).unwrap_err();
     assert_eq!((e), LyapunovError::NoParameters);
     for bad in [f64::NAN, 0.0, -20.0] {
         let e = tle_diagram(
@@ -578,7 +579,7 @@ fn bad_input_gives_clear_errors() {
             rest(),
             &[20.0, bad],
             PAPER_D0,
-            Norm::paper(),
+            paper_norm(),
             &settings,
         )
         .unwrap_err();
@@ -590,7 +591,7 @@ fn bad_input_gives_clear_errors() {
         rest(),
         &[20.0],
         f64::NAN,
-        Norm::paper(),
+        paper_norm(),
         &settings,
     )
     .unwrap_err();

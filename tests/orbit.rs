@@ -21,10 +21,11 @@ use nonsmooth::drive::Simulation;
 use nonsmooth::excite::Harmonic;
 use nonsmooth::force::{CubicSpring, ViscousDamper};
 use nonsmooth::integrate::{Dopri5, Tolerances};
-use nonsmooth::lyapunov::{Norm, TangentSpace, tangent_tolerances};
+use nonsmooth::lyapunov::{TangentSpace, tangent_tolerances};
 use nonsmooth::model::{Element, Load, Mechanical};
 use nonsmooth::orbit::{Shooting, modulus};
 use nonsmooth::sample::Stroboscopic;
+use nonsmooth::systems::paper::lyapunov::norm as paper_norm;
 
 const C: f64 = 0.1;
 const F: f64 = 0.5;
@@ -156,7 +157,7 @@ fn paper_period_two_orbit_at_omega_19() {
     let mut qr = TangentSpace::<f64, 2, 2, 6, _, _>::new(
         sys,
         Dopri5::new(tangent_tolerances::<f64, 2, 2, 6>(&tol, 1e-10, 1e-12).unwrap()),
-        Norm::paper(),
+        paper_norm(),
     )
     .unwrap();
     qr.start(t0, orbit.state).unwrap();

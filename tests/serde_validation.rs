@@ -25,6 +25,7 @@ use nonsmooth::force::{
 use nonsmooth::lyapunov::{DiagramSettings, IntervalRule, LyapunovError};
 use nonsmooth::model::Oscillator;
 use nonsmooth::signal::{InitialState, LowPass, PhaseInput, PhaseSection, ThresholdCrossing};
+use nonsmooth::systems::paper::lyapunov::diagram_settings as paper_diagram_settings;
 use nonsmooth::systems::{BouncingBallTable, DuffingUeda, TwoDofImpact};
 
 // ---------------------------------------------------------------------------------------
@@ -545,7 +546,7 @@ fn diagram_settings() {
         .unwrap();
     s.t0 = 3.5;
     round_trip(&s);
-    round_trip(&DiagramSettings::<f64>::paper());
+    round_trip(&paper_diagram_settings::<f64>());
     rejects(
         &s,
         "/intervals",

@@ -13,13 +13,13 @@ use nonsmooth::entropy::{
 };
 use nonsmooth::integrate::{Dopri5, Tolerances};
 use nonsmooth::lyapunov::{
-    Diagram, DiagramSettings, IntervalRule, Norm, PAPER_D0, TwoTrajectory, pair_tolerances,
-    tle_diagram,
+    Diagram, DiagramSettings, IntervalRule, TwoTrajectory, pair_tolerances, tle_diagram,
 };
 use nonsmooth::sweep::{
     Stop, SweepConfig, SweepDirection, SweepPoint, SweepResult, SweepSystem, Transition, run_point,
     sweep,
 };
+use nonsmooth::systems::paper::lyapunov::{D0 as PAPER_D0, norm as paper_norm};
 use nonsmooth::systems::paper::{PAPER, PaperOscillator};
 
 pub type Res<T> = Result<T, nonsmooth::Error>;
@@ -288,7 +288,7 @@ pub fn tle(omega: f64, transient: usize, periods: usize, rtol: f64) -> Res<(f64,
     let osc = PAPER.oscillator::<f64>(omega)?;
     let tol = pair_tolerances::<f64, 2, 4>(&tolerances(rtol))?;
     let mut est =
-        TwoTrajectory::<f64, 2, 4, _, _>::new(osc, Dopri5::new(tol), PAPER_D0, Norm::paper())?;
+        TwoTrajectory::<f64, 2, 4, _, _>::new(osc, Dopri5::new(tol), PAPER_D0, paper_norm())?;
     est.start(0.0, rest()?)?;
     let tau = TAU / omega;
     est.transient(tau, transient)?;
@@ -317,7 +317,7 @@ pub fn tle_fig5(
         rest()?,
         omegas,
         PAPER_D0,
-        Norm::paper(),
+        paper_norm(),
         &settings,
     )?)
 }

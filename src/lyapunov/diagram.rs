@@ -104,20 +104,6 @@ crate::serde_check::deserialize_checked! {
 }
 
 impl<T: Real> DiagramSettings<T> {
-    /// The paper's schedule (Sect. 4): one forcing period per interval, 100 transient periods
-    /// at the start, 50 after each parameter step, 10³ periods for the exponent, 10 blocks,
-    /// `t0 = 0`.
-    pub fn paper() -> Self {
-        Self {
-            interval: IntervalRule::ForcingPeriod,
-            first_transient: 100,
-            step_transient: 50,
-            intervals: 1000,
-            blocks: DEFAULT_BLOCKS,
-            t0: T::zero(),
-        }
-    }
-
     /// A schedule with 10 blocks and `t0 = 0`.
     ///
     /// # Errors
@@ -341,10 +327,10 @@ mod tests {
         assert!((t - std::f64::consts::TAU / 20.0).abs() < 1e-16);
         assert!(IntervalRule::<f64>::ForcingPeriod.interval(0.0).is_err());
         assert_eq!(DiagramDirection::Decreasing.as_str(), "decreasing");
-        let p = DiagramSettings::<f64>::paper();
+        let p = DiagramSettings::new(IntervalRule::<f64>::ForcingPeriod, 100, 50, 1000).unwrap();
         assert_eq!(
-            (p.first_transient, p.step_transient, p.intervals),
-            (100, 50, 1000)
+            (p.first_transient, p.step_transient, p.intervals, p.blocks),
+            (100, 50, 1000, DEFAULT_BLOCKS)
         );
         assert!(DiagramSettings::new(IntervalRule::Fixed(1.0_f64), 1, 1, 1).is_err());
         assert!(DiagramSettings::new(IntervalRule::Fixed(f64::NAN), 1, 1, 10).is_err());

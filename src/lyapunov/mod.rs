@@ -1,6 +1,6 @@
 //! Lyapunov exponents: the top exponent by two nearby trajectories (Benettin) and the
 //! spectrum by the tangent-space (QR) method, a separation (`d0`) study, and the
-//! exponent-versus-parameter diagram of the paper's Fig. 5.
+//! exponent-versus-parameter diagram.
 //!
 //! # The two methods
 //! **Two trajectories** ([`TwoTrajectory`]). A reference trajectory `y` and a perturbed one
@@ -18,8 +18,8 @@
 //! rounding errors of the difference dominate, too large and the estimate stops being local
 //! (the pair feels the nonlinearity — for an impact oscillator: the two trajectories hit the
 //! stop at noticeably different times). [`separation_study`] scans `d0` over decades;
-//! choose `d0` in the plateau (see [`PAPER_D0`] for the paper's model and the study behind
-//! it).
+//! choose `d0` in the plateau (for the paper's model and the study behind its value see
+//! [`systems::paper::lyapunov::D0`](crate::systems::paper::lyapunov::D0)).
 //!
 //! **Tangent space** ([`TangentSpace`]). `K ≤ N` tangent vectors are integrated with the
 //! state through the variational equations ([`Variational`], dimension `M = N + N·K`)
@@ -36,11 +36,11 @@
 //! $$\|\delta\|_w = \Bigl(\sum_i (\delta_i/w_i)^2\Bigr)^{1/2},$$
 //! with `w_i` the characteristic scale of component `i` (units of the component). The limit
 //! exponents do not depend on the norm (all norms on `ℝᴺ` are equivalent), but finite-time
-//! estimates, the meaning of `d0` and the conditioning of Gram–Schmidt do: in SI units the
-//! paper's position (`~10⁻³ m`) and velocity (`~3·10⁻²` m/s) differ by a factor of about
-//! 30, and an unweighted norm would let the velocity alone decide. The tangent method works in
-//! the scaled coordinates `ψ = D⁻¹δ`, `D = diag(w)` (so `ψ̇ = D⁻¹JD ψ`, and Gram–Schmidt is
-//! Euclidean in `ψ`). [`Norm::paper`] gives the scales used for the paper's model.
+//! estimates, the meaning of `d0` and the conditioning of Gram–Schmidt do: in SI units a
+//! position of `~10⁻³ m` and a velocity of `~3·10⁻²` m/s differ by a factor of about 30, and
+//! an unweighted norm would let the velocity alone decide. The tangent method works in the
+//! scaled coordinates `ψ = D⁻¹δ`, `D = diag(w)` (so `ψ̇ = D⁻¹JD ψ`, and Gram–Schmidt is
+//! Euclidean in `ψ`).
 //!
 //! # Statistical spread
 //! The per-interval rates `s_k = ln(d_k/d_0)/τ` are correlated, so their naive standard
@@ -51,47 +51,20 @@
 //! each interval is kept as the convergence [`history`](Estimate::history).
 //!
 //! # Where the Jacobian is singular
-//! The paper's contact damping `b·δ^{n2}·sgn(ẋ)|ẋ|^{n3}` with `n3 ≈ 0.187 < 1` has an
-//! infinite slope `∂F/∂ẋ` at `ẋ = 0` in contact, and the regularized friction
-//! `T·ẋ/√(ẋ²+ε²)` a slope `T/ε ≈ 6·10⁵ N·s/m` there. For the exact law the variational
-//! equations are therefore not defined wherever the cart reverses while pressed into the
-//! stop — at the turning point of *every* impact, and whenever it rests against the stop —
-//! and `∂F/∂ẋ` returned by [`HertzContact`](crate::force::HertzContact) is the largest
-//! finite number there. (The singularity is integrable along a trajectory — `∫|ẋ|^{n3−1}dt`
-//! converges when `ẍ ≠ 0` — but no step-based integrator can evaluate `J` at it.) With the
-//! exact law (`η = 0`) the QR method fails at the first reversal in contact
-//! ([`IntegrateError::StepSizeTooSmall`] — measured at ω = 20.465 after 0.08 s), while the
-//! two-trajectory method runs at its usual cost and gives `λ₁ = 0.694 ± 0.013 s⁻¹`, the
-//! regularized model's value within the spread.
-//!
-//! The crate's paper model uses the rate regularization
-//! `sgn(ẋ)|ẋ|^{n3} → ẋ(ẋ²+η²)^{(n3−1)/2}` with `η = 10⁻⁸ m/s`
-//! ([`PAPER.eta`](crate::systems::paper::PaperParameters::eta)), whose slope at `ẋ = 0` is
-//! `η^{n3−1} ≈ 3·10⁶ (m/s)^{n3−1}`: `J` is finite but very large in short windows around
-//! each reversal in contact — `J_ẋẋ = −∂F/∂ẋ/m ≈ −k_I·b·δ^{3/2}·η^{n3−1}/m` is about
-//! `−10⁶ s⁻¹` for the cart resting in the stop (`δ ≈ 5 µm`) and `−10⁸ s⁻¹` at the turning
-//! point of an impact (`δ ≈ 0.1 mm`), over a time `~η/|ẍ| ≈ 10⁻⁹ s`. Those windows are
-//! strongly *contracting* (the large entry is damping), so they cannot blow the tangent
-//! vectors up, and they carry only a few per cent of the integrated damping
-//! `∫ ∂F/∂ẋ dt` through a reversal (`2g(η)` of `2g(v_impact)`, `g(v) = v^{n3}`), so an
-//! explicit stepper that steps over them errs little. The QR method then estimates the
-//! exponents of the regularized flow. The two-trajectory method never forms `J`, and the two
-//! agree on the paper's model (`tests/lyapunov.rs`, measured with DOPRI5):
-//!
-//! | ω (rad/s) | two trajectories | QR `λ₁` (`λ₂`) | tolerances, `d0` |
-//! |---|---|---|---|
-//! | 19.0 (period 2) | −2.13346 ± 0.00025 | −2.13408 (−17.859) | rtol 1e-10, `d0 = 10⁻⁶` |
-//! | 20.465 (chaotic) | 0.682 ± 0.015 | 0.702 ± 0.017 (−8.741) | rtol 1e-10, `d0 = 10⁻⁶` |
-//! | 19.0 | −2.1142 ± 0.0006 | −2.1340 (−17.859) | rtol 1e-8, `d0 = 10⁻⁴` |
-//! | 20.465 | 0.707 ± 0.015 | 0.697 ± 0.015 (−8.737) | rtol 1e-8, `d0 = 10⁻⁴` |
-//!
-//! On the chaotic attractor the two runs follow different (diverged) trajectories, so they
-//! agree within their spreads; on the periodic orbit they agree to `3·10⁻⁴` at tight
-//! tolerances and to 1 % at the paper-grade tolerances, where the two-trajectory estimate
-//! carries the integration error of the difference (see [`PAPER_D0`]). The QR method costs
-//! about 2.5 times as much per period (15 ms against 5.8 ms for 50 periods at ω = 20.465,
-//! `benches/lyapunov.rs`) and gives the second exponent too; the two-trajectory method is
-//! the one that needs no derivatives and also works for the exact law (`η = 0`).
+//! A law with a cusp in the rate — a contact damping `sgn(ẋ)|ẋ|^{p}` with `p < 1`, a
+//! friction regularized on a small scale `ε` — has an infinite (or a very large) slope
+//! `∂F/∂ẋ` at `ẋ = 0`. For the exact cusp the variational equations are not defined
+//! wherever the rate reverses in contact, and `∂F/∂ẋ` returned by the law (e.g.
+//! [`HertzContact`](crate::force::HertzContact)) is the largest finite number there. (The
+//! singularity is integrable along a trajectory — `∫|ẋ|^{p−1}dt` converges when `ẍ ≠ 0` —
+//! but no step-based integrator can evaluate `J` at it.) The QR method then fails at the
+//! first reversal in contact ([`IntegrateError::StepSizeTooSmall`]), while the
+//! two-trajectory method, which never forms `J`, runs at its usual cost. With a rate
+//! regularization `sgn(ẋ)|ẋ|^{p} → ẋ(ẋ²+η²)^{(p−1)/2}` the Jacobian is finite but very
+//! large in short windows around each reversal; those windows are strongly contracting (the
+//! large entry is damping), so they cannot blow the tangent vectors up, and the QR method
+//! estimates the exponents of the regularized flow. The paper's model, with both methods
+//! compared, is documented in [`systems::paper::lyapunov`](crate::systems::paper::lyapunov).
 //!
 //! # Examples
 //! ```
@@ -122,7 +95,7 @@
 //! G. Benettin, L. Galgani, A. Giorgilli, J.-M. Strelcyn, *Lyapunov characteristic
 //! exponents for smooth dynamical systems and for Hamiltonian systems*, Meccanica 15
 //! (1980); A. Wolf et al., *Determining Lyapunov exponents from a time series*, Physica D 16
-//! (1985); the paper, Sect. 4 and Fig. 5.
+//! (1985).
 
 mod diagram;
 pub mod hybrid;
@@ -321,61 +294,6 @@ pub const DEFAULT_BLOCKS: usize = 10;
 /// Default cap of accepted steps per renormalization interval.
 pub const DEFAULT_MAX_STEPS_PER_INTERVAL: usize = 10_000_000;
 
-/// Characteristic scales `(w_x, w_ẋ) = (10⁻³ m, 3·10⁻² m/s)` of the paper's model, used by
-/// [`Norm::paper`].
-///
-/// Measured on the attractors of the paper's oscillator reached from rest (200 periods
-/// sampled 64 times per period after 100 transient periods): the standard deviations of
-/// position and velocity are `(3.1·10⁻⁴ m, 1.0·10⁻² m/s)` at `ω = 17.5`,
-/// `(5.3·10⁻⁴, 1.7·10⁻²)` at 19, `(9.0·10⁻⁴, 2.8·10⁻²)` at 20.465 and
-/// `(1.6·10⁻³, 5.5·10⁻²)` at 25 rad/s — a ratio `σ_ẋ/σ_x ≈ 30–34 s⁻¹`, above `ω` because
-/// the impacts put energy into higher harmonics. With these weights a separation of 1 in
-/// the norm is about one typical amplitude in either component, so neither dominates.
-pub const PAPER_SCALES: [f64; 2] = [1e-3, 3e-2];
-
-/// The initial separation `d0` (in the [`Norm::paper`] norm) for the two-trajectory
-/// estimate on the paper's model with the paper-grade tolerances
-/// `Tolerances::per_component(1e-8, [1e-12, 1e-10])`.
-///
-/// # The study behind it
-/// [`separation_study`] from rest, 100 transient and 10³ recorded periods, DOPRI5 at
-/// `rtol = 10⁻⁸`; `λ₁` in s⁻¹ (± the block standard error):
-///
-/// | d0 | ω = 20.465 (chaotic) | ω = 18 (chaotic) | ω = 19 (period 2) | ω = 20.2 (periodic) |
-/// |---|---|---|---|---|
-/// | 1e-8 | 0.829 ± 0.029 | 1.780 ± 0.027 | −1.923 ± 0.025 | −0.693 ± 0.005 |
-/// | 1e-7 | 0.822 ± 0.027 | 1.768 ± 0.029 | −1.920 ± 0.007 | −0.700 ± 0.004 |
-/// | 1e-6 | 0.713 ± 0.019 | 1.439 ± 0.024 | −2.129 ± 0.001 | −0.666 ± 0.003 |
-/// | 1e-5 | 0.653 ± 0.029 | 1.429 ± 0.029 | −2.125 ± 0.001 | −0.697 ± 0.002 |
-/// | **1e-4** | **0.707 ± 0.015** | **1.429 ± 0.022** | **−2.114 ± 0.001** | **−0.698 ± 0.001** |
-/// | 1e-3 | 0.659 ± 0.024 | 1.451 ± 0.041 | −2.135 ± 0.000 | −0.686 ± 0.000 |
-/// | 1e-2 | 0.707 ± 0.014 | 1.297 ± 0.038 | −2.192 ± 0.000 | −0.690 ± 0.000 |
-/// | 1e-1 | 0.108 ± 0.045 | −2.353 ± 0.064 | −5.107 ± 0.040 | −0.804 ± 0.000 |
-/// | QR (rtol 1e-10) | 0.702 ± 0.017 | 1.360 ± 0.041 | −2.1341 | −0.6886 |
-///
-/// - **Too small** (`d0 ≲ 3·10⁻⁷`): biased (0.82 instead of 0.70 at 20.465, −1.92 instead
-///   of −2.13 at 19). The error controller allows a local error of about
-///   `atol + rtol·|y|` ≈ `3·10⁻¹¹ m` and `4·10⁻¹⁰ m/s` per step; the two copies share
-///   their steps, so their errors are correlated where `f` is smooth on the scale of a step,
-///   but not at the contact entries and exits and the velocity reversals (where, as the
-///   crate's profiling shows, most steps are spent). There the separation picks up errors of
-///   the size of that allowance, i.e. a relative error `~(3·10⁻¹¹ m)/(d0·w_x)`. At
-///   `rtol = 10⁻¹⁰` the same study is flat from `d0 = 10⁻⁸` up: at ω = 19 it gives
-///   −2.1353, −2.1339, −2.1332, −2.1340, −2.1348 for `d0 = 10⁻⁷ … 10⁻³`, the QR value
-///   −2.1341 to 4 digits.
-/// - **Too large** (`d0 ≳ 3·10⁻³`): the pair is no longer local (−2.19 at 19 and 1.30 at
-///   18 for `10⁻²`, nonsense at `10⁻¹` — a tenth of the attractor).
-/// - In between, the estimates are flat within their spreads on the chaotic attractors and
-///   within about 1 % of the QR value on the periodic ones. `10⁻⁴` (a position offset of
-///   `~7·10⁻⁸ m`, velocity `~2·10⁻⁶ m/s`) sits a factor `~10³` above the error allowance
-///   and a factor `~30` below the onset of non-locality. Rule of thumb for other tolerances:
-///   `d0 ≈ 10⁴·rtol` (for `rtol = 10⁻¹⁰`, `d0 = 10⁻⁶`, at twice the cost and with the
-///   periodic orbits' exponents correct to `~10⁻⁴`).
-///
-/// `tests/lyapunov.rs` (`d0_study_is_flat_on_the_paper_model`) checks the plateau over a
-/// decade around this value at ω = 20.465, with `10⁻⁸` and `10⁻¹` as controls.
-pub const PAPER_D0: f64 = 1e-4;
-
 /// A weighted Euclidean norm for separations (see the module docs).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Norm<T, const N: usize> {
@@ -383,14 +301,6 @@ pub enum Norm<T, const N: usize> {
     Euclidean,
     /// `‖δ‖ = (Σ (δ_i/w_i)²)^{1/2}` with `w_i > 0` the characteristic scale of component `i`.
     Weighted([T; N]),
-}
-
-impl<T: Real> Norm<T, 2> {
-    /// The norm used for the paper's model: weights [`PAPER_SCALES`]
-    /// `(10⁻³ m, 2·10⁻² m/s)`.
-    pub fn paper() -> Self {
-        Norm::Weighted([lit(PAPER_SCALES[0]), lit(PAPER_SCALES[1])])
-    }
 }
 
 impl<T: Real, const N: usize> Norm<T, N> {
@@ -677,7 +587,7 @@ mod tests {
         );
         assert!(Norm::weighted([f64::NAN, 1.0]).is_err());
         assert!(Norm::Weighted([-1.0_f64, 1.0]).validate().is_err());
-        let p = Norm::<f32, 2>::paper();
+        let p = Norm::<f32, 2>::Weighted([1e-3, 3e-2]);
         assert!((p.norm(&SVector::<f32, 2>::new(1e-3, 3e-2)) - 2.0_f32.sqrt()).abs() < 1e-6);
         assert_eq!(p.scales()[1], 3e-2_f32);
     }

@@ -309,7 +309,7 @@ where
     ///     Dopri5::new,
     ///     &tol,
     ///     (1e-8, 1e-8),
-    ///     Norm::paper(),
+    ///     Norm::weighted([1e-3, 3e-2])?,
     /// )?;
     /// # drop(qr);
     /// # Ok::<(), nonsmooth::Error>(())

@@ -242,7 +242,7 @@ where
     ///     Dopri5::new,
     ///     &tol,
     ///     1e-8,
-    ///     Norm::paper(),
+    ///     Norm::weighted([1e-3, 3e-2])?,
     /// )?;
     /// # drop(est);
     /// # Ok::<(), nonsmooth::Error>(())
@@ -506,7 +506,7 @@ pub fn decades<T: Real>(lo: i32, hi: i32, per_decade: usize) -> Vec<T> {
 /// values in parallel with feature `parallel`; the results do not depend on it.
 ///
 /// # Study on the paper's model
-/// See [`PAPER_D0`](super::PAPER_D0) for the table at four frequencies and the reasons for
+/// See [`systems::paper::lyapunov::D0`](crate::systems::paper::lyapunov::D0) for the table at four frequencies and the reasons for
 /// both ends of the plateau.
 ///
 /// # Errors

@@ -64,7 +64,7 @@ impl ModelKind {
     /// detection.
     pub(crate) fn scales(self) -> [f64; 2] {
         match self {
-            Self::Paper => crate::lyapunov::PAPER_SCALES,
+            Self::Paper => crate::systems::paper::lyapunov::NORM_SCALES,
             Self::DuffingUeda => [1.0, 1.0],
         }
     }
@@ -80,7 +80,7 @@ impl ModelKind {
     /// Default Lyapunov separation (in the scaled norm).
     pub(crate) fn d0(self) -> f64 {
         match self {
-            Self::Paper => crate::lyapunov::PAPER_D0,
+            Self::Paper => crate::systems::paper::lyapunov::D0,
             Self::DuffingUeda => 1e-6,
         }
     }

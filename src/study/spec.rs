@@ -241,7 +241,7 @@ pub struct LyapunovSpec {
     /// Forcing periods averaged (≥ 10: the spread needs 10 blocks).
     pub periods: usize,
     /// Initial separation in the model's norm; default the model's (the paper:
-    /// [`PAPER_D0`](crate::lyapunov::PAPER_D0)).
+    /// [`systems::paper::lyapunov::D0`](crate::systems::paper::lyapunov::D0)).
     #[serde(default)]
     pub d0: Option<f64>,
 }

@@ -30,6 +30,7 @@
 
 mod experiment;
 mod fit;
+pub mod lyapunov;
 
 pub use experiment::{Forcing, SyntheticExperiment, SyntheticRecord};
 pub use fit::{
