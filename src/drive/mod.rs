@@ -1117,16 +1117,11 @@ mod tests {
     use super::*;
     use crate::event::{Event, FnEvent, Level};
     use crate::integrate::{Dopri5, Rk4, Tolerances};
+    use crate::testing::HarmonicOscillator;
 
     /// `ẍ = −x` (state `(x, ẋ)`).
-    #[derive(Debug, Clone, Copy)]
-    struct Oscillator;
-
-    impl Dynamics<f64, 2> for Oscillator {
-        fn rhs(&self, _t: f64, y: &SVector<f64, 2>, dy: &mut SVector<f64, 2>) {
-            dy[0] = y[1];
-            dy[1] = -y[0];
-        }
+    fn oscillator() -> HarmonicOscillator<f64> {
+        HarmonicOscillator::new(1.0).unwrap()
     }
 
     fn adaptive() -> Dopri5<f64, 2> {
@@ -1201,7 +1196,7 @@ mod tests {
 
     #[test]
     fn check_work_rejects_a_span_beyond_the_step_cap_of_a_fixed_step() {
-        let sim = Simulation::new(Oscillator, Rk4::new(0.1).unwrap())
+        let sim = Simulation::new(oscillator(), Rk4::new(0.1).unwrap())
             .max_steps(10)
             .unwrap();
         // 2 s at h = 0.1 needs 20 steps; the cap is 10 (plus one for rounding).
@@ -1221,7 +1216,7 @@ mod tests {
     #[test]
     fn check_work_bounds_the_step_by_the_grid_and_the_events() {
         // An adaptive stepper without h_max is unbounded: any span passes.
-        let sim = Simulation::new(Oscillator, adaptive())
+        let sim = Simulation::new(oscillator(), adaptive())
             .max_steps(3)
             .unwrap();
         assert_eq!(sim.check_work(0.0, 1e9), Ok(()));
@@ -1255,7 +1250,7 @@ mod tests {
             FnEvent(|_t: f64, y: &SVector<f64, 2>| y[0]),
             Direction::Either,
         );
-        let mut sim = Simulation::new(Oscillator, adaptive()).with_events((
+        let mut sim = Simulation::new(oscillator(), adaptive()).with_events((
             on(0.0),
             on(1.0),
             on(-1.0),
@@ -1285,7 +1280,7 @@ mod tests {
             FnEvent(|_t: f64, _y: &SVector<f64, 2>| f64::NAN),
             Direction::Either,
         );
-        let mut sim = Simulation::new(Oscillator, adaptive()).with_events((
+        let mut sim = Simulation::new(oscillator(), adaptive()).with_events((
             Event::new(Level::new(0, 0.0).unwrap(), Direction::Either),
             bad,
         ));
