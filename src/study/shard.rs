@@ -356,24 +356,8 @@ fn read_shard(
 ) -> Result<Vec<PointRecord>, StudyError> {
     let pp = dir.join(&m.points_file);
     let sp = dir.join(&m.sections_file);
-    let points = fs::read(&pp).map_err(|e| {
-        StudyError::MissingShards(format!(
-            "{} (listed in {}): {e}; re-run shard {}/{}",
-            pp.display(),
-            manifest_path.display(),
-            m.shard,
-            m.shards
-        ))
-    })?;
-    let sections = fs::read(&sp).map_err(|e| {
-        StudyError::MissingShards(format!(
-            "{} (listed in {}): {e}; re-run shard {}/{}",
-            sp.display(),
-            manifest_path.display(),
-            m.shard,
-            m.shards
-        ))
-    })?;
+    let points = read_listed(&pp, m, manifest_path)?;
+    let sections = read_listed(&sp, m, manifest_path)?;
     for (p, bytes, want) in [
         (&pp, &points, &m.points_fnv),
         (&sp, &sections, &m.sections_fnv),
@@ -390,71 +374,110 @@ fn read_shard(
             ));
         }
     }
-    let mut rd = csv::Reader::from_reader(points.as_slice());
-    let header = rd.headers().map_err(|e| corrupt(&pp, e))?.clone();
+    let records = parse_points(&pp, &points, &m.spec_hash)?;
+    attach_sections(&sp, &sections, records)
+}
+
+/// The bytes of a file listed in the manifest `m` (at `manifest_path`).
+fn read_listed(
+    path: &Path,
+    m: &ShardManifest,
+    manifest_path: &Path,
+) -> Result<Vec<u8>, StudyError> {
+    fs::read(path).map_err(|e| {
+        StudyError::MissingShards(format!(
+            "{} (listed in {}): {e}; re-run shard {}/{}",
+            path.display(),
+            manifest_path.display(),
+            m.shard,
+            m.shards
+        ))
+    })
+}
+
+/// The points file `pp` (its bytes `points`): each point with its number of kept sections
+/// (its `sections` still empty), every row of the study with hash `spec_hash`.
+fn parse_points(
+    pp: &Path,
+    points: &[u8],
+    spec_hash: &str,
+) -> Result<Vec<(PointRecord, usize)>, StudyError> {
+    let mut rd = csv::Reader::from_reader(points);
+    let header = rd.headers().map_err(|e| corrupt(pp, e))?.clone();
     if header.iter().ne(POINT_HEADER.iter().copied()) {
-        return Err(corrupt(&pp, "unexpected header"));
+        return Err(corrupt(pp, "unexpected header"));
     }
     let mut records = Vec::new();
     for (row, rec) in rd.records().enumerate() {
-        let rec = rec.map_err(|e| corrupt(&pp, e))?;
+        let rec = rec.map_err(|e| corrupt(pp, e))?;
         let f = |k: usize| rec.get(k).unwrap_or("");
-        if f(9) != m.spec_hash {
+        if f(9) != spec_hash {
             return Err(corrupt(
-                &pp,
+                pp,
                 format!("row {row}: spec hash {} differs", f(9)),
             ));
         }
-        let mut cells = Vec::new();
-        for c in f(8).split_whitespace() {
-            let (a, b) = c
-                .split_once(':')
-                .ok_or_else(|| corrupt(&pp, format!("row {row}: cell {c:?}")))?;
-            let a: i64 = a
-                .parse()
-                .map_err(|_| corrupt(&pp, format!("row {row}: cell {c:?}")))?;
-            let b: i64 = b
-                .parse()
-                .map_err(|_| corrupt(&pp, format!("row {row}: cell {c:?}")))?;
-            cells.push((a, b));
-        }
-        let kept = parse_usize(&pp, row, "kept_sections", f(7))?;
+        let cells = parse_cells(pp, row, f(8))?;
+        let kept = parse_usize(pp, row, "kept_sections", f(7))?;
         records.push((
             PointRecord {
-                index: parse_usize(&pp, row, "index", f(0))?,
+                index: parse_usize(pp, row, "index", f(0))?,
                 status: f(1).to_string(),
-                period: parse_usize(&pp, row, "period", f(2))?,
-                impacts_per_period: parse_f64(&pp, row, "impacts_per_period", f(3))?,
-                tle: parse_f64(&pp, row, "tle", f(4))?,
-                tle_spread: parse_f64(&pp, row, "tle_spread", f(5))?,
-                q: parse_f64(&pp, row, "q", f(6))?,
+                period: parse_usize(pp, row, "period", f(2))?,
+                impacts_per_period: parse_f64(pp, row, "impacts_per_period", f(3))?,
+                tle: parse_f64(pp, row, "tle", f(4))?,
+                tle_spread: parse_f64(pp, row, "tle_spread", f(5))?,
+                q: parse_f64(pp, row, "q", f(6))?,
                 sections: Vec::with_capacity(kept),
                 cells,
             },
             kept,
         ));
     }
+    Ok(records)
+}
+
+/// The cells `a:b` (separated by white space) of row `row` of the points file `pp`.
+fn parse_cells(pp: &Path, row: usize, text: &str) -> Result<Vec<(i64, i64)>, StudyError> {
+    let mut cells = Vec::new();
+    for c in text.split_whitespace() {
+        let bad = || corrupt(pp, format!("row {row}: cell {c:?}"));
+        let (a, b) = c.split_once(':').ok_or_else(bad)?;
+        let a: i64 = a.parse().map_err(|_| bad())?;
+        let b: i64 = b.parse().map_err(|_| bad())?;
+        cells.push((a, b));
+    }
+    Ok(cells)
+}
+
+/// Appends the sections file `sp` (its bytes `sections`) to the points of `records`; each
+/// point must get exactly its number of kept sections.
+fn attach_sections(
+    sp: &Path,
+    sections: &[u8],
+    mut records: Vec<(PointRecord, usize)>,
+) -> Result<Vec<PointRecord>, StudyError> {
     let mut pos: BTreeMap<usize, usize> = BTreeMap::new();
     for (k, (r, _)) in records.iter().enumerate() {
         pos.insert(r.index, k);
     }
-    let mut rd = csv::Reader::from_reader(sections.as_slice());
+    let mut rd = csv::Reader::from_reader(sections);
     for (row, rec) in rd.records().enumerate() {
-        let rec = rec.map_err(|e| corrupt(&sp, e))?;
+        let rec = rec.map_err(|e| corrupt(sp, e))?;
         let f = |k: usize| rec.get(k).unwrap_or("");
-        let index = parse_usize(&sp, row, "index", f(0))?;
+        let index = parse_usize(sp, row, "index", f(0))?;
         let k = *pos
             .get(&index)
-            .ok_or_else(|| corrupt(&sp, format!("row {row}: point {index} is not in the shard")))?;
-        let x = parse_f64(&sp, row, "x", f(2))?;
-        let v = parse_f64(&sp, row, "v", f(3))?;
+            .ok_or_else(|| corrupt(sp, format!("row {row}: point {index} is not in the shard")))?;
+        let x = parse_f64(sp, row, "x", f(2))?;
+        let v = parse_f64(sp, row, "v", f(3))?;
         records[k].0.sections.push([x, v]);
     }
     let mut out = Vec::with_capacity(records.len());
     for (r, kept) in records {
         if r.sections.len() != kept {
             return Err(corrupt(
-                &sp,
+                sp,
                 format!(
                     "point {}: {} sections, {kept} expected",
                     r.index,
