@@ -1111,3 +1111,186 @@ fn sign_of<T: Real>(x: T) -> i8 {
         0
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::event::{Event, FnEvent, Level};
+    use crate::integrate::{Dopri5, Rk4, Tolerances};
+    use crate::testing::HarmonicOscillator;
+
+    /// `ẍ = −x` (state `(x, ẋ)`).
+    fn oscillator() -> HarmonicOscillator<f64> {
+        HarmonicOscillator::new(1.0).unwrap()
+    }
+
+    fn adaptive() -> Dopri5<f64, 2> {
+        Dopri5::new(Tolerances::new(1e-8, 1e-10).unwrap())
+    }
+
+    fn work_exceeds(needed: f64, span: f64, h: f64, max_steps: usize) -> RunError {
+        IntegrateError::WorkExceedsCap {
+            needed,
+            span,
+            h,
+            max_steps,
+        }
+        .into()
+    }
+
+    #[test]
+    fn landing_limit_is_t_end_without_a_grid() {
+        assert_eq!(landing_limit(0.25, 7.0, None), 7.0);
+    }
+
+    #[test]
+    fn landing_limit_computes_grid_points_from_their_index() {
+        // The next point after t = 0.25 on 0 + k·0.1 is k = 3, computed as 3·0.1 (which
+        // is 0.30000000000000004, not the accumulated 0.1 + 0.1 + 0.1).
+        assert_eq!(landing_limit(0.25, 1.0, Some((0.0, 0.1))), 3.0 * 0.1);
+        // Far along the grid: k = 10001, no drift.
+        assert_eq!(
+            landing_limit(1000.05, 2000.0, Some((0.0, 0.1))),
+            10001.0 * 0.1
+        );
+        // An origin off zero: 1 + k·0.5.
+        assert_eq!(landing_limit(1.2, 9.0, Some((1.0, 0.5))), 1.5);
+        assert_eq!(landing_limit(-0.2, 9.0, Some((1.0, 0.5))), 0.0);
+        // f32: the same rule.
+        assert_eq!(
+            landing_limit::<f32>(0.25, 1.0, Some((0.0, 0.1))),
+            3.0f32 * 0.1
+        );
+    }
+
+    #[test]
+    fn landing_limit_skips_a_point_within_rounding_of_t() {
+        // t = 0.3 lies just below 3·0.1 = 0.30000000000000004: that point is within
+        // rounding of t, so the next one, 4·0.1, is the limit (no step of 4e-17 s).
+        assert_eq!(landing_limit(0.3, 1.0, Some((0.0, 0.1))), 4.0 * 0.1);
+        // Exactly on a grid point: the next one.
+        assert_eq!(landing_limit(3.0 * 0.1, 1.0, Some((0.0, 0.1))), 4.0 * 0.1);
+        assert_eq!(landing_limit(1.5, 9.0, Some((1.0, 0.5))), 2.0);
+    }
+
+    #[test]
+    fn landing_limit_is_capped_at_t_end() {
+        assert_eq!(landing_limit(0.25, 0.28, Some((0.0, 0.1))), 0.28);
+        assert_eq!(landing_limit(0.25, 0.3, Some((0.0, 0.1))), 0.3);
+    }
+
+    #[test]
+    fn sign_of_and_signed_tiny() {
+        assert_eq!(sign_of(2.5), 1);
+        assert_eq!(sign_of(-1e-300), -1);
+        assert_eq!(sign_of(0.0), 0);
+        assert_eq!(sign_of(-0.0), 0);
+        assert_eq!(sign_of(f64::NAN), 0);
+        assert_eq!(sign_of(f32::NEG_INFINITY), -1);
+        let tiny = f64::EPSILON * f64::EPSILON;
+        assert_eq!(signed_tiny::<f64>(-1), -tiny);
+        assert_eq!(signed_tiny::<f64>(1), tiny);
+        assert_eq!(signed_tiny::<f64>(0), tiny);
+        assert_eq!(signed_tiny::<f32>(-1), -(f32::EPSILON * f32::EPSILON));
+    }
+
+    #[test]
+    fn check_work_rejects_a_span_beyond_the_step_cap_of_a_fixed_step() {
+        let sim = Simulation::new(oscillator(), Rk4::new(0.1).unwrap())
+            .max_steps(10)
+            .unwrap();
+        // 2 s at h = 0.1 needs 20 steps; the cap is 10 (plus one for rounding).
+        assert_eq!(
+            sim.check_work(0.0, 2.0),
+            Err(work_exceeds(20.0, 2.0, 0.1, 10))
+        );
+        // 1 s needs 10: accepted, and so is 11 (the margin of one step).
+        assert_eq!(sim.check_work(0.0, 1.0), Ok(()));
+        assert_eq!(sim.check_work(0.0, 1.0999999), Ok(()));
+        // The same check runs before a run takes a step.
+        let mut sim = sim;
+        let err = sim.run(0.0, SVector::from([1.0, 0.0]), 2.0, &mut ());
+        assert_eq!(err.unwrap_err(), work_exceeds(20.0, 2.0, 0.1, 10));
+    }
+
+    #[test]
+    fn check_work_bounds_the_step_by_the_grid_and_the_events() {
+        // An adaptive stepper without h_max is unbounded: any span passes.
+        let sim = Simulation::new(oscillator(), adaptive())
+            .max_steps(3)
+            .unwrap();
+        assert_eq!(sim.check_work(0.0, 1e9), Ok(()));
+        // A landing grid bounds the step by its spacing.
+        let sim = sim.landing_grid(Some((0.0, 0.5))).unwrap();
+        assert_eq!(
+            sim.check_work(0.0, 10.0),
+            Err(work_exceeds(20.0, 10.0, 0.5, 3))
+        );
+        // An event's max_step bounds it too; the smaller bound counts.
+        let e = Event::new(Level::new(0, 0.0).unwrap(), Direction::Either)
+            .with_max_step(0.25)
+            .unwrap();
+        let sim = sim.with_events(e);
+        assert_eq!(
+            sim.check_work(0.0, 10.0),
+            Err(work_exceeds(40.0, 10.0, 0.25, 3))
+        );
+        let sim = sim.landing_grid(None).unwrap();
+        assert_eq!(sim.check_work(1.0, 1.5), Ok(()));
+        assert_eq!(
+            sim.check_work(0.0, 2.0),
+            Err(work_exceeds(8.0, 2.0, 0.25, 3))
+        );
+    }
+
+    #[test]
+    fn initial_sides_of_a_start_on_a_surface_come_from_the_rate() {
+        let on = |level| Event::new(Level::new(0, level).unwrap(), Direction::Either);
+        let no_rate = Event::new(
+            FnEvent(|_t: f64, y: &SVector<f64, 2>| y[0]),
+            Direction::Either,
+        );
+        let mut sim = Simulation::new(oscillator(), adaptive()).with_events((
+            on(0.0),
+            on(1.0),
+            on(-1.0),
+            Event::new(Level::new(1, 0.0).unwrap(), Direction::Either),
+            no_rate,
+        ));
+        // On x = 0 moving up (ẋ = 1): side +1, although g = 0.
+        sim.stepper.reset_state(0.0, SVector::from([0.0, 1.0]));
+        let sides = sim.initial_sides().unwrap();
+        assert_eq!(sides.side, [1, -1, 1, 1, 0, 0, 0, 0]);
+        assert_eq!(sides.armed, [true; MAX_EVENTS]);
+        // On x = 0 moving down: side −1. The closure has no rate: unknown (0) until the
+        // first step, whichever way the state moves.
+        sim.stepper.reset_state(0.0, SVector::from([0.0, -1.0]));
+        assert_eq!(
+            sim.initial_sides().unwrap().side,
+            [-1, -1, 1, -1, 0, 0, 0, 0]
+        );
+        // At rest on x = 0 and on ẋ = 0: both rates (ẋ, ẍ = −x) are 0, the sides unknown.
+        sim.stepper.reset_state(0.0, SVector::from([0.0, 0.0]));
+        assert_eq!(sim.initial_sides().unwrap().side, [0, -1, 1, 0, 0, 0, 0, 0]);
+    }
+
+    #[test]
+    fn initial_sides_reject_a_non_finite_event_value() {
+        let bad = Event::new(
+            FnEvent(|_t: f64, _y: &SVector<f64, 2>| f64::NAN),
+            Direction::Either,
+        );
+        let mut sim = Simulation::new(oscillator(), adaptive()).with_events((
+            Event::new(Level::new(0, 0.0).unwrap(), Direction::Either),
+            bad,
+        ));
+        sim.stepper.reset_state(0.5, SVector::from([1.0, 0.0]));
+        match sim.initial_sides() {
+            Err(RunError::Event(EventError::NonFinite { index, t, value })) => {
+                assert_eq!((index, t), (1, 0.5));
+                assert!(value.is_nan());
+            }
+            other => panic!("expected NonFinite, got {other:?}"),
+        }
+    }
+}

@@ -35,7 +35,9 @@ use std::ops::Range;
 use std::path::Path;
 use std::sync::OnceLock;
 
+use plotters::chart::SeriesAnno;
 use plotters::coord::Shift;
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use plotters::style::FontStyle;
 
@@ -487,13 +489,49 @@ fn draw_figure<DB: DrawingBackend>(
     root.present().map_err(e)
 }
 
+/// A panel's chart: linear axes over the panel's ranges.
+type Chart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+/// The legend glyph of a series.
+#[derive(Debug, Clone, Copy)]
+enum Glyph {
+    /// A short line (lines, stems).
+    Line,
+    /// A dot.
+    Dot,
+    /// A filled box (bars).
+    Bar,
+}
+
+fn area_error<E: std::error::Error + Send + Sync>(e: DrawingAreaErrorKind<E>) -> String {
+    e.to_string()
+}
+
+fn finite_point(&(x, y): &(f64, f64)) -> bool {
+    x.is_finite() && y.is_finite()
+}
+
 fn draw_panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     panel: &Panel,
 ) -> std::result::Result<(), String> {
-    let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
     let (xr, yr) = panel.ranges();
-    let (x0, x1, y0, y1) = (xr.start, xr.end, yr.start, yr.end);
+    let frame = (xr.start, xr.end, yr.start, yr.end);
+    let mut chart = build_chart(area, panel, xr, yr)?;
+    draw_reference_lines(&mut chart, panel, frame)?;
+    for s in &panel.series {
+        draw_one_series(&mut chart, s)?;
+    }
+    draw_legend(&mut chart, panel)
+}
+
+/// The chart over `xr × yr` with its caption, axis labels and ticks.
+fn build_chart<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    panel: &Panel,
+    xr: Range<f64>,
+    yr: Range<f64>,
+) -> std::result::Result<Chart<'a, DB>, String> {
     let mut builder = ChartBuilder::on(area);
     builder
         .margin(12)
@@ -503,7 +541,7 @@ fn draw_panel<DB: DrawingBackend>(
     if let Some(t) = &panel.title {
         builder.caption(t, (FAMILY, 22).into_font());
     }
-    let mut chart = builder.build_cartesian_2d(xr, yr).map_err(e)?;
+    let mut chart = builder.build_cartesian_2d(xr, yr).map_err(area_error)?;
     chart
         .configure_mesh()
         .disable_mesh()
@@ -516,21 +554,30 @@ fn draw_panel<DB: DrawingBackend>(
         .x_label_formatter(&|v| tick(*v))
         .y_label_formatter(&|v| tick(*v))
         .draw()
-        .map_err(e)?;
+        .map_err(area_error)?;
+    Ok(chart)
+}
+
+/// The frame `(x0, x1, y0, y1)` and the panel's vertical and horizontal reference lines.
+fn draw_reference_lines<DB: DrawingBackend>(
+    chart: &mut Chart<'_, DB>,
+    panel: &Panel,
+    (x0, x1, y0, y1): (f64, f64, f64, f64),
+) -> std::result::Result<(), String> {
     // A frame around the plotting area (the mesh draws only the left and bottom axes).
     chart
         .draw_series(std::iter::once(PathElement::new(
             vec![(x0, y1), (x1, y1), (x1, y0)],
             BLACK.stroke_width(1),
         )))
-        .map_err(e)?;
+        .map_err(area_error)?;
     for &(x, c) in &panel.vlines {
         chart
             .draw_series(std::iter::once(PathElement::new(
                 vec![(x, y0), (x, y1)],
                 c.color().stroke_width(2),
             )))
-            .map_err(e)?;
+            .map_err(area_error)?;
     }
     for &(y, c) in &panel.hlines {
         chart
@@ -538,119 +585,144 @@ fn draw_panel<DB: DrawingBackend>(
                 vec![(x0, y), (x1, y)],
                 c.color().stroke_width(2),
             )))
-            .map_err(e)?;
-    }
-    let inside = |&(x, y): &(f64, f64)| x.is_finite() && y.is_finite();
-    for s in &panel.series {
-        let color = s.color.color();
-        let anno = match s.mark {
-            Mark::Line { width } => {
-                // Break the line at non-finite points.
-                let mut segments: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
-                for p in &s.points {
-                    if inside(p) {
-                        if let Some(last) = segments.last_mut() {
-                            last.push(*p);
-                        }
-                    } else if segments.last().is_some_and(|l| !l.is_empty()) {
-                        segments.push(Vec::new());
-                    }
-                }
-                let style = color.stroke_width(width.max(1));
-                let anno = chart
-                    .draw_series(
-                        segments
-                            .into_iter()
-                            .filter(|s| !s.is_empty())
-                            .map(|seg| PathElement::new(seg, style)),
-                    )
-                    .map_err(e)?;
-                Some((anno, 0u8))
-            }
-            Mark::Dots { radius } => {
-                let pts = s.points.iter().copied().filter(|p| inside(p));
-                let anno = if radius < 1.0 {
-                    chart
-                        .draw_series(pts.map(|p| Pixel::new(p, color)))
-                        .map_err(e)?
-                } else if radius < 2.0 {
-                    // Small dots as filled squares of side round(2r) px: crisper than
-                    // rasterized circles, which come out as crosses at this size.
-                    let side = (2.0 * radius).round() as i32;
-                    let lo = -(side / 2);
-                    let hi = lo + side;
-                    chart
-                        .draw_series(pts.map(|p| {
-                            EmptyElement::at(p)
-                                + Rectangle::new([(lo, lo), (hi, hi)], color.filled())
-                        }))
-                        .map_err(e)?
-                } else {
-                    chart
-                        .draw_series(pts.map(|p| Circle::new(p, radius, color.filled())))
-                        .map_err(e)?
-                };
-                Some((anno, 1u8))
-            }
-            Mark::Stems { width } => {
-                let style = color.stroke_width(width.max(1));
-                let anno = chart
-                    .draw_series(
-                        s.points
-                            .iter()
-                            .copied()
-                            .filter(|p| inside(p))
-                            .map(|(x, y)| PathElement::new(vec![(x, 0.0), (x, y)], style)),
-                    )
-                    .map_err(e)?;
-                Some((anno, 0u8))
-            }
-            Mark::Bars { width } => {
-                let anno =
-                    chart
-                        .draw_series(s.points.iter().copied().filter(|p| inside(p)).map(
-                            |(x, y)| {
-                                Rectangle::new(
-                                    [(x - 0.5 * width, 0.0), (x + 0.5 * width, y)],
-                                    color.filled(),
-                                )
-                            },
-                        ))
-                        .map_err(e)?;
-                Some((anno, 2u8))
-            }
-        };
-        if let (Some(label), Some((anno, kind))) = (&s.label, anno) {
-            let anno = anno.label(label.as_str());
-            match kind {
-                1 => anno.legend(move |(x, y)| Circle::new((x + 10, y), 4, color.filled())),
-                2 => anno.legend(move |(x, y)| {
-                    Rectangle::new([(x + 4, y - 5), (x + 16, y + 5)], color.filled())
-                }),
-                _ => anno.legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
-                }),
-            };
-        }
-    }
-    if let Some(pos) = panel.legend {
-        if panel.series.iter().any(|s| s.label.is_some()) {
-            chart
-                .configure_series_labels()
-                .position(match pos {
-                    Legend::UpperLeft => SeriesLabelPosition::UpperLeft,
-                    Legend::UpperRight => SeriesLabelPosition::UpperRight,
-                    Legend::LowerLeft => SeriesLabelPosition::LowerLeft,
-                    Legend::LowerRight => SeriesLabelPosition::LowerRight,
-                })
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .label_font((FAMILY, 15).into_font())
-                .draw()
-                .map_err(e)?;
-        }
+            .map_err(area_error)?;
     }
     Ok(())
+}
+
+/// One series in its mark, with its legend entry if it has a label.
+fn draw_one_series<DB: DrawingBackend>(
+    chart: &mut Chart<'_, DB>,
+    s: &Series,
+) -> std::result::Result<(), String> {
+    let color = s.color.color();
+    let (anno, glyph) = draw_marks(chart, s)?;
+    if let Some(label) = &s.label {
+        let anno = anno.label(label.as_str());
+        match glyph {
+            Glyph::Dot => anno.legend(move |(x, y)| Circle::new((x + 10, y), 4, color.filled())),
+            Glyph::Bar => anno.legend(move |(x, y)| {
+                Rectangle::new([(x + 4, y - 5), (x + 16, y + 5)], color.filled())
+            }),
+            Glyph::Line => anno.legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
+            }),
+        };
+    }
+    Ok(())
+}
+
+/// Draws the finite points of a series in its mark; returns the series' annotation and
+/// its legend glyph.
+fn draw_marks<'a, 'c, DB: DrawingBackend>(
+    chart: &'c mut Chart<'a, DB>,
+    s: &Series,
+) -> std::result::Result<(&'c mut SeriesAnno<'a, DB>, Glyph), String> {
+    let color = s.color.color();
+    let points = s.points.iter().copied().filter(finite_point);
+    match s.mark {
+        Mark::Line { width } => {
+            let style = color.stroke_width(width.max(1));
+            let segments = line_segments(&s.points);
+            let anno = chart
+                .draw_series(segments.into_iter().map(|seg| PathElement::new(seg, style)))
+                .map_err(area_error)?;
+            Ok((anno, Glyph::Line))
+        }
+        Mark::Dots { radius } => Ok((draw_dots(chart, &s.points, radius, color)?, Glyph::Dot)),
+        Mark::Stems { width } => {
+            let style = color.stroke_width(width.max(1));
+            let anno = chart
+                .draw_series(points.map(|(x, y)| PathElement::new(vec![(x, 0.0), (x, y)], style)))
+                .map_err(area_error)?;
+            Ok((anno, Glyph::Line))
+        }
+        Mark::Bars { width } => {
+            let anno = chart
+                .draw_series(points.map(|(x, y)| {
+                    Rectangle::new(
+                        [(x - 0.5 * width, 0.0), (x + 0.5 * width, y)],
+                        color.filled(),
+                    )
+                }))
+                .map_err(area_error)?;
+            Ok((anno, Glyph::Bar))
+        }
+    }
+}
+
+/// The runs of finite points of a line (the line is broken at non-finite points), each
+/// non-empty.
+fn line_segments(points: &[(f64, f64)]) -> Vec<Vec<(f64, f64)>> {
+    let mut segments: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
+    for p in points {
+        if finite_point(p) {
+            if let Some(last) = segments.last_mut() {
+                last.push(*p);
+            }
+        } else if segments.last().is_some_and(|l| !l.is_empty()) {
+            segments.push(Vec::new());
+        }
+    }
+    segments.retain(|s| !s.is_empty());
+    segments
+}
+
+/// Dots of the given radius in pixels: single pixels below 1, squares of side
+/// `round(2r)` px below 2, circles above.
+fn draw_dots<'a, 'c, DB: DrawingBackend>(
+    chart: &'c mut Chart<'a, DB>,
+    points: &[(f64, f64)],
+    radius: f64,
+    color: RGBColor,
+) -> std::result::Result<&'c mut SeriesAnno<'a, DB>, String> {
+    let pts = points.iter().copied().filter(finite_point);
+    if radius < 1.0 {
+        chart
+            .draw_series(pts.map(|p| Pixel::new(p, color)))
+            .map_err(area_error)
+    } else if radius < 2.0 {
+        // Small dots as filled squares of side round(2r) px: crisper than
+        // rasterized circles, which come out as crosses at this size.
+        let side = (2.0 * radius).round() as i32;
+        let lo = -(side / 2);
+        let hi = lo + side;
+        chart
+            .draw_series(pts.map(|p| {
+                EmptyElement::at(p) + Rectangle::new([(lo, lo), (hi, hi)], color.filled())
+            }))
+            .map_err(area_error)
+    } else {
+        chart
+            .draw_series(pts.map(|p| Circle::new(p, radius, color.filled())))
+            .map_err(area_error)
+    }
+}
+
+/// The legend box, if the panel has one and a labelled series.
+fn draw_legend<'a, DB: DrawingBackend + 'a>(
+    chart: &mut Chart<'a, DB>,
+    panel: &Panel,
+) -> std::result::Result<(), String> {
+    let Some(pos) = panel.legend else {
+        return Ok(());
+    };
+    if !panel.series.iter().any(|s| s.label.is_some()) {
+        return Ok(());
+    }
+    chart
+        .configure_series_labels()
+        .position(match pos {
+            Legend::UpperLeft => SeriesLabelPosition::UpperLeft,
+            Legend::UpperRight => SeriesLabelPosition::UpperRight,
+            Legend::LowerLeft => SeriesLabelPosition::LowerLeft,
+            Legend::LowerRight => SeriesLabelPosition::LowerRight,
+        })
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font((FAMILY, 15).into_font())
+        .draw()
+        .map_err(area_error)
 }
 
 /// A tick label: short decimal form, no trailing zeros, scientific outside `[1e-3, 1e5)`.
@@ -932,6 +1004,25 @@ fn dashed(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn line_segments_break_at_non_finite_points() {
+        let nan = f64::NAN;
+        let pts = [
+            (nan, 0.0),
+            (0.0, 1.0),
+            (1.0, 2.0),
+            (2.0, f64::INFINITY),
+            (3.0, nan),
+            (4.0, 5.0),
+            (nan, nan),
+        ];
+        assert_eq!(
+            line_segments(&pts),
+            vec![vec![(0.0, 1.0), (1.0, 2.0)], vec![(4.0, 5.0)]]
+        );
+        assert!(line_segments(&[(nan, 1.0)]).is_empty());
+    }
 
     #[test]
     fn ranges_and_ticks() {

@@ -356,24 +356,8 @@ fn read_shard(
 ) -> Result<Vec<PointRecord>, StudyError> {
     let pp = dir.join(&m.points_file);
     let sp = dir.join(&m.sections_file);
-    let points = fs::read(&pp).map_err(|e| {
-        StudyError::MissingShards(format!(
-            "{} (listed in {}): {e}; re-run shard {}/{}",
-            pp.display(),
-            manifest_path.display(),
-            m.shard,
-            m.shards
-        ))
-    })?;
-    let sections = fs::read(&sp).map_err(|e| {
-        StudyError::MissingShards(format!(
-            "{} (listed in {}): {e}; re-run shard {}/{}",
-            sp.display(),
-            manifest_path.display(),
-            m.shard,
-            m.shards
-        ))
-    })?;
+    let points = read_listed(&pp, m, manifest_path)?;
+    let sections = read_listed(&sp, m, manifest_path)?;
     for (p, bytes, want) in [
         (&pp, &points, &m.points_fnv),
         (&sp, &sections, &m.sections_fnv),
@@ -390,71 +374,110 @@ fn read_shard(
             ));
         }
     }
-    let mut rd = csv::Reader::from_reader(points.as_slice());
-    let header = rd.headers().map_err(|e| corrupt(&pp, e))?.clone();
+    let records = parse_points(&pp, &points, &m.spec_hash)?;
+    attach_sections(&sp, &sections, records)
+}
+
+/// The bytes of a file listed in the manifest `m` (at `manifest_path`).
+fn read_listed(
+    path: &Path,
+    m: &ShardManifest,
+    manifest_path: &Path,
+) -> Result<Vec<u8>, StudyError> {
+    fs::read(path).map_err(|e| {
+        StudyError::MissingShards(format!(
+            "{} (listed in {}): {e}; re-run shard {}/{}",
+            path.display(),
+            manifest_path.display(),
+            m.shard,
+            m.shards
+        ))
+    })
+}
+
+/// The points file `pp` (its bytes `points`): each point with its number of kept sections
+/// (its `sections` still empty), every row of the study with hash `spec_hash`.
+fn parse_points(
+    pp: &Path,
+    points: &[u8],
+    spec_hash: &str,
+) -> Result<Vec<(PointRecord, usize)>, StudyError> {
+    let mut rd = csv::Reader::from_reader(points);
+    let header = rd.headers().map_err(|e| corrupt(pp, e))?.clone();
     if header.iter().ne(POINT_HEADER.iter().copied()) {
-        return Err(corrupt(&pp, "unexpected header"));
+        return Err(corrupt(pp, "unexpected header"));
     }
     let mut records = Vec::new();
     for (row, rec) in rd.records().enumerate() {
-        let rec = rec.map_err(|e| corrupt(&pp, e))?;
+        let rec = rec.map_err(|e| corrupt(pp, e))?;
         let f = |k: usize| rec.get(k).unwrap_or("");
-        if f(9) != m.spec_hash {
+        if f(9) != spec_hash {
             return Err(corrupt(
-                &pp,
+                pp,
                 format!("row {row}: spec hash {} differs", f(9)),
             ));
         }
-        let mut cells = Vec::new();
-        for c in f(8).split_whitespace() {
-            let (a, b) = c
-                .split_once(':')
-                .ok_or_else(|| corrupt(&pp, format!("row {row}: cell {c:?}")))?;
-            let a: i64 = a
-                .parse()
-                .map_err(|_| corrupt(&pp, format!("row {row}: cell {c:?}")))?;
-            let b: i64 = b
-                .parse()
-                .map_err(|_| corrupt(&pp, format!("row {row}: cell {c:?}")))?;
-            cells.push((a, b));
-        }
-        let kept = parse_usize(&pp, row, "kept_sections", f(7))?;
+        let cells = parse_cells(pp, row, f(8))?;
+        let kept = parse_usize(pp, row, "kept_sections", f(7))?;
         records.push((
             PointRecord {
-                index: parse_usize(&pp, row, "index", f(0))?,
+                index: parse_usize(pp, row, "index", f(0))?,
                 status: f(1).to_string(),
-                period: parse_usize(&pp, row, "period", f(2))?,
-                impacts_per_period: parse_f64(&pp, row, "impacts_per_period", f(3))?,
-                tle: parse_f64(&pp, row, "tle", f(4))?,
-                tle_spread: parse_f64(&pp, row, "tle_spread", f(5))?,
-                q: parse_f64(&pp, row, "q", f(6))?,
+                period: parse_usize(pp, row, "period", f(2))?,
+                impacts_per_period: parse_f64(pp, row, "impacts_per_period", f(3))?,
+                tle: parse_f64(pp, row, "tle", f(4))?,
+                tle_spread: parse_f64(pp, row, "tle_spread", f(5))?,
+                q: parse_f64(pp, row, "q", f(6))?,
                 sections: Vec::with_capacity(kept),
                 cells,
             },
             kept,
         ));
     }
+    Ok(records)
+}
+
+/// The cells `a:b` (separated by white space) of row `row` of the points file `pp`.
+fn parse_cells(pp: &Path, row: usize, text: &str) -> Result<Vec<(i64, i64)>, StudyError> {
+    let mut cells = Vec::new();
+    for c in text.split_whitespace() {
+        let bad = || corrupt(pp, format!("row {row}: cell {c:?}"));
+        let (a, b) = c.split_once(':').ok_or_else(bad)?;
+        let a: i64 = a.parse().map_err(|_| bad())?;
+        let b: i64 = b.parse().map_err(|_| bad())?;
+        cells.push((a, b));
+    }
+    Ok(cells)
+}
+
+/// Appends the sections file `sp` (its bytes `sections`) to the points of `records`; each
+/// point must get exactly its number of kept sections.
+fn attach_sections(
+    sp: &Path,
+    sections: &[u8],
+    mut records: Vec<(PointRecord, usize)>,
+) -> Result<Vec<PointRecord>, StudyError> {
     let mut pos: BTreeMap<usize, usize> = BTreeMap::new();
     for (k, (r, _)) in records.iter().enumerate() {
         pos.insert(r.index, k);
     }
-    let mut rd = csv::Reader::from_reader(sections.as_slice());
+    let mut rd = csv::Reader::from_reader(sections);
     for (row, rec) in rd.records().enumerate() {
-        let rec = rec.map_err(|e| corrupt(&sp, e))?;
+        let rec = rec.map_err(|e| corrupt(sp, e))?;
         let f = |k: usize| rec.get(k).unwrap_or("");
-        let index = parse_usize(&sp, row, "index", f(0))?;
+        let index = parse_usize(sp, row, "index", f(0))?;
         let k = *pos
             .get(&index)
-            .ok_or_else(|| corrupt(&sp, format!("row {row}: point {index} is not in the shard")))?;
-        let x = parse_f64(&sp, row, "x", f(2))?;
-        let v = parse_f64(&sp, row, "v", f(3))?;
+            .ok_or_else(|| corrupt(sp, format!("row {row}: point {index} is not in the shard")))?;
+        let x = parse_f64(sp, row, "x", f(2))?;
+        let v = parse_f64(sp, row, "v", f(3))?;
         records[k].0.sections.push([x, v]);
     }
     let mut out = Vec::with_capacity(records.len());
     for (r, kept) in records {
         if r.sections.len() != kept {
             return Err(corrupt(
-                &sp,
+                sp,
                 format!(
                     "point {}: {} sections, {kept} expected",
                     r.index,
@@ -477,6 +500,29 @@ fn read_shard(
 /// whose content hash differs from its manifest, or a shard whose points are not exactly
 /// its share (every index must appear exactly once).
 pub fn read_shards(dir: &Path) -> Result<(Study, Vec<PointRecord>), StudyError> {
+    let ms = read_manifests(dir)?;
+    check_consistent(&ms)?;
+    let (p0, m0) = &ms[0];
+    let study = embedded_study(p0, m0)?;
+    let n = m0.shards;
+    let by_index = index_shards(dir, ms, n)?;
+    let total = study.points();
+    let mut slots: Vec<Option<PointRecord>> = vec![None; total];
+    for (i, (p, m)) in &by_index {
+        let shard = Shard::new(*i, n)?;
+        place_shard(dir, p, m, shard, total, &mut slots)?;
+    }
+    let mut out = Vec::with_capacity(total);
+    for (i, s) in slots.into_iter().enumerate() {
+        out.push(s.ok_or_else(|| {
+            StudyError::MissingShards(format!("point {i} is in no shard of {}", dir.display()))
+        })?);
+    }
+    Ok((study, out))
+}
+
+/// The manifests in `dir` (at least one), each readable and of the format [`SHARD_FORMAT`].
+fn read_manifests(dir: &Path) -> Result<Vec<(PathBuf, ShardManifest)>, StudyError> {
     let all = manifests(dir)?;
     if all.is_empty() {
         return Err(StudyError::MissingShards(format!(
@@ -495,6 +541,11 @@ pub fn read_shards(dir: &Path) -> Result<(Study, Vec<PointRecord>), StudyError> 
         }
         ms.push((p, m));
     }
+    Ok(ms)
+}
+
+/// Every manifest of the same crate version (this one), spec and shard count as the first.
+fn check_consistent(ms: &[(PathBuf, ShardManifest)]) -> Result<(), StudyError> {
     let (p0, m0) = &ms[0];
     for (p, m) in &ms[1..] {
         if m.crate_version != m0.crate_version {
@@ -532,18 +583,33 @@ pub fn read_shards(dir: &Path) -> Result<(Study, Vec<PointRecord>), StudyError> 
             env!("CARGO_PKG_VERSION")
         )));
     }
-    let study = Study::new(m0.spec.clone())?;
-    if study.hash() != m0.spec_hash {
+    Ok(())
+}
+
+/// The study of the spec embedded in manifest `m` (at `p`), which must hash to the
+/// manifest's spec hash.
+fn embedded_study(p: &Path, m: &ShardManifest) -> Result<Study, StudyError> {
+    let study = Study::new(m.spec.clone())?;
+    if study.hash() != m.spec_hash {
         return Err(corrupt(
-            p0,
+            p,
             format!(
                 "the embedded spec hashes to {}, the manifest says {}",
                 study.hash(),
-                m0.spec_hash
+                m.spec_hash
             ),
         ));
     }
-    let n = m0.shards;
+    Ok(study)
+}
+
+/// The manifests by shard index, each in the file named after its shard; every shard
+/// `1..=n` must be present.
+fn index_shards(
+    dir: &Path,
+    ms: Vec<(PathBuf, ShardManifest)>,
+    n: usize,
+) -> Result<BTreeMap<usize, (PathBuf, ShardManifest)>, StudyError> {
     let mut by_index: BTreeMap<usize, (PathBuf, ShardManifest)> = BTreeMap::new();
     for (p, m) in ms {
         let shard = Shard::new(m.shard, m.shards).map_err(|e| corrupt(&p, e))?;
@@ -568,78 +634,97 @@ pub fn read_shards(dir: &Path) -> Result<(Study, Vec<PointRecord>), StudyError> 
             missing.join(", ")
         )));
     }
-    let total = study.points();
-    let mut slots: Vec<Option<PointRecord>> = vec![None; total];
-    for (i, (p, m)) in &by_index {
-        let shard = Shard::new(*i, n)?;
-        let expected: Vec<usize> = shard_indices(total, shard).collect();
-        // The manifest's counts against the spec, then the points file against both: each
-        // message says which count is claimed and which was found.
-        if m.total_points != total {
+    Ok(by_index)
+}
+
+/// Reads the points of `shard` (manifest `m` at `p`) into their `slots`, after checking
+/// the manifest's counts against the spec's `total` and the points file against both:
+/// each message says which count is claimed and which was found.
+fn place_shard(
+    dir: &Path,
+    p: &Path,
+    m: &ShardManifest,
+    shard: Shard,
+    total: usize,
+    slots: &mut [Option<PointRecord>],
+) -> Result<(), StudyError> {
+    let expected: Vec<usize> = shard_indices(total, shard).collect();
+    check_manifest_counts(p, m, shard, total, expected.len())?;
+    let recs = read_shard(dir, m, p)?;
+    check_points_file(p, m, &recs)?;
+    for (r, &e) in recs.into_iter().zip(&expected) {
+        if r.index != e {
             return Err(corrupt(
                 p,
-                format!(
-                    "the manifest claims a study of {} points, its spec has {total}",
-                    m.total_points
-                ),
+                format!("point {} where point {e} was expected", r.index),
             ));
         }
-        if m.points != expected.len() {
-            return Err(corrupt(
-                p,
-                format!(
-                    "the manifest claims {} points, shard {shard} of a study of {total} points \
-                     has {}",
-                    m.points,
-                    expected.len()
-                ),
-            ));
+        let slot = slots
+            .get_mut(e)
+            .ok_or_else(|| corrupt(p, format!("point {e} outside the grid")))?;
+        if slot.is_some() {
+            return Err(corrupt(p, format!("point {e} appears twice")));
         }
-        let recs = read_shard(dir, m, p)?;
-        if recs.len() != m.points {
-            return Err(corrupt(
-                p,
-                format!(
-                    "the manifest claims {} points, its points file {} holds {}",
-                    m.points,
-                    m.points_file,
-                    recs.len()
-                ),
-            ));
-        }
-        let failed = recs.iter().filter(|r| !r.is_ok()).count();
-        if failed != m.failed_points {
-            return Err(corrupt(
-                p,
-                format!(
-                    "the manifest claims {} failed points, its points file {} holds {failed}",
-                    m.failed_points, m.points_file
-                ),
-            ));
-        }
-        for (r, &e) in recs.into_iter().zip(&expected) {
-            if r.index != e {
-                return Err(corrupt(
-                    p,
-                    format!("point {} where point {e} was expected", r.index),
-                ));
-            }
-            let slot = slots
-                .get_mut(e)
-                .ok_or_else(|| corrupt(p, format!("point {e} outside the grid")))?;
-            if slot.is_some() {
-                return Err(corrupt(p, format!("point {e} appears twice")));
-            }
-            *slot = Some(r);
-        }
+        *slot = Some(r);
     }
-    let mut out = Vec::with_capacity(total);
-    for (i, s) in slots.into_iter().enumerate() {
-        out.push(s.ok_or_else(|| {
-            StudyError::MissingShards(format!("point {i} is in no shard of {}", dir.display()))
-        })?);
+    Ok(())
+}
+
+/// The manifest's study size and point count against the spec's `total` and the shard's
+/// share `expected` of it.
+fn check_manifest_counts(
+    p: &Path,
+    m: &ShardManifest,
+    shard: Shard,
+    total: usize,
+    expected: usize,
+) -> Result<(), StudyError> {
+    if m.total_points != total {
+        return Err(corrupt(
+            p,
+            format!(
+                "the manifest claims a study of {} points, its spec has {total}",
+                m.total_points
+            ),
+        ));
     }
-    Ok((study, out))
+    if m.points != expected {
+        return Err(corrupt(
+            p,
+            format!(
+                "the manifest claims {} points, shard {shard} of a study of {total} points \
+                 has {expected}",
+                m.points
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The points read from the points file against the manifest's point and failure counts.
+fn check_points_file(p: &Path, m: &ShardManifest, recs: &[PointRecord]) -> Result<(), StudyError> {
+    if recs.len() != m.points {
+        return Err(corrupt(
+            p,
+            format!(
+                "the manifest claims {} points, its points file {} holds {}",
+                m.points,
+                m.points_file,
+                recs.len()
+            ),
+        ));
+    }
+    let failed = recs.iter().filter(|r| !r.is_ok()).count();
+    if failed != m.failed_points {
+        return Err(corrupt(
+            p,
+            format!(
+                "the manifest claims {} failed points, its points file {} holds {failed}",
+                m.failed_points, m.points_file
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// The indices of `shard`: `i ≡ shard.index() − 1 (mod shard.count())`, ascending

@@ -332,6 +332,54 @@ impl StudySpec {
     /// # Errors
     /// [`StudyError::InvalidSpec`].
     pub fn validate(&self) -> Result<(), StudyError> {
+        self.validate_name()?;
+        let kind = ModelKind::parse(&self.system.model)?;
+        self.validate_system(kind)?;
+        let axes = self.axes();
+        self.validate_grid(kind, &axes)?;
+        self.validate_initial()?;
+        self.validate_integration()?;
+        self.validate_periods()?;
+        self.validate_record()?;
+        self.validate_attractors()?;
+        self.validate_axis_models(kind, &axes)
+    }
+
+    /// The number of grid points.
+    pub fn points(&self) -> usize {
+        self.grid.x.points * self.grid.y.as_ref().map_or(1, |y| y.points)
+    }
+
+    /// The canonical text of the spec (JSON with every default filled in and parameters
+    /// sorted by name): two specs with the same canonical text describe the same study,
+    /// whatever their TOML layout.
+    ///
+    /// # Errors
+    /// [`StudyError::Io`] if serialization fails (it does not for a validated spec).
+    pub fn canonical(&self) -> Result<String, StudyError> {
+        serde_json::to_string(self).map_err(|e| StudyError::Io(e.to_string()))
+    }
+
+    /// The spec hash: 64-bit FNV-1a of the canonical text and the crate version, as 16 hex
+    /// digits. Stable across runs, machines and thread counts (unlike std's `DefaultHasher`,
+    /// which is randomly keyed per process).
+    ///
+    /// # Errors
+    /// As [`canonical`](Self::canonical).
+    pub fn hash(&self) -> Result<String, StudyError> {
+        let text = format!(
+            "nonsmooth {}\n{}",
+            env!("CARGO_PKG_VERSION"),
+            self.canonical()?
+        );
+        Ok(format!("{:016x}", fnv1a(text.as_bytes())))
+    }
+}
+
+// The checks of `StudySpec::validate`, one per section of the spec, in the order it runs them
+// (so that the error names the first invalid field).
+impl StudySpec {
+    fn validate_name(&self) -> Result<(), StudyError> {
         if self.name.is_empty()
             || !self
                 .name
@@ -346,7 +394,11 @@ impl StudySpec {
                 ),
             ));
         }
-        let kind = ModelKind::parse(&self.system.model)?;
+        Ok(())
+    }
+
+    /// The fixed parameters: known to the model and finite.
+    fn validate_system(&self, kind: ModelKind) -> Result<(), StudyError> {
         for (name, &v) in &self.system.parameters {
             if !kind.parameter_names().contains(&name.as_str()) {
                 return Err(invalid(
@@ -365,45 +417,23 @@ impl StudySpec {
                 ));
             }
         }
+        Ok(())
+    }
+
+    /// The grid's axes with their field names: `grid.x`, then `grid.y` if present.
+    fn axes(&self) -> Vec<(&'static str, &Axis)> {
         let mut axes = vec![("grid.x", &self.grid.x)];
         if let Some(y) = &self.grid.y {
             axes.push(("grid.y", y));
         }
-        for (field, a) in &axes {
-            let known =
-                a.is_initial_condition() || kind.parameter_names().contains(&a.parameter.as_str());
-            if !known {
-                return Err(invalid(
-                    format!("{field}.parameter"),
-                    format!(
-                        "unknown parameter {:?} of model {:?}; known: {}, x0, v0",
-                        a.parameter,
-                        self.system.model,
-                        kind.parameter_names().join(", ")
-                    ),
-                ));
-            }
-            if a.points == 0 {
-                return Err(invalid(
-                    format!("{field}.points"),
-                    "the grid is empty: points must be >= 1",
-                ));
-            }
-            if !a.start.is_finite() {
-                return Err(invalid(format!("{field}.start"), "must be finite"));
-            }
-            if !a.end.is_finite() {
-                return Err(invalid(format!("{field}.end"), "must be finite"));
-            }
-            if a.points > 1 && !(a.end > a.start) {
-                return Err(invalid(
-                    format!("{field}.end"),
-                    format!(
-                        "must be > start ({}) for {} points (got {})",
-                        a.start, a.points, a.end
-                    ),
-                ));
-            }
+        axes
+    }
+
+    /// Each axis on its own, two distinct axes, the number of points, and the forcing
+    /// frequency given somewhere if the model needs one.
+    fn validate_grid(&self, kind: ModelKind, axes: &[(&str, &Axis)]) -> Result<(), StudyError> {
+        for (field, a) in axes {
+            self.validate_axis(kind, field, a)?;
         }
         if let Some(y) = &self.grid.y {
             if y.parameter == self.grid.x.parameter {
@@ -430,6 +460,49 @@ impl StudySpec {
                 "the forcing frequency must be given (here or as a grid axis)",
             ));
         }
+        Ok(())
+    }
+
+    /// One axis: a known parameter, at least one point, finite and increasing ends.
+    fn validate_axis(&self, kind: ModelKind, field: &str, a: &Axis) -> Result<(), StudyError> {
+        let known =
+            a.is_initial_condition() || kind.parameter_names().contains(&a.parameter.as_str());
+        if !known {
+            return Err(invalid(
+                format!("{field}.parameter"),
+                format!(
+                    "unknown parameter {:?} of model {:?}; known: {}, x0, v0",
+                    a.parameter,
+                    self.system.model,
+                    kind.parameter_names().join(", ")
+                ),
+            ));
+        }
+        if a.points == 0 {
+            return Err(invalid(
+                format!("{field}.points"),
+                "the grid is empty: points must be >= 1",
+            ));
+        }
+        if !a.start.is_finite() {
+            return Err(invalid(format!("{field}.start"), "must be finite"));
+        }
+        if !a.end.is_finite() {
+            return Err(invalid(format!("{field}.end"), "must be finite"));
+        }
+        if a.points > 1 && !(a.end > a.start) {
+            return Err(invalid(
+                format!("{field}.end"),
+                format!(
+                    "must be > start ({}) for {} points (got {})",
+                    a.start, a.points, a.end
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    fn validate_initial(&self) -> Result<(), StudyError> {
         if let Some(s) = self.initial.state {
             for (k, v) in s.iter().enumerate() {
                 if !v.is_finite() {
@@ -437,6 +510,10 @@ impl StudySpec {
                 }
             }
         }
+        Ok(())
+    }
+
+    fn validate_integration(&self) -> Result<(), StudyError> {
         positive_finite("integration.rtol", self.integration.rtol)?;
         if let Some(a) = self.integration.atol {
             positive_finite("integration.atol[0]", a[0])?;
@@ -445,6 +522,12 @@ impl StudySpec {
         if self.integration.max_steps == 0 {
             return Err(invalid("integration.max_steps", "must be >= 1"));
         }
+        Ok(())
+    }
+
+    /// The recorded periods, their total against [`MAX_PERIODS`], and the step cap against
+    /// the total.
+    fn validate_periods(&self) -> Result<(), StudyError> {
         if self.periods.record == 0 {
             return Err(invalid("periods.record", "must be >= 1"));
         }
@@ -477,48 +560,24 @@ impl StudySpec {
                 ),
             ));
         }
+        Ok(())
+    }
+
+    fn validate_record(&self) -> Result<(), StudyError> {
         positive_finite("record.period_tol", self.record.period_tol)?;
         if self.record.max_period == 0 {
             return Err(invalid("record.max_period", "must be >= 1"));
         }
         if let Some(l) = &self.record.lyapunov {
-            if l.periods < 10 {
-                return Err(invalid(
-                    "record.lyapunov.periods",
-                    format!(
-                        "must be >= 10 (the spread uses 10 blocks; got {})",
-                        l.periods
-                    ),
-                ));
-            }
-            if l.periods > crate::lyapunov::MAX_INTERVALS {
-                return Err(invalid(
-                    "record.lyapunov.periods",
-                    format!(
-                        "{} exceeds the limit of {} intervals of one estimate \
-                         (lyapunov::MAX_INTERVALS)",
-                        l.periods,
-                        crate::lyapunov::MAX_INTERVALS
-                    ),
-                ));
-            }
-            if let Some(d0) = l.d0 {
-                positive_finite("record.lyapunov.d0", d0)?;
-            }
+            validate_lyapunov(l)?;
         }
         if let Some(q) = &self.record.q {
-            if !(q.lo.is_finite() && q.hi.is_finite() && q.hi > q.lo) {
-                return Err(invalid(
-                    "record.q.hi",
-                    format!("must be finite and > lo (lo = {}, hi = {})", q.lo, q.hi),
-                ));
-            }
-            positive_finite("record.q.step", q.step)?;
-            // The histogram itself (bins at most `Histogram::MAX_BINS`, resolvable edges):
-            // otherwise every point's `q` would be NaN without a word.
-            crate::entropy::Histogram::<f64>::new(q.lo, q.hi, q.step)
-                .map_err(|e| invalid("record.q.step", e.to_string()))?;
+            validate_q(q)?;
         }
+        Ok(())
+    }
+
+    fn validate_attractors(&self) -> Result<(), StudyError> {
         if let Some(s) = self.attractors.scales {
             positive_finite("attractors.scales[0]", s[0])?;
             positive_finite("attractors.scales[1]", s[1])?;
@@ -531,11 +590,19 @@ impl StudySpec {
                 format!("must be in (0, 1] (got {})", self.attractors.overlap),
             ));
         }
-        // Every axis value must give a valid model, with the other axis at the base value
-        // (the fixed parameters or the model's default), so that an error names the axis
-        // at fault; a parameter without a default (the paper's `omega`) takes its axis start.
+        Ok(())
+    }
+
+    /// Every axis value must give a valid model, with the other axis at the base value
+    /// (the fixed parameters or the model's default), so that an error names the axis
+    /// at fault; a parameter without a default (the paper's `omega`) takes its axis start.
+    fn validate_axis_models(
+        &self,
+        kind: ModelKind,
+        axes: &[(&str, &Axis)],
+    ) -> Result<(), StudyError> {
         let set = ParameterSet::new(kind, &self.system.parameters);
-        for (field, a) in &axes {
+        for (field, a) in axes {
             for k in 0..a.points {
                 let v = a.value(k);
                 if !v.is_finite() {
@@ -550,7 +617,7 @@ impl StudySpec {
                 }
                 let mut p = set.clone();
                 let mut y0 = self.initial.state;
-                for (_, b) in &axes {
+                for (_, b) in axes {
                     if b.parameter == a.parameter {
                         apply_axis(&mut p, &mut y0, &b.parameter, v);
                     } else if b.parameter == "omega"
@@ -573,36 +640,50 @@ impl StudySpec {
         }
         Ok(())
     }
+}
 
-    /// The number of grid points.
-    pub fn points(&self) -> usize {
-        self.grid.x.points * self.grid.y.as_ref().map_or(1, |y| y.points)
+/// `record.lyapunov`: enough periods for the spread's blocks, no more than one estimate takes.
+fn validate_lyapunov(l: &LyapunovSpec) -> Result<(), StudyError> {
+    if l.periods < 10 {
+        return Err(invalid(
+            "record.lyapunov.periods",
+            format!(
+                "must be >= 10 (the spread uses 10 blocks; got {})",
+                l.periods
+            ),
+        ));
     }
+    if l.periods > crate::lyapunov::MAX_INTERVALS {
+        return Err(invalid(
+            "record.lyapunov.periods",
+            format!(
+                "{} exceeds the limit of {} intervals of one estimate \
+                 (lyapunov::MAX_INTERVALS)",
+                l.periods,
+                crate::lyapunov::MAX_INTERVALS
+            ),
+        ));
+    }
+    if let Some(d0) = l.d0 {
+        positive_finite("record.lyapunov.d0", d0)?;
+    }
+    Ok(())
+}
 
-    /// The canonical text of the spec (JSON with every default filled in and parameters
-    /// sorted by name): two specs with the same canonical text describe the same study,
-    /// whatever their TOML layout.
-    ///
-    /// # Errors
-    /// [`StudyError::Io`] if serialization fails (it does not for a validated spec).
-    pub fn canonical(&self) -> Result<String, StudyError> {
-        serde_json::to_string(self).map_err(|e| StudyError::Io(e.to_string()))
+/// `record.q`: a finite increasing range and a histogram that can be built on it.
+fn validate_q(q: &QSpec) -> Result<(), StudyError> {
+    if !(q.lo.is_finite() && q.hi.is_finite() && q.hi > q.lo) {
+        return Err(invalid(
+            "record.q.hi",
+            format!("must be finite and > lo (lo = {}, hi = {})", q.lo, q.hi),
+        ));
     }
-
-    /// The spec hash: 64-bit FNV-1a of the canonical text and the crate version, as 16 hex
-    /// digits. Stable across runs, machines and thread counts (unlike std's `DefaultHasher`,
-    /// which is randomly keyed per process).
-    ///
-    /// # Errors
-    /// As [`canonical`](Self::canonical).
-    pub fn hash(&self) -> Result<String, StudyError> {
-        let text = format!(
-            "nonsmooth {}\n{}",
-            env!("CARGO_PKG_VERSION"),
-            self.canonical()?
-        );
-        Ok(format!("{:016x}", fnv1a(text.as_bytes())))
-    }
+    positive_finite("record.q.step", q.step)?;
+    // The histogram itself (bins at most `Histogram::MAX_BINS`, resolvable edges):
+    // otherwise every point's `q` would be NaN without a word.
+    crate::entropy::Histogram::<f64>::new(q.lo, q.hi, q.step)
+        .map_err(|e| invalid("record.q.step", e.to_string()))?;
+    Ok(())
 }
 
 /// 64-bit FNV-1a.

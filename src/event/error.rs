@@ -1,0 +1,60 @@
+//! The errors of event functions, resets and the event loop.
+
+use thiserror::Error;
+
+/// Event errors.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum EventError {
+    /// Events accumulate (Zeno/chatter): their intervals shrank geometrically below the
+    /// guard's time floor. The simulation is left at the last event, so a caller can switch
+    /// model (e.g. to sticking) and continue from `t`, `state`.
+    #[error(
+        "{count} events with geometrically shrinking intervals, the last {last_interval} s, at t = {t}: accumulation of events (Zeno/chatter); the run was stopped there"
+    )]
+    Zeno {
+        /// Time of the last event.
+        t: f64,
+        /// Number of consecutive shrinking intervals (or events in the guard's window).
+        count: usize,
+        /// The last inter-event interval.
+        last_interval: f64,
+        /// The state after the last event (after its reset, if any), to restart from.
+        state: Vec<f64>,
+    },
+    /// After a reset the trajectory stayed on the far side of the surface and turned
+    /// deeper again instead of leaving it: the reset cannot separate it (the body sticks to
+    /// the surface, e.g. a ball caught by a table accelerating upwards). The simulation is
+    /// left at `t`, `state`; continue with a constrained (sticking) model.
+    #[error(
+        "event {index}: after its reset the trajectory turned back into the surface at t = {t} (depth {depth}): sticking; continue with a constrained model from this state"
+    )]
+    Sticking {
+        /// The event's index.
+        index: usize,
+        /// Time (a step end).
+        t: f64,
+        /// `|g|` there.
+        depth: f64,
+        /// The state there.
+        state: Vec<f64>,
+    },
+    /// An event or reset index outside the state vector.
+    #[error("event or reset index {index} out of range (state dimension {len})")]
+    IndexOutOfRange {
+        /// Index.
+        index: usize,
+        /// The state dimension.
+        len: usize,
+    },
+    /// An event function returned NaN or ±∞.
+    #[error("event function {index} is not finite (g = {value}) at t = {t}")]
+    NonFinite {
+        /// The event's index in the set.
+        index: usize,
+        /// Time.
+        t: f64,
+        /// The value.
+        value: f64,
+    },
+}

@@ -1,0 +1,67 @@
+//! Event functions `g(t, y)`: the trait, the index check of its implementations and the
+//! closure adapter.
+
+use nalgebra::SVector;
+
+use super::error::EventError;
+use crate::Real;
+
+/// A scalar function `g(t, y)` whose zeros are events.
+///
+/// ```
+/// use nalgebra::SVector;
+/// use nonsmooth::event::EventFunction;
+/// /// The energy surface E(y) = E0 of an oscillator.
+/// struct Energy(f64);
+/// impl EventFunction<f64, 2> for Energy {
+///     fn value(&self, _t: f64, y: &SVector<f64, 2>) -> f64 { 0.5 * (y[0] * y[0] + y[1] * y[1]) - self.0 }
+/// }
+/// ```
+pub trait EventFunction<T: Real, const N: usize> {
+    /// `g(t, y)`; must not mutate anything.
+    fn value(&self, t: T, y: &SVector<T, N>) -> T;
+
+    /// `dg/dt` along the trajectory, given `dy = f(t, y)`, if known. Enables grazing
+    /// detection from the step's end derivatives.
+    fn rate(&self, _t: T, _y: &SVector<T, N>, _dy: &SVector<T, N>) -> Option<T> {
+        None
+    }
+
+    /// The shortest time over which the function's explicit dependence on `t` can turn
+    /// around near `t` (e.g. a fraction of a moving surface's period), if it has one. While
+    /// the event is in a simulation, no step is longer than this, so that a moving surface
+    /// cannot be stepped over (see the module docs). Default: `None` (no explicit time
+    /// dependence).
+    fn time_scale(&self, _t: T) -> Option<T> {
+        None
+    }
+
+    /// Checks that the function can be evaluated on states of dimension `N` (e.g. that a
+    /// component index is in range); the driver calls it before a run starts. Default: `Ok`.
+    ///
+    /// # Errors
+    /// [`EventError::IndexOutOfRange`] for an index `≥ N`.
+    fn check(&self) -> Result<(), EventError> {
+        Ok(())
+    }
+}
+
+/// `Err(IndexOutOfRange)` unless `index < n` (for implementations of the `check` hooks).
+pub fn check_index(index: usize, n: usize) -> Result<(), EventError> {
+    if index < n {
+        Ok(())
+    } else {
+        Err(EventError::IndexOutOfRange { index, len: n })
+    }
+}
+
+/// An event function from a closure `g(t, y)` (no rate: use interior samples for grazing).
+#[derive(Debug, Clone, Copy)]
+pub struct FnEvent<F>(pub F);
+
+impl<T: Real, const N: usize, F: Fn(T, &SVector<T, N>) -> T> EventFunction<T, N> for FnEvent<F> {
+    #[inline(always)]
+    fn value(&self, t: T, y: &SVector<T, N>) -> T {
+        (self.0)(t, y)
+    }
+}
