@@ -4,7 +4,7 @@ use std::cell::Cell;
 
 use nonsmooth::identify::{
     IdentifyError, M2_TO_MM2, NelderMeadOptions, ParamValues, Parameter, ParameterSpace,
-    Termination, Transform, fit_nelder_mead, objective_f0, objective_f0_mm2,
+    FitTermination, Transform, fit_nelder_mead, objective_f0, objective_f0_mm2,
 };
 use nonsmooth::signal::{Location, SignalError, TimeSeries};
 
@@ -28,7 +28,7 @@ fn rosenbrock_in_named_parameters() {
         &NelderMeadOptions::default().with_tolerances(1e-10, 1e-16),
     )
     .unwrap();
-    assert_eq!(r.termination, Termination::Converged);
+    assert_eq!(r.termination, FitTermination::Converged);
     assert!((r.values["a"] - 1.0).abs() < 1e-6, "{}", r.values);
     assert!((r.values["b"] - 1.0).abs() < 1e-6, "{}", r.values);
     assert!(r.objective < 1e-12);
@@ -90,7 +90,7 @@ fn failing_region_is_avoided_not_fatal() {
         &NelderMeadOptions::default().with_tolerances(1e-10, 1e-14),
     )
     .unwrap();
-    assert_eq!(r.termination, Termination::Converged);
+    assert_eq!(r.termination, FitTermination::Converged);
     assert!((r.values["a"] - 1.9).abs() < 1e-6, "{}", r.values);
     assert!(r.values["b"].abs() < 1e-6);
     assert!(r.failed_evaluations > 0);
@@ -157,7 +157,7 @@ fn caps_target_and_restarts() {
         &NelderMeadOptions::default().with_max_iterations(10),
     )
     .unwrap();
-    assert_eq!(r.termination, Termination::MaxIterations);
+    assert_eq!(r.termination, FitTermination::MaxIterations);
     assert_eq!(r.iterations, 10);
     let r = fit_nelder_mead(
         &space,
@@ -165,7 +165,7 @@ fn caps_target_and_restarts() {
         &NelderMeadOptions::default().with_max_evaluations(30),
     )
     .unwrap();
-    assert_eq!(r.termination, Termination::MaxEvaluations);
+    assert_eq!(r.termination, FitTermination::MaxEvaluations);
     assert!(r.evaluations >= 30 && r.evaluations < 30 + 4);
     let r = fit_nelder_mead(
         &space,
@@ -173,7 +173,7 @@ fn caps_target_and_restarts() {
         &NelderMeadOptions::default().with_target(1e-3),
     )
     .unwrap();
-    assert_eq!(r.termination, Termination::TargetReached);
+    assert_eq!(r.termination, FitTermination::TargetReached);
     assert!(r.objective <= 1e-3);
     // Restarts stop as soon as one brings no improvement; the history covers every run.
     let r = fit_nelder_mead(
@@ -352,7 +352,7 @@ fn identification_recovers_a_damped_oscillation() {
         &NelderMeadOptions::default().with_tolerances(1e-8, 1e-12),
     )
     .unwrap();
-    assert_eq!(r.termination, Termination::Converged);
+    assert_eq!(r.termination, FitTermination::Converged);
     // The simulation's linear interpolation (h = 0.67 ms) biases F0 by O(h²), which moves
     // the optimum by far less than this.
     assert!(

@@ -152,18 +152,21 @@ fn equilibrium<T: Real, L: ForceLaw<T>, E: Excitation<T>>(
 ///
 /// # Examples
 /// ```
-/// use nonsmooth::analysis::LinearizedResponse;
-/// use nonsmooth::systems::paper::PAPER;
-/// let osc = PAPER.oscillator::<f64>(14.0)?;
-/// let x0 = PAPER.static_equilibrium()?;
-/// let lin = LinearizedResponse::new(&osc, x0, PAPER.c)?;
-/// let (a1, a2) = lin.coefficients(14.0);
-/// assert!((a1 - 4.2606e-6).abs() < 1e-10);   // paper, eq. (4)
-/// assert!((a2 + 4.7779e-10).abs() < 1e-14);  // paper, eq. (4)
-/// let w = lin.grazing_omega(PAPER.x_i, 10.0, 30.0)?;
-/// assert!((w - 15.657).abs() < 1e-3);        // paper: ω = 15.657 rad/s
+/// use nonsmooth::analysis::{AmplitudeLaw, LinearizedResponse};
+/// // ÿ + 0.2ẏ + 4y = sin ωt about X0 = 0: at ω = 1, Δ = k − mω² = 3 and
+/// // A1 = FΔ/((ωc)² + Δ²), A2 = −cFω/((ωc)² + Δ²).
+/// let lin = LinearizedResponse::from_parts(1.0, 4.0, 0.2, 0.0, AmplitudeLaw::Constant(1.0))?;
+/// let (a1, a2) = lin.coefficients(1.0);
+/// let d = 0.2_f64.powi(2) + 9.0;
+/// assert!((a1 - 3.0 / d).abs() < 1e-15 && (a2 + 0.2 / d).abs() < 1e-15);
+/// // The lower turning point X0 − A(ω) grazes a stop at −0.4 where A(ω) = 0.4.
+/// let w = lin.grazing_omega(-0.4, 0.5, 1.9)?;
+/// assert!((lin.amplitude(w) - 0.4).abs() < 1e-9);
 /// # Ok::<(), nonsmooth::Error>(())
 /// ```
+///
+/// The paper's numbers (its eq. (4) and the grazing at ω = 15.657 rad/s) are in
+/// [`systems::paper`](crate::systems::paper), "Results".
 ///
 /// # References
 /// The paper's Sect. 5, eq. (4) and the grazing estimate that follows it.
@@ -398,19 +401,8 @@ impl TurningPoint {
 /// Because $R$ stiffens strongly in contact and softens to $k$ out of contact, the two
 /// balances differ: the lower turning point sees the soft side, whence the earlier grazing.
 ///
-/// # Examples
-/// ```
-/// use nonsmooth::analysis::{AmplitudePhase, TurningPoint};
-/// use nonsmooth::systems::paper::PAPER;
-/// let osc = PAPER.oscillator::<f64>(14.0)?;
-/// let ap = AmplitudePhase::new(&osc, PAPER.static_equilibrium()?, PAPER.c)?;
-/// let s = ap.solve(14.0, TurningPoint::Upper)?;
-/// assert!((s.sin_coefficient() - 3.6833e-6).abs() < 1e-10);   // paper, eq. (6)
-/// assert!((s.cos_coefficient() + 3.5707e-10).abs() < 1e-14);  // paper, eq. (6)
-/// let w = ap.grazing_omega(PAPER.x_i, TurningPoint::Lower, 10.0, 14.0)?;
-/// assert!((w - 12.789).abs() < 1e-3);                        // paper: ω = 12.789
-/// # Ok::<(), nonsmooth::Error>(())
-/// ```
+/// The paper's numbers (its eq. (6) and the grazing at ω = 12.789 rad/s), computed with this
+/// type, are in [`systems::paper`](crate::systems::paper), "Results".
 ///
 /// # References
 /// The paper's Sect. 5, eqs. (5)–(6) and the grazing estimate after them; the method after

@@ -128,7 +128,7 @@ impl<T: Real> QRange<T> {
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct EntropyIndex<T> {
-    /// The entropy index `q*` (the paper finds 0.62 at `ω = 20.465`).
+    /// The entropy index `q*`.
     pub q: T,
     /// The maximal redundancy `R(q*)`.
     pub redundancy: T,

@@ -1,10 +1,10 @@
 //! Tsallis and Shannon entropy, redundancy, and the entropy index `q` of a sample.
 //!
-//! The paper (Sect. 4, "Statistical analysis", Figs. 6–7) characterizes a chaotic regime by
-//! the distribution of its inter-impact intervals `T_j`: the sample is arranged in a
-//! normalized histogram, empty bins are dropped, and the resulting probabilities `p_i`,
-//! `i = 1…N`, are described by the Tsallis entropy with the index `q` that maximizes the
-//! redundancy.
+//! A chaotic regime of an impact oscillator can be characterized by the distribution of its
+//! inter-impact intervals `T_j`: the sample is arranged in a normalized histogram, empty bins
+//! are dropped, and the resulting probabilities `p_i`, `i = 1…N`, are described by the
+//! Tsallis entropy with the index `q` that maximizes the redundancy (the paper's values are
+//! in [`systems::paper`](crate::systems::paper), "Results").
 //!
 //! As in DynamicalSystems.jl / ComplexityMeasures.jl, the *definition* of an entropy is kept
 //! apart from how the probabilities are *estimated*:
@@ -52,11 +52,9 @@
 //!
 //! ## Interpretation
 //! `q* < 1` means that rare events weigh in the distribution (many improbable states affect
-//! the behaviour); `q* > 1` means the frequent events dominate. The paper finds `q* = 0.62` at
-//! `ω = 20.465 rad/s` (histogram on `(0.05, 0.3)` s with step `0.001` s) and `q* < 1`,
-//! varying weakly, over the chaotic window `ω ∈ (20.433, 20.515)`, growing abruptly towards 1
-//! at its edges where the attractor becomes almost periodic. A strictly periodic regime fills
-//! a single bin (`N = 1`), for which `R` — and so `q*` — is undefined
+//! the behaviour); `q* > 1` means the frequent events dominate; `q*` growing towards 1 at
+//! the edge of a chaotic window marks an attractor that becomes almost periodic. A strictly
+//! periodic regime fills a single bin (`N = 1`), for which `R` — and so `q*` — is undefined
 //! ([`EntropyError::SingleState`]); equiprobable occupied bins (a periodic orbit sampled
 //! over whole periods) give `R ≡ 0` and no index either ([`EntropyError::Equiprobable`]).
 //!
@@ -80,7 +78,7 @@
 //!     })
 //!     .collect();
 //!
-//! // The paper's estimator: bins of 0.001 on [0.05, 0.3], empty bins dropped.
+//! // Bins of 0.001 on [0.05, 0.3], empty bins dropped.
 //! let hist = Histogram::new(0.05, 0.3, 0.001)?.estimate(&intervals)?;
 //! assert_eq!(hist.tally.below + hist.tally.above, 0);
 //! let index = entropy_index(&hist.probabilities, &QRange::default())?;
@@ -89,7 +87,6 @@
 //! ```
 //!
 //! # References
-//! - The paper, Sect. 4, the formulas for `S_T`, `S_T,max` and `R_T`; Figs. 6–7.
 //! - C. Tsallis, *Possible generalization of Boltzmann–Gibbs statistics*, J. Stat. Phys. 52
 //!   (1988) 479–487 (the entropy `S_q`).
 //! - E. T. Jaynes, *Information theory and statistical mechanics*, Phys. Rev. 106 (1957)

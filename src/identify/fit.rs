@@ -142,7 +142,7 @@ impl NelderMeadOptions {
 /// Why the search stopped.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[non_exhaustive]
-pub enum Termination {
+pub enum FitTermination {
     /// Both tolerances were met.
     Converged,
     /// The iteration cap was reached.
@@ -153,13 +153,13 @@ pub enum Termination {
     TargetReached,
 }
 
-impl std::fmt::Display for Termination {
+impl std::fmt::Display for FitTermination {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(match self {
-            Termination::Converged => "converged",
-            Termination::MaxIterations => "maximum number of iterations reached",
-            Termination::MaxEvaluations => "maximum number of objective evaluations reached",
-            Termination::TargetReached => "target objective reached",
+            FitTermination::Converged => "converged",
+            FitTermination::MaxIterations => "maximum number of iterations reached",
+            FitTermination::MaxEvaluations => "maximum number of objective evaluations reached",
+            FitTermination::TargetReached => "target objective reached",
         })
     }
 }
@@ -188,7 +188,7 @@ pub struct FitReport {
     /// iteration (so `history.len() == iterations + runs`; non-increasing).
     pub history: Vec<f64>,
     /// Why the last run stopped.
-    pub termination: Termination,
+    pub termination: FitTermination,
 }
 
 /// The objective in unconstrained coordinates with failure handling and book-keeping.
@@ -355,16 +355,16 @@ where
         history.push(simplex[0].f);
         termination = loop {
             if converged(&simplex, &steps, options.x_tolerance, f_tol) {
-                break Termination::Converged;
+                break FitTermination::Converged;
             }
             if simplex[0].f <= target {
-                break Termination::TargetReached;
+                break FitTermination::TargetReached;
             }
             if iterations >= max_iterations {
-                break Termination::MaxIterations;
+                break FitTermination::MaxIterations;
             }
             if ev.evaluations >= max_evaluations {
-                break Termination::MaxEvaluations;
+                break FitTermination::MaxEvaluations;
             }
             iterate(&mut simplex, &mut ev);
             iterations += 1;
@@ -373,7 +373,7 @@ where
         // The previous best stays in the simplex (shrinks keep vertex 0), so this is ≤ it.
         best = simplex[0].clone();
         let improved = best.f < best_before;
-        if termination != Termination::Converged
+        if termination != FitTermination::Converged
             || runs > options.restarts
             || (runs > 1 && !improved)
         {
@@ -523,7 +523,7 @@ mod tests {
         )
         .unwrap();
         assert!((r.values["a"] - 0.3).abs() < 1e-6, "{}", r.values);
-        assert_eq!(r.termination, Termination::Converged);
+        assert_eq!(r.termination, FitTermination::Converged);
         assert_eq!(r.runs, 1);
         assert_eq!(r.history.len() as u64, r.iterations + 1);
         assert!(r.history.windows(2).all(|w| w[1] <= w[0]));

@@ -18,7 +18,40 @@
 //! - the synthetic experiment ([`SyntheticExperiment`] under a [`Forcing`]), a
 //!   configuration of [`ModelExperiment`](crate::signal::ModelExperiment);
 //! - the identification ([`PaperFit`] over [`PAPER_FIT_PARAMETERS`]), a configuration of
-//!   [`ModelFit`](crate::identify::ModelFit).
+//!   [`ModelFit`](crate::identify::ModelFit);
+//! - the Lyapunov settings ([`lyapunov`]: the norm, `d0` and the diagram schedule).
+//!
+//! # Results
+//! The paper's statistical analysis (Sect. 4, Figs. 6–7) histograms the inter-impact
+//! intervals on `(0.05, 0.3)` s with bins of `0.001` s, drops empty bins and takes the
+//! Tsallis entropy index `q*` that maximizes the redundancy
+//! ([`entropy_index`](crate::entropy::entropy_index)): `q* = 0.62` at `ω = 20.465 rad/s`,
+//! and `q* < 1`, varying weakly, over the chaotic window `ω ∈ (20.433, 20.515)`, growing
+//! abruptly towards 1 at its edges where the attractor becomes almost periodic. The example
+//! `examples/paper/` reproduces it.
+//!
+//! The approximate solutions of its Sect. 5 ([`analysis`](crate::analysis)) at ω = 14 rad/s
+//! and the grazing frequencies they predict:
+//!
+//! ```
+//! use nonsmooth::analysis::{AmplitudePhase, LinearizedResponse, TurningPoint};
+//! use nonsmooth::systems::paper::PAPER;
+//! let osc = PAPER.oscillator::<f64>(14.0)?;
+//! let x0 = PAPER.static_equilibrium()?;
+//! let lin = LinearizedResponse::new(&osc, x0, PAPER.c)?;
+//! let (a1, a2) = lin.coefficients(14.0);
+//! assert!((a1 - 4.2606e-6).abs() < 1e-10);   // eq. (4)
+//! assert!((a2 + 4.7779e-10).abs() < 1e-14);  // eq. (4)
+//! let w = lin.grazing_omega(PAPER.x_i, 10.0, 30.0)?;
+//! assert!((w - 15.657).abs() < 1e-3);        // ω = 15.657 rad/s
+//! let ap = AmplitudePhase::new(&osc, x0, PAPER.c)?;
+//! let s = ap.solve(14.0, TurningPoint::Upper)?;
+//! assert!((s.sin_coefficient() - 3.6833e-6).abs() < 1e-10);   // eq. (6)
+//! assert!((s.cos_coefficient() + 3.5707e-10).abs() < 1e-14);  // eq. (6)
+//! let w = ap.grazing_omega(PAPER.x_i, TurningPoint::Lower, 10.0, 14.0)?;
+//! assert!((w - 12.789).abs() < 1e-3);                        // ω = 12.789 rad/s
+//! # Ok::<(), nonsmooth::Error>(())
+//! ```
 //!
 //! Builders and single-layer helpers return that layer's error
 //! ([`SignalError`], [`IdentifyError`](crate::identify::IdentifyError)); what builds the
