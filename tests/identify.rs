@@ -3,8 +3,8 @@
 use std::cell::Cell;
 
 use nonsmooth::identify::{
-    IdentifyError, M2_TO_MM2, NelderMeadOptions, ParamValues, Parameter, ParameterSpace,
-    FitTermination, Transform, fit_nelder_mead, objective_f0, objective_f0_mm2,
+    FitTermination, IdentifyError, M2_TO_MM2, NelderMeadOptions, ParamValues, Parameter,
+    ParameterSpace, Transform, fit_nelder_mead, objective_f0, objective_f0_mm2,
 };
 use nonsmooth::signal::{Location, SignalError, TimeSeries};
 

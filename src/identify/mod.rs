@@ -47,7 +47,7 @@ mod model_fit;
 mod objective;
 mod space;
 
-pub use fit::{FitReport, NelderMeadOptions, FitTermination, fit_nelder_mead};
+pub use fit::{FitReport, FitTermination, NelderMeadOptions, fit_nelder_mead};
 pub use model_fit::ModelFit;
 pub(crate) use model_fit::{simulate_at_nodes, window_nodes};
 pub use objective::{M2_TO_MM2, objective_f0, objective_f0_mm2};
