@@ -83,3 +83,27 @@ pub enum ModeError {
         tolerance: f64,
     },
 }
+
+/// `From` the engine's errors (parameters, roots, models, integration, events, modes) for an
+/// instrument's error type with a `Run(RunError)` variant, so that `?` works inside it.
+macro_rules! from_engine_errors {
+    ($target:ty) => {
+        $crate::drive::from_engine_errors!(
+            @each $target,
+            $crate::validate::ParameterError,
+            $crate::roots::RootError,
+            $crate::model::ModelError,
+            $crate::integrate::IntegrateError,
+            $crate::event::EventError,
+            $crate::drive::ModeError
+        );
+    };
+    (@each $target:ty, $($err:ty),+) => {$(
+        impl From<$err> for $target {
+            fn from(e: $err) -> Self {
+                <$target>::Run(e.into())
+            }
+        }
+    )+};
+}
+pub(crate) use from_engine_errors;

@@ -30,6 +30,7 @@ pub mod modes;
 pub mod stick_slip;
 pub mod sticking;
 
+pub(crate) use error::from_engine_errors;
 pub use error::{ModeError, RunError};
 pub use modes::{ModeRun, ModeSystem, Segment, run_modes};
 pub use stick_slip::{Coulomb, SlipMode, StickSlip};

@@ -114,11 +114,8 @@ pub use two_trajectory::{
 use nalgebra::SVector;
 use thiserror::Error;
 
-use crate::drive::{ModeError, RunError};
-use crate::event::EventError;
+use crate::drive::RunError;
 use crate::integrate::{IntegrateError, Stats, Stepper};
-use crate::model::ModelError;
-use crate::roots::RootError;
 use crate::scalar::{lit, to_f64};
 use crate::validate::ParameterError;
 use crate::{Dynamics, Real};
@@ -270,23 +267,7 @@ pub enum LyapunovError {
 /// `Result` with [`LyapunovError`].
 pub(crate) type Result<T, E = LyapunovError> = std::result::Result<T, E>;
 
-macro_rules! via_run {
-    ($($err:ty),+) => {$(
-        impl From<$err> for LyapunovError {
-            fn from(e: $err) -> Self {
-                LyapunovError::Run(e.into())
-            }
-        }
-    )+};
-}
-via_run!(
-    ParameterError,
-    RootError,
-    ModelError,
-    IntegrateError,
-    EventError,
-    ModeError
-);
+crate::drive::from_engine_errors!(LyapunovError);
 
 /// Default number of blocks for the standard error.
 pub const DEFAULT_BLOCKS: usize = 10;

@@ -60,17 +60,14 @@
 use nalgebra::{Complex, DMatrix, SMatrix, SVector};
 
 use crate::Real;
+use crate::drive::RunError;
 use crate::drive::Simulation;
-use crate::drive::{ModeError, RunError};
 use crate::dynamics::Dynamics;
-use crate::event::{EventError, EventSet};
-use crate::integrate::{Dopri5, IntegrateError, Tolerances};
+use crate::event::EventSet;
+use crate::integrate::{Dopri5, Tolerances};
 use crate::linalg::Lu;
 use crate::lyapunov::{LyapunovError, Norm, Saltation, Variational};
-use crate::model::ModelError;
-use crate::roots::RootError;
 use crate::scalar::{lit, to_f64};
-use crate::validate::ParameterError;
 
 pub mod continuation;
 
@@ -129,23 +126,7 @@ pub enum OrbitError {
 /// `Result` with [`OrbitError`].
 pub(crate) type Result<T, E = OrbitError> = std::result::Result<T, E>;
 
-macro_rules! via_run {
-    ($($err:ty),+) => {$(
-        impl From<$err> for OrbitError {
-            fn from(e: $err) -> Self {
-                OrbitError::Run(e.into())
-            }
-        }
-    )+};
-}
-via_run!(
-    ParameterError,
-    RootError,
-    ModelError,
-    IntegrateError,
-    EventError,
-    ModeError
-);
+crate::drive::from_engine_errors!(OrbitError);
 
 /// A periodic orbit found by [`Shooting::find`].
 #[derive(Debug, Clone, PartialEq)]
