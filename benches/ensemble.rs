@@ -77,7 +77,7 @@ fn lanes_in<V: Lanes>(s: &Setup, math: LaneMath, simd: Simd) -> u64 {
         .with_math(math)
         .with_simd(simd);
     let mut obs = vec![(); s.jobs.len()];
-    e.run::<V, _>(&s.jobs, &mut obs)
+    e.run::<V, _, _>(&s.jobs, &mut obs)
         .unwrap()
         .into_iter()
         .map(|o| o.unwrap().stats.rhs_evals)

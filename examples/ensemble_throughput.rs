@@ -128,11 +128,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         Ok((obs, evals))
     };
     fn lanes<V: Lanes>(
-        e: &Ensemble<Stop<f64>>,
+        e: &Ensemble<Event<Stop<f64>>>,
         jobs: &[MemberRun],
         obs: &mut [Collect],
     ) -> nonsmooth::Result<()> {
-        for r in e.run::<V, _>(jobs, obs)? {
+        for r in e.run::<V, _, _>(jobs, obs)? {
             r?;
         }
         Ok(())

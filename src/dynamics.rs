@@ -3,6 +3,7 @@
 use nalgebra::{SMatrix, SVector};
 
 use crate::Real;
+use crate::lanes::{LaneMath, Lanes};
 
 /// A first-order system `ẏ = f(t, y)` of dimension `N`.
 ///
@@ -96,5 +97,164 @@ impl<T: Real, const N: usize, D: Dynamics<T, N> + ?Sized> Dynamics<T, N> for &D 
     #[inline(always)]
     fn contact_onset(&self) -> Option<crate::force::ContactOnset<T>> {
         (**self).contact_onset()
+    }
+}
+
+/// The lane form of a system: its right-hand side evaluated for `L` trajectories at once,
+/// one per lane of a [`Lanes`] vector, each with its own parameters. The ensemble
+/// ([`ensemble`](crate::ensemble)) steps a `LaneDynamics` model in SIMD lanes.
+///
+/// The crate's models implement it when their parts have lane forms:
+/// [`Oscillator`](crate::model::Oscillator) with laws implementing
+/// [`LaneLaw`](crate::force::LaneLaw) and an excitation implementing
+/// [`LaneExcitation`](crate::excite::LaneExcitation), and
+/// [`Mechanical`](crate::model::Mechanical) with such elements and loads. Any other
+/// system runs in lanes through [`LaneByLane`], which evaluates its scalar `rhs` lane by
+/// lane.
+///
+/// # Contract
+/// [`rhs_lanes`](Self::rhs_lanes) must compute in every lane `i` the value of
+/// [`rhs`](Dynamics::rhs) for the model packed into lane `i`
+/// ([`pack_lane`](Self::pack_lane)), and may depend on nothing else (not on the other lanes,
+/// not on the lane count). With [`LaneMath::Exact`] the crate's lane forms perform the
+/// scalar operations in the scalar order, so each lane's value is the scalar value to the
+/// bit; the ensemble then reproduces the scalar driver step for step.
+///
+/// The evaluation is split in two: [`time_lanes`](Self::time_lanes) computes what depends
+/// on `t` alone (the loads), [`rhs_lanes`](Self::rhs_lanes) the rest, so two stages of a
+/// step at the same time (the last two of DOPRI5) share the loads.
+///
+/// [`LaneMath::Exact`]: crate::lanes::LaneMath::Exact
+pub trait LaneDynamics<const M: usize>: Dynamics<f64, M> + Clone {
+    /// The parameters of `L` models, one per lane.
+    type Packed<V: Lanes>: Clone + core::fmt::Debug + Send + Sync;
+    /// What [`time_lanes`](Self::time_lanes) computes.
+    type Time<V: Lanes>: Copy;
+
+    /// Every lane set to this model.
+    fn pack<V: Lanes>(&self) -> Self::Packed<V>;
+
+    /// Lane `lane` of `packed` set to this model (the other lanes unchanged).
+    fn pack_lane<V: Lanes>(&self, packed: &mut Self::Packed<V>, lane: usize);
+
+    /// Whether `other` can share lanes with `self`: the parts of a model that its lane
+    /// form takes from the model packed first (the structure, e.g. the coordinates of a
+    /// [`Mechanical`](crate::model::Mechanical) system) are the same. The ensemble runs
+    /// a trajectory whose model differs in structure from the first one's as an error in
+    /// its result slot. Default `true` (every part is per lane).
+    fn same_structure(&self, _other: &Self) -> bool {
+        true
+    }
+
+    /// The terms of the right-hand side that depend on the time only, in every lane.
+    fn time_lanes<V: Lanes>(packed: &Self::Packed<V>, math: LaneMath, t: V) -> Self::Time<V>;
+
+    /// `ẏ = f(t, y)` in every lane, with the time terms of `t` given.
+    fn rhs_lanes<V: Lanes>(
+        packed: &Self::Packed<V>,
+        math: LaneMath,
+        t: V,
+        time: &Self::Time<V>,
+        y: &[V; M],
+        dy: &mut [V; M],
+    );
+}
+
+/// Any [`Dynamics`] in lanes: [`LaneDynamics::rhs_lanes`] calls the system's scalar
+/// [`rhs`](Dynamics::rhs) once per lane.
+///
+/// This is the fallback for a system whose parts have no lane form (a user's own force law
+/// or right-hand side): the ensemble's stepping, error control and event handling still
+/// run in lanes, the right-hand side does not, so it is correct (each lane is the scalar
+/// path to the bit, whatever the math mode) and slower than a lane form — by how much
+/// depends on the share of the right-hand side in a step.
+///
+/// ```
+/// use nalgebra::SVector;
+/// use nonsmooth::lanes::{F64x4, LaneMath, Lanes};
+/// use nonsmooth::{Dynamics, LaneByLane, LaneDynamics};
+///
+/// #[derive(Clone)]
+/// struct Decay(f64);
+/// impl Dynamics<f64, 1> for Decay {
+///     fn rhs(&self, _t: f64, y: &SVector<f64, 1>, dy: &mut SVector<f64, 1>) {
+///         dy[0] = -self.0 * y[0];
+///     }
+/// }
+/// let m = LaneByLane(Decay(2.0));
+/// let p = m.pack::<F64x4>();
+/// let t = F64x4::splat(0.0);
+/// let time = LaneByLane::<Decay>::time_lanes(&p, LaneMath::Exact, t);
+/// let mut dy = [F64x4::splat(0.0)];
+/// LaneByLane::<Decay>::rhs_lanes(&p, LaneMath::Exact, t, &time, &[F64x4::splat(3.0)], &mut dy);
+/// assert_eq!(dy[0].lane(2), -6.0);
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LaneByLane<D>(pub D);
+
+impl<const M: usize, D: Dynamics<f64, M>> Dynamics<f64, M> for LaneByLane<D> {
+    #[inline(always)]
+    fn rhs(&self, t: f64, y: &SVector<f64, M>, dy: &mut SVector<f64, M>) {
+        self.0.rhs(t, y, dy)
+    }
+    fn jacobian(&self, t: f64, y: &SVector<f64, M>) -> Option<SMatrix<f64, M, M>> {
+        self.0.jacobian(t, y)
+    }
+    fn time_derivative(&self, t: f64, y: &SVector<f64, M>) -> Option<SVector<f64, M>> {
+        self.0.time_derivative(t, y)
+    }
+    fn time_scale(&self, t: f64) -> Option<f64> {
+        self.0.time_scale(t)
+    }
+    fn velocity_exponent(&self) -> Option<f64> {
+        self.0.velocity_exponent()
+    }
+    fn contact_onset(&self) -> Option<crate::force::ContactOnset<f64>> {
+        self.0.contact_onset()
+    }
+}
+
+impl<const M: usize, D> LaneDynamics<M> for LaneByLane<D>
+where
+    D: Dynamics<f64, M> + Clone + core::fmt::Debug + Send + Sync,
+{
+    /// One model per lane.
+    type Packed<V: Lanes> = Vec<D>;
+    type Time<V: Lanes> = ();
+
+    fn pack<V: Lanes>(&self) -> Vec<D> {
+        vec![self.0.clone(); V::LANES]
+    }
+
+    fn pack_lane<V: Lanes>(&self, packed: &mut Vec<D>, lane: usize) {
+        if let Some(m) = packed.get_mut(lane) {
+            *m = self.0.clone();
+        }
+    }
+
+    #[inline(always)]
+    fn time_lanes<V: Lanes>(_packed: &Vec<D>, _math: LaneMath, _t: V) {}
+
+    #[inline(always)]
+    fn rhs_lanes<V: Lanes>(
+        packed: &Vec<D>,
+        _math: LaneMath,
+        t: V,
+        _time: &(),
+        y: &[V; M],
+        dy: &mut [V; M],
+    ) {
+        let mut out = [[0.0f64; 16]; M];
+        for (i, model) in packed.iter().enumerate().take(V::LANES) {
+            let yi = SVector::<f64, M>::from_fn(|k, _| y[k].lane(i));
+            let mut di = SVector::<f64, M>::zeros();
+            model.rhs(t.lane(i), &yi, &mut di);
+            for k in 0..M {
+                out[k][i] = di[k];
+            }
+        }
+        for k in 0..M {
+            dy[k] = V::load(&out[k]);
+        }
     }
 }

@@ -6,6 +6,7 @@
 
 use crate::Real;
 use crate::fastmath;
+use crate::lanes::{LaneMath, Lanes};
 use crate::scalar::lit;
 use crate::validate::ParameterError;
 use crate::validate::{finite, non_negative, positive};
@@ -537,6 +538,117 @@ impl<T: Real> Excitation<T> for RampedRotor<T> {
     }
     fn angular_frequency(&self, t: T) -> Option<T> {
         Some(self.omega_at(t))
+    }
+}
+
+/// The lane form of an [`Excitation`]: `f(t)` of `L` excitations of the same type at once,
+/// one per lane, each with its own parameters (see [`LaneLaw`](crate::force::LaneLaw) for
+/// packing; the same contract: each lane is the scalar [`force`](Excitation::force) of
+/// the excitation packed into it, to the bit with
+/// [`LaneMath::Exact`](crate::lanes::LaneMath::Exact)).
+///
+/// Implemented by `()`, [`Constant`], [`Harmonic`], [`UnbalancedRotor`] (their `sin` is
+/// the lane form of the scalar `fastmath` kernel, [`lanes::math::sin`](crate::lanes::math::sin))
+/// and [`RampedRotor`] (evaluated lane by lane).
+pub trait LaneExcitation: Excitation<f64> {
+    /// The excitation's parameters in `L` lanes.
+    type Packed<V: Lanes>: Copy + core::fmt::Debug + Send + Sync;
+
+    /// Every lane set to this excitation.
+    fn pack<V: Lanes>(&self) -> Self::Packed<V>;
+
+    /// Lane `lane` of `packed` set to this excitation.
+    fn pack_lane<V: Lanes>(&self, packed: &mut Self::Packed<V>, lane: usize);
+
+    /// The force at `t` in every lane.
+    fn force_lanes<V: Lanes>(packed: &Self::Packed<V>, math: LaneMath, t: V) -> V;
+}
+
+/// [`saturate`] lane-wise.
+#[inline(always)]
+fn saturate_lanes<V: Lanes>(x: V) -> V {
+    let z = V::splat(0.0);
+    let max = V::splat(f64::MAX);
+    let out = x.gt(z).select(max, x.lt(z).select(-max, x));
+    x.finite().select(x, out)
+}
+
+impl LaneExcitation for () {
+    type Packed<V: Lanes> = ();
+    fn pack<V: Lanes>(&self) {}
+    fn pack_lane<V: Lanes>(&self, _packed: &mut (), _lane: usize) {}
+    #[inline(always)]
+    fn force_lanes<V: Lanes>(_packed: &(), _math: LaneMath, _t: V) -> V {
+        V::splat(0.0)
+    }
+}
+
+impl LaneExcitation for Constant<f64> {
+    type Packed<V: Lanes> = V;
+    fn pack<V: Lanes>(&self) -> V {
+        V::splat(self.value)
+    }
+    fn pack_lane<V: Lanes>(&self, p: &mut V, lane: usize) {
+        *p = p.with_lane(lane, self.value);
+    }
+    #[inline(always)]
+    fn force_lanes<V: Lanes>(p: &V, _math: LaneMath, _t: V) -> V {
+        *p
+    }
+}
+
+impl LaneExcitation for Harmonic<f64> {
+    /// `(F0, ω, φ0)` per lane.
+    type Packed<V: Lanes> = [V; 3];
+    fn pack<V: Lanes>(&self) -> [V; 3] {
+        [self.amplitude, self.omega, self.phase0].map(V::splat)
+    }
+    fn pack_lane<V: Lanes>(&self, p: &mut [V; 3], lane: usize) {
+        for (v, x) in p.iter_mut().zip([self.amplitude, self.omega, self.phase0]) {
+            *v = v.with_lane(lane, x);
+        }
+    }
+    #[inline(always)]
+    fn force_lanes<V: Lanes>(p: &[V; 3], _math: LaneMath, t: V) -> V {
+        p[0] * crate::lanes::math::sin(saturate_lanes(p[1] * t + p[2]))
+    }
+}
+
+impl LaneExcitation for UnbalancedRotor<f64> {
+    /// `(m0e·ω², ω)` per lane.
+    type Packed<V: Lanes> = [V; 2];
+    fn pack<V: Lanes>(&self) -> [V; 2] {
+        [self.amp, self.omega].map(V::splat)
+    }
+    fn pack_lane<V: Lanes>(&self, p: &mut [V; 2], lane: usize) {
+        p[0] = p[0].with_lane(lane, self.amp);
+        p[1] = p[1].with_lane(lane, self.omega);
+    }
+    #[inline(always)]
+    fn force_lanes<V: Lanes>(p: &[V; 2], _math: LaneMath, t: V) -> V {
+        p[0] * crate::lanes::math::sin(saturate_lanes(p[1] * t))
+    }
+}
+
+impl LaneExcitation for RampedRotor<f64> {
+    /// One rotor per lane (evaluated lane by lane: the ramp's saturation guards are
+    /// scalar code).
+    type Packed<V: Lanes> = [RampedRotor<f64>; 16];
+    fn pack<V: Lanes>(&self) -> [RampedRotor<f64>; 16] {
+        [*self; 16]
+    }
+    fn pack_lane<V: Lanes>(&self, p: &mut [RampedRotor<f64>; 16], lane: usize) {
+        if let Some(r) = p.get_mut(lane) {
+            *r = *self;
+        }
+    }
+    #[inline(always)]
+    fn force_lanes<V: Lanes>(p: &[RampedRotor<f64>; 16], _math: LaneMath, t: V) -> V {
+        let mut out = [0.0f64; 16];
+        for (i, (o, r)) in out.iter_mut().zip(p).enumerate().take(V::LANES) {
+            *o = r.force(t.lane(i));
+        }
+        V::load(&out)
     }
 }
 

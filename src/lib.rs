@@ -59,6 +59,7 @@ pub mod fastmath;
 pub mod force;
 pub mod identify;
 pub mod integrate;
+pub mod lanes;
 pub mod linalg;
 pub mod lyapunov;
 pub mod model;
@@ -78,7 +79,7 @@ pub mod systems;
 pub mod testing;
 pub(crate) mod validate;
 
-pub use dynamics::Dynamics;
+pub use dynamics::{Dynamics, LaneByLane, LaneDynamics};
 
 /// The README's code blocks, compiled and run as doctests.
 #[doc = include_str!("../README.md")]

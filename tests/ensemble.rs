@@ -6,10 +6,11 @@
 use nalgebra::Vector2;
 use nonsmooth::drive::{Control, EventRecord, Observer, Simulation};
 use nonsmooth::ensemble::{
-    Ensemble, F64x2, F64x4, F64x8, F64x16, LaneMath, Lanes, Member, MemberRun, math,
+    Ensemble, F64x2, F64x4, F64x8, F64x16, LaneMath, Lanes, Member, MemberRun,
 };
 use nonsmooth::event::{Direction, Event, Level, Stop};
 use nonsmooth::integrate::{Dopri5, Stats, Tolerances};
+use nonsmooth::lanes::math;
 use nonsmooth::sample::Stroboscopic;
 use nonsmooth::systems::paper::{PAPER, PaperParameters};
 
@@ -102,7 +103,7 @@ fn lanes<V: Lanes>(
         .with_event(impact())
         .unwrap()
         .with_math(math);
-    let out = ens.run::<V, _>(jobs, &mut recs).unwrap();
+    let out = ens.run::<V, _, _>(jobs, &mut recs).unwrap();
     recs.into_iter()
         .zip(out)
         .map(|(r, o)| {
@@ -339,7 +340,7 @@ fn events_in_lanes_are_located_like_the_scalar_ones() {
             .with_event(ev)
             .unwrap()
             .with_math(math);
-        ens.run::<F64x4, _>(&jobs, &mut recs).unwrap();
+        ens.run::<F64x4, _, _>(&jobs, &mut recs).unwrap();
         let mut n = 0;
         for (job, rec) in jobs.iter().zip(&recs) {
             let lin = Linear::new(job.member.omega());
@@ -422,7 +423,7 @@ fn results_do_not_depend_on_lanes_order_or_threads() {
                 .map(|j| Record::new(j.member.period()))
                 .collect();
             let out = pool
-                .install(|| ens.run_parallel::<F64x4, _>(&jobs, &mut recs, chunk))
+                .install(|| ens.run_parallel::<F64x4, _, _>(&jobs, &mut recs, chunk))
                 .unwrap();
             let got: Vec<_> = recs
                 .into_iter()
@@ -616,18 +617,18 @@ fn invalid_input_is_an_error() {
     );
     let jobs = paper_jobs(&[20.0, 21.0], 2.0);
     let mut one = vec![()];
-    assert!(ens.run::<F64x4, _>(&jobs, &mut one).is_err());
-    let mut terminal = impact();
-    terminal.terminal = true;
-    assert!(Ensemble::new(tol).unwrap().with_event(terminal).is_err());
+    assert!(ens.run::<F64x4, _, _>(&jobs, &mut one).is_err());
+    let mut bad = impact();
+    bad.function.position = 5;
+    assert!(Ensemble::new(tol).unwrap().with_event(bad).is_err());
     assert!(ens.clone().max_steps(0).is_err());
     // A step cap too small for a trajectory fails that trajectory only.
     let capped = ens.max_steps(50).unwrap();
     let short = [MemberRun::new(m, 0.0, rest(), 2e-5).unwrap(), jobs[0]];
     let mut obs = vec![(); 2];
-    let out = capped.run::<F64x4, _>(&jobs, &mut obs).unwrap();
+    let out = capped.run::<F64x4, _, _>(&jobs, &mut obs).unwrap();
     assert!(out.iter().all(|o| o.is_err()));
-    let out = capped.run::<F64x4, _>(&short, &mut obs).unwrap();
+    let out = capped.run::<F64x4, _, _>(&short, &mut obs).unwrap();
     assert!(out[0].is_ok() && out[1].is_err(), "{out:?}");
 }
 
@@ -654,7 +655,7 @@ fn run_records(jobs: Vec<MemberRun>) -> Vec<Result<Summary, String>> {
             .unwrap()
             .with_event(impact())
             .unwrap();
-        let out = ens.run::<F64x8, _>(&jobs, &mut recs).unwrap();
+        let out = ens.run::<F64x8, _, _>(&jobs, &mut recs).unwrap();
         recs.into_iter()
             .zip(out)
             .map(|(r, o)| {
@@ -711,6 +712,39 @@ fn an_invalid_trajectory_fails_alone() {
             assert!(g.is_err(), "trajectory {k}");
         } else {
             assert_eq!(g, b, "trajectory {k}");
+        }
+    }
+}
+
+/// A terminal event and a restarting event run in lanes as in the scalar driver: the
+/// terminal impact ends each trajectory at its first impact (same time and state to the
+/// bit, same termination and statistics); a restart at every impact gives the scalar
+/// run's end state and statistics.
+#[test]
+fn terminal_and_restarting_events_match_the_driver() {
+    use nonsmooth::drive::Termination;
+    let tol = tol(1e-8);
+    let jobs = paper_jobs(&[17.0, 19.0, 20.465, 22.0, 25.0], 10.0);
+    for restart in [false, true] {
+        let mut ev = impact();
+        ev.terminal = !restart;
+        ev.restart = restart;
+        let ens = Ensemble::new(tol).unwrap().with_event(ev).unwrap();
+        let mut obs = vec![(); jobs.len()];
+        let out = ens.run::<F64x4, _, _>(&jobs, &mut obs).unwrap();
+        for (j, o) in jobs.iter().zip(&out) {
+            let o = o.as_ref().unwrap();
+            let want = Simulation::new(*j.member.scalar(), Dopri5::new(tol))
+                .with_events(ev)
+                .landing_grid(j.grid)
+                .unwrap()
+                .run(j.t0, j.y0, j.t_end, &mut ())
+                .unwrap();
+            assert_eq!((o.t, o.y, o.stats), (want.t, want.y, want.stats));
+            assert_eq!(o.termination, want.termination);
+            if !restart {
+                assert_eq!(o.termination, Termination::TerminalEvent(0));
+            }
         }
     }
 }

@@ -150,13 +150,13 @@ fn every_instruction_set_gives_the_same_bits() {
             assert_eq!(e.simd(), simd);
             let mut obs = vec![(); jobs.len()];
             let a: Vec<_> = e
-                .run::<F64x4, _>(&jobs, &mut obs)
+                .run::<F64x4, _, _>(&jobs, &mut obs)
                 .unwrap()
                 .into_iter()
                 .map(|o| o.unwrap())
                 .collect();
             let b: Vec<_> = e
-                .run::<F64x8, _>(&jobs, &mut obs)
+                .run::<F64x8, _, _>(&jobs, &mut obs)
                 .unwrap()
                 .into_iter()
                 .map(|o| o.unwrap())

@@ -27,6 +27,7 @@ use nalgebra::SVector;
 
 mod error;
 pub mod modes;
+mod scan;
 pub mod stick_slip;
 pub mod sticking;
 
@@ -36,12 +37,13 @@ pub use modes::{ModeRun, ModeSystem, Segment, run_modes};
 pub use stick_slip::{Coulomb, SlipMode, StickSlip};
 pub use sticking::{Constrained, ContactMode, ModeLog, RigidContact, run_with_sticking};
 
-use crate::event::{Direction, EventError, EventHistory, EventSet, MAX_EVENTS, ZenoGuard, locate};
+use crate::event::{Direction, EventHistory, EventSet, MAX_EVENTS, ZenoGuard};
 use crate::integrate::{DenseOutput, IntegrateError, Stats, Stepper, check_state};
 use crate::scalar::{lit, to_f64};
 use crate::validate::ParameterError;
 use crate::{Dynamics, Real};
 use error::Result;
+pub(crate) use scan::{Scan, Sides, initial_sides};
 
 /// Whether a run goes on.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -477,40 +479,57 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
     /// [`Dynamics::time_scale`]).
     #[inline(always)]
     fn time_scale(&self, t: T) -> Option<T> {
-        match (self.events.max_step(t), self.system.time_scale(t)) {
-            (Some(a), Some(b)) => Some(a.min(b)),
-            (a, b) => a.or(b),
-        }
+        time_scale(&self.system, &self.events, t)
     }
 
     /// Fails at once when the run provably needs more steps than the cap: its span over the
     /// largest step it may take (the stepper's `h_max` or fixed step, the landing grid's
     /// spacing, the time scale of the events and the system).
     fn check_work(&self, t0: T, t_end: T) -> Result<()> {
-        let mut h = self.stepper.max_step();
-        if let Some((_, dt)) = self.grid {
-            h = Some(h.map_or(dt, |h| h.min(dt)));
+        check_work(
+            t0,
+            t_end,
+            self.stepper.max_step(),
+            self.grid,
+            |t| self.time_scale(t),
+            self.max_steps,
+        )
+    }
+
+    /// Each event's side at the current state, every event armed.
+    fn initial_sides(&self) -> Result<Sides> {
+        let (t, y) = self.stepper.current();
+        scan::initial_sides(&self.system, &self.events, t, y)
+    }
+
+    /// The events and observer calls of the step just taken ([`scan::Scan`]): the stepper
+    /// moves to where a reset, restart or stop at an event leaves the trajectory, and
+    /// counts the scan's work. Returns how the run ends, if it ends here.
+    fn scan_step<O: Observer<T, N>>(
+        &mut self,
+        sides: &mut Sides,
+        observer: &mut O,
+    ) -> Result<Option<Termination>> {
+        let mut work = Stats::default();
+        let mut restart = None;
+        let out = Scan {
+            system: &self.system,
+            events: &self.events,
+            zeno: &self.zeno,
+            event_tol: self.event_tol,
+            history: &mut self.history,
+            dense: self.stepper.dense(),
+            stats: &mut work,
+            restart: &mut restart,
         }
-        // The time scale bounds every step; the larger of its values at the two ends bounds
-        // it over the run when it changes monotonically (a ramp).
-        if let (Some(a), Some(b)) = (self.time_scale(t0), self.time_scale(t_end)) {
-            let s = a.max(b);
-            h = Some(h.map_or(s, |h| h.min(s)));
+        .scan_step(sides, observer);
+        let stats = self.stepper.stats_mut();
+        stats.events += work.events;
+        stats.rhs_evals += work.rhs_evals;
+        if let Some((t, y)) = restart {
+            self.stepper.reset_state(t, y);
         }
-        let Some(h) = h else { return Ok(()) };
-        let span = to_f64(t_end - t0);
-        let needed = span / to_f64(h);
-        // A margin of one step for the rounding of the last one.
-        if !(needed <= self.max_steps as f64 + 1.0) {
-            return Err(IntegrateError::WorkExceedsCap {
-                needed,
-                span,
-                h: to_f64(h),
-                max_steps: self.max_steps,
-            }
-            .into());
-        }
-        Ok(())
+        out
     }
 
     /// The driver's loop: a step to the next landing point, then the step's events and
@@ -532,13 +551,7 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
                 }
                 .into());
             }
-            let limit = landing_limit(t_now, t_end, self.grid);
-            // The time scales of the events (moving surfaces, mode conditions) and of the
-            // system (constrained modes) bound the step.
-            let limit = match self.time_scale(t_now) {
-                Some(h) => limit.min(t_now + h),
-                None => limit,
-            };
+            let limit = step_limit(t_now, t_end, self.grid, self.time_scale(t_now));
             self.stepper.step(&self.system, limit)?;
             steps += 1;
             if let Some(t) = self.scan_step(&mut sides, observer)? {
@@ -557,481 +570,70 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
         observer.on_finish(&out);
         Ok(out)
     }
-
-    /// Each event's side at the current state, every event armed.
-    fn initial_sides(&self) -> Result<Sides> {
-        let mut sides = Sides {
-            side: [0; MAX_EVENTS],
-            armed: [true; MAX_EVENTS],
-        };
-        let (t, y) = self.stepper.current();
-        let mut f = SVector::zeros();
-        let mut have_f = false;
-        for (i, s) in sides.side.iter_mut().enumerate().take(E::LEN) {
-            let g = self.events.value(i, t, y);
-            if !g.is_finite() {
-                return Err(non_finite(i, t, g));
-            }
-            *s = sign_of(g);
-            if *s == 0 {
-                // Start on the surface: it has not been crossed; the side is the one
-                // the trajectory moves to (from the rate, else from the first step).
-                if !have_f {
-                    self.system.rhs(t, y, &mut f);
-                    have_f = true;
-                }
-                if let Some(r) = self.events.rate(i, t, y, &f) {
-                    *s = sign_of(r);
-                }
-            }
-        }
-        Ok(sides)
-    }
-
-    /// The events and observer calls of the step just taken: its crossings in time order
-    /// ([`crossings`](Self::crossings)), the sticking check, then the observer's view of
-    /// the rest of the step. Returns how the run ends, if it ends here.
-    fn scan_step<O: Observer<T, N>>(
-        &mut self,
-        sides: &mut Sides,
-        observer: &mut O,
-    ) -> Result<Option<Termination>> {
-        let mut scan = self.start_scan(sides)?;
-        let (t_lo, y_lo) = match self.crossings(&mut scan, sides, observer)? {
-            Crossings::Through(t_lo, y_lo) => (t_lo, y_lo),
-            // The state was reset or cut at an event: the next step starts there.
-            Crossings::Cut => return Ok(None),
-            Crossings::End(t) => return Ok(Some(t)),
-        };
-        self.check_sticking(&scan, sides, t_lo, y_lo, observer)?;
-        let dense = self.stepper.dense();
-        let view = StepView {
-            t0: t_lo,
-            t1: scan.t1,
-            y0: y_lo,
-            y1: scan.y1,
-            dense,
-        };
-        let stop = observer.on_step(&view) == Control::Stop;
-        for (i, s) in sides.side.iter_mut().enumerate().take(E::LEN) {
-            if scan.g_end[i] != T::zero() {
-                *s = sign_of(scan.g_end[i]);
-            }
-        }
-        Ok(stop.then_some(Termination::ObserverStopped))
-    }
-
-    /// Every event's values and rates at both ends of the step and its first crossing.
-    fn start_scan(&self, sides: &mut Sides) -> Result<StepScan<T, N>> {
-        let dense = self.stepper.dense();
-        let (ts0, ts1) = dense.span();
-        let (y_start, y_end) = dense.endpoints();
-        let (f_start, f_end) = dense.end_derivatives();
-        let (y_start, y_end, f_start, f_end) = (*y_start, *y_end, *f_start, *f_end);
-        let mut scan = StepScan {
-            t0: ts0,
-            t1: ts1,
-            y0: y_start,
-            y1: y_end,
-            g_end: [T::zero(); MAX_EVENTS],
-            r_end: [None; MAX_EVENTS],
-            found: [None; MAX_EVENTS],
-        };
-        for i in 0..E::LEN {
-            let g0 = self.events.value(i, ts0, &y_start);
-            let ge = self.events.value(i, ts1, &y_end);
-            scan.g_end[i] = ge;
-            if !(g0.is_finite() && ge.is_finite()) {
-                let (t, g) = if g0.is_finite() { (ts1, ge) } else { (ts0, g0) };
-                return Err(non_finite(i, t, g));
-            }
-            if sides.side[i] == 0 {
-                // Started on the surface with no rate: the side is where it goes.
-                sides.side[i] = if ge != T::zero() { sign_of(ge) } else { 1 };
-            }
-            let st_g = if g0 == T::zero() {
-                signed_tiny(sides.side[i])
-            } else {
-                g0
-            };
-            let st_r = self.events.rate(i, ts0, &y_start, &f_start);
-            scan.r_end[i] = self.events.rate(i, ts1, &y_end, &f_end);
-            scan.found[i] = self.find_crossing(i, ts0, st_g, st_r, ts1, ge, scan.r_end[i]);
-        }
-        Ok(scan)
-    }
-
-    /// The step's crossings, earliest first: the observer's view up to each accepted one,
-    /// its record, its reset (which ends the step there), a restart, a terminal event or
-    /// an observer's stop. Returns where the step's last piece starts if it goes on to the
-    /// step's end.
-    fn crossings<O: Observer<T, N>>(
-        &mut self,
-        scan: &mut StepScan<T, N>,
-        sides: &mut Sides,
-        observer: &mut O,
-    ) -> Result<Crossings<T, N>> {
-        let n_ev = E::LEN;
-        let mut t_lo = scan.t0;
-        let mut y_lo = scan.y0;
-        loop {
-            let mut best: Option<(usize, Crossing<T>)> = None;
-            for (i, f) in scan.found.iter().enumerate().take(n_ev) {
-                if let Some(c) = f {
-                    if best.is_none_or(|(_, b)| c.t < b.t) {
-                        best = Some((i, *c));
-                    }
-                }
-            }
-            let Some((i, c)) = best else {
-                return Ok(Crossings::Through(t_lo, y_lo));
-            };
-            // Where the scan of event i resumes (None: no further crossing this step).
-            scan.found[i] = match c.resume {
-                Some((tr, gr)) => {
-                    self.find_crossing(i, tr, gr, None, scan.t1, scan.g_end[i], scan.r_end[i])
-                }
-                None => None,
-            };
-            let was_armed = sides.armed[i];
-            sides.armed[i] = true;
-            sides.side[i] = if c.rising { 1 } else { -1 };
-            if !was_armed || !self.events.direction(i).accepts(c.rising) {
-                // Re-arming crossing (the exit after a reset) or an unwanted direction.
-                continue;
-            }
-            let tc = c.t;
-            let dense = self.stepper.dense();
-            let mut yc = SVector::zeros();
-            dense.interpolate_unchecked(tc, &mut yc);
-            let view = StepView {
-                t0: t_lo,
-                t1: tc,
-                y0: y_lo,
-                y1: yc,
-                dense,
-            };
-            let stop_obs = observer.on_step(&view) == Control::Stop;
-            let direction = if c.rising {
-                Direction::Rising
-            } else {
-                Direction::Falling
-            };
-            self.stepper.stats_mut().events += 1;
-            if let Some((count, last)) = self.history.push(tc, &self.zeno) {
-                // Leave the simulation at the event (after its reset) so that the
-                // caller can change the model and continue from there.
-                let mut ya = yc;
-                if self.events.resets(i) {
-                    self.events.apply_reset(i, tc, &mut ya);
-                }
-                self.stepper.reset_state(tc, ya);
-                return Err(EventError::Zeno {
-                    t: to_f64(tc),
-                    count,
-                    last_interval: to_f64(last),
-                    state: ya.iter().map(|&v| to_f64(v)).collect(),
-                }
-                .into());
-            }
-            let terminal = self.events.is_terminal(i);
-            if self.events.resets(i) {
-                // An impact moves into the surface. A located crossing where the rate does
-                // not (the far end of a bracket past the top of a graze of zero normal
-                // velocity: the arrival of a chattering sequence) is no impact: the body
-                // stays on the surface, reported as sticking, not as an event.
-                let mut fc = SVector::zeros();
-                self.system.rhs(tc, &yc, &mut fc);
-                self.stepper.stats_mut().rhs_evals += 1;
-                let into = if c.rising { T::one() } else { -T::one() };
-                if let Some(r) = self.events.rate(i, tc, &yc, &fc) {
-                    if !(into * r > T::zero()) {
-                        self.stepper.stats_mut().events -= 1;
-                        self.stepper.reset_state(tc, yc);
-                        return Err(EventError::Sticking {
-                            index: i,
-                            t: to_f64(tc),
-                            depth: to_f64(self.events.value(i, tc, &yc).abs()),
-                            state: yc.iter().map(|&v| to_f64(v)).collect(),
-                        }
-                        .into());
-                    }
-                }
-                let mut ya = yc;
-                self.events.apply_reset(i, tc, &mut ya);
-                let rec = EventRecord {
-                    index: i,
-                    t: tc,
-                    y: yc,
-                    y_after: Some(ya),
-                    direction,
-                };
-                let stop_ev = observer.on_event(&rec) == Control::Stop;
-                self.stepper.reset_state(tc, ya);
-                self.after_reset(i, tc, &ya, sides);
-                return Ok(if terminal {
-                    Crossings::End(Termination::TerminalEvent(i))
-                } else if stop_obs || stop_ev {
-                    Crossings::End(Termination::ObserverStopped)
-                } else {
-                    Crossings::Cut
-                });
-            }
-            let rec = EventRecord {
-                index: i,
-                t: tc,
-                y: yc,
-                y_after: None,
-                direction,
-            };
-            let stop_ev = observer.on_event(&rec) == Control::Stop;
-            if self.events.restarts(i) && !(terminal || stop_obs || stop_ev) {
-                // A switching point: cut the step here and start the next one on it.
-                self.stepper.reset_state(tc, yc);
-                return Ok(Crossings::Cut);
-            }
-            if terminal || stop_obs || stop_ev {
-                // Rewind the stepper to the event.
-                self.stepper.reset_state(tc, yc);
-                return Ok(Crossings::End(if terminal {
-                    Termination::TerminalEvent(i)
-                } else {
-                    Termination::ObserverStopped
-                }));
-            }
-            t_lo = tc;
-            y_lo = yc;
-        }
-    }
-
-    /// The sides after event `i`'s reset to `ya` at `tc`; event `i` is disarmed if the
-    /// reset left the state on the far side while moving back out.
-    fn after_reset(&mut self, i: usize, tc: T, ya: &SVector<T, N>, sides: &mut Sides) {
-        let mut fa = SVector::zeros();
-        self.system.rhs(tc, ya, &mut fa);
-        self.stepper.stats_mut().rhs_evals += 1;
-        for (j, s) in sides.side.iter_mut().enumerate().take(E::LEN) {
-            let g = self.events.value(j, tc, ya);
-            if g != T::zero() {
-                *s = sign_of(g);
-            }
-            if j == i {
-                // Left on the far side but moving back out: disarmed until it has
-                // crossed back.
-                let r = self.events.rate(j, tc, ya, &fa).unwrap_or(T::zero());
-                sides.armed[j] = !(g != T::zero() && r != T::zero() && sign_of(g) != sign_of(r));
-                if g == T::zero() && r != T::zero() {
-                    *s = sign_of(r);
-                }
-            }
-        }
-    }
-
-    /// Sticking: an event disarmed after a reset (or an impact event on its far side),
-    /// still on the far side at the step end and moving deeper again, never left the
-    /// surface: the reset could not separate the trajectory from it. Never silent: stops
-    /// where it turned (the extremum of g on the dense output), with the state to go on
-    /// from, and an [`EventError::Sticking`].
-    fn check_sticking<O: Observer<T, N>>(
-        &mut self,
-        scan: &StepScan<T, N>,
-        sides: &Sides,
-        t_lo: T,
-        y_lo: SVector<T, N>,
-        observer: &mut O,
-    ) -> Result<()> {
-        for i in 0..E::LEN {
-            // For an impact (a resetting event with a direction) the far side is the
-            // wrong side at any step end: its crossings are reset away from it.
-            let wrong_side = match self.events.direction(i) {
-                Direction::Rising => 1,
-                Direction::Falling => -1,
-                Direction::Either => 0,
-            };
-            let (ge, re) = (scan.g_end[i], scan.r_end[i]);
-            let stuck = !sides.armed[i] || (self.events.resets(i) && sign_of(ge) == wrong_side);
-            if !(stuck
-                && ge != T::zero()
-                && re.is_some_and(|r| r != T::zero() && sign_of(r) == sign_of(ge)))
-            {
-                continue;
-            }
-            let dense = self.stepper.dense();
-            let tol = self
-                .event_tol
-                .max(lit::<T>(4.0) * T::default_epsilon() * scan.t1.abs());
-            let sg = if ge > T::zero() { T::one() } else { -T::one() };
-            let events = &self.events;
-            let (te, _) = crate::roots::golden_max(
-                |t| {
-                    let mut y = SVector::<T, N>::zeros();
-                    dense.interpolate_unchecked(t, &mut y);
-                    -sg * events.value(i, t, &y)
-                },
-                t_lo,
-                scan.t1,
-                tol,
-            );
-            let mut ye = SVector::zeros();
-            dense.interpolate_unchecked(te, &mut ye);
-            let view = StepView {
-                t0: t_lo,
-                t1: te,
-                y0: y_lo,
-                y1: ye,
-                dense,
-            };
-            observer.on_step(&view);
-            let depth = self.events.value(i, te, &ye).abs();
-            self.stepper.reset_state(te, ye);
-            return Err(EventError::Sticking {
-                index: i,
-                t: to_f64(te),
-                depth: to_f64(depth),
-                state: ye.iter().map(|&v| to_f64(v)).collect(),
-            }
-            .into());
-        }
-        Ok(())
-    }
-
-    /// The earliest crossing (any direction) of event `i` in `(t_lo, t1]`, starting from
-    /// `g_lo ≠ 0` (rate `r_lo` if known) and ending at `g1` (rate `r1`).
-    #[allow(clippy::too_many_arguments)]
-    #[inline(always)]
-    fn find_crossing(
-        &self,
-        i: usize,
-        t_lo: T,
-        g_lo: T,
-        r_lo: Option<T>,
-        t1: T,
-        g1: T,
-        r1: Option<T>,
-    ) -> Option<Crossing<T>> {
-        let ev = &self.events;
-        let dense = self.stepper.dense();
-        let tol = self
-            .event_tol
-            .max(lit::<T>(4.0) * T::default_epsilon() * t1.abs());
-        let g_at = |t: T| {
-            let mut y = SVector::<T, N>::zeros();
-            dense.interpolate_unchecked(t, &mut y);
-            ev.value(i, t, &y)
-        };
-        // Interior samples (grazing safety for functions without a rate).
-        let k = ev.interior_samples(i);
-        if k > 0 {
-            let mut ta = t_lo;
-            let mut ga = g_lo;
-            for m in 1..=(k + 1) {
-                let (tb, gb) = if m == k + 1 {
-                    (t1, g1)
-                } else {
-                    let tb = t_lo + (t1 - t_lo) * lit::<T>(m as f64 / (k as f64 + 1.0));
-                    (tb, g_at(tb))
-                };
-                if !gb.is_finite() {
-                    // Not a crossing (the step ends are checked to be finite).
-                    continue;
-                }
-                if gb != T::zero() && sign_of(gb) != sign_of(ga) {
-                    let (tc, _) = locate(g_at, ta, tb, ga, gb, tol);
-                    let resume = if m == k + 1 { None } else { Some((tb, gb)) };
-                    return Some(Crossing {
-                        t: tc,
-                        rising: gb > T::zero(),
-                        resume,
-                    });
-                }
-                if gb != T::zero() {
-                    ta = tb;
-                    ga = gb;
-                }
-            }
-            return None;
-        }
-        let rate_lo = || {
-            r_lo.or_else(|| {
-                let mut y = SVector::zeros();
-                dense.interpolate_unchecked(t_lo, &mut y);
-                let mut f = SVector::zeros();
-                self.system.rhs(t_lo, &y, &mut f);
-                ev.rate(i, t_lo, &y, &f)
-            })
-        };
-        crossing_between(g_at, rate_lo, tol, t_lo, g_lo, t1, g1, r1)
-    }
 }
 
-/// The earliest crossing of `g` (its value on the step's dense output: `g_at`) in
-/// `(t_lo, t1]`, from `g_lo ≠ 0` to `g1` with the rate `r1` at `t1`: a sign change of the
-/// ends, located by the bracketing solver; else, with the same sign at both ends (or
-/// `g1 = 0`), a grazing pair when the rates show an interior extremum that reaches the
-/// other side (`rate_lo`, the rate at `t_lo`, is evaluated only then): the extremum by
-/// golden-section search, the crossing before it, and the extremum as where the scan
-/// resumes. The ensemble's lanes run the same search written for `f64`
-/// (`ensemble::engine::find_crossing`): through this generic function their throughput
-/// was 3–4 % lower (same machine, alternating runs), and their events are tested equal to
-/// the driver's bit for bit.
-#[allow(clippy::too_many_arguments)]
+/// The longest step the events and the system allow near `t`, if they bound it (see
+/// [`EventFunction::time_scale`](crate::event::EventFunction::time_scale) and
+/// [`Dynamics::time_scale`]).
 #[inline(always)]
-fn crossing_between<T: Real>(
-    g_at: impl Fn(T) -> T + Copy,
-    rate_lo: impl FnOnce() -> Option<T>,
-    tol: T,
-    t_lo: T,
-    g_lo: T,
-    t1: T,
-    g1: T,
-    r1: Option<T>,
-) -> Option<Crossing<T>> {
-    let s = sign_of(g_lo);
-    if g1 != T::zero() && sign_of(g1) != s {
-        let (tc, _) = locate(g_at, t_lo, t1, g_lo, g1, tol);
-        return Some(Crossing {
-            t: tc,
-            rising: g1 > T::zero(),
-            resume: None,
-        });
+pub(crate) fn time_scale<T: Real, const N: usize, S: Dynamics<T, N>, E: EventSet<T, N>>(
+    system: &S,
+    events: &E,
+    t: T,
+) -> Option<T> {
+    match (events.max_step(t), system.time_scale(t)) {
+        (Some(a), Some(b)) => Some(a.min(b)),
+        (a, b) => a.or(b),
     }
-    let (Some(r_lo), Some(r1)) = (rate_lo(), r1) else {
-        return None;
-    };
-    let towards = if s > 0 {
-        r_lo < T::zero()
-    } else {
-        r_lo > T::zero()
-    };
-    let away = if s > 0 {
-        r1 > T::zero()
-    } else {
-        r1 < T::zero()
-    };
-    if !(towards && (away || g1 == T::zero())) {
-        return None;
-    }
-    let sg = if s > 0 { T::one() } else { -T::one() };
-    let (te, neg) = crate::roots::golden_max(|t| -sg * g_at(t), t_lo, t1, tol);
-    let ge = -neg * sg;
-    if ge == T::zero() || sign_of(ge) == s {
-        return None;
-    }
-    let (tc, _) = locate(g_at, t_lo, te, g_lo, ge, tol);
-    Some(Crossing {
-        t: tc,
-        rising: ge > T::zero(),
-        resume: Some((te, ge)),
-    })
 }
 
-fn non_finite<T: Real>(index: usize, t: T, g: T) -> RunError {
-    EventError::NonFinite {
-        index,
-        t: to_f64(t),
-        value: to_f64(g),
+/// Where the step from `t` must end: the next landing point ([`landing_limit`]), sooner
+/// if the time scale of the events (moving surfaces, mode conditions) or of the system
+/// (constrained modes) bounds the step.
+#[inline(always)]
+pub(crate) fn step_limit<T: Real>(t: T, t_end: T, grid: Option<(T, T)>, scale: Option<T>) -> T {
+    let limit = landing_limit(t, t_end, grid);
+    match scale {
+        Some(h) => limit.min(t + h),
+        None => limit,
     }
-    .into()
+}
+
+/// Fails at once when a run provably needs more steps than the cap: its span over the
+/// largest step it may take (the stepper's `h_max` or fixed step `h_stepper`, the landing
+/// grid's spacing, the time `scale` of the events and the system at the two ends).
+pub(crate) fn check_work<T: Real>(
+    t0: T,
+    t_end: T,
+    h_stepper: Option<T>,
+    grid: Option<(T, T)>,
+    scale: impl Fn(T) -> Option<T>,
+    max_steps: usize,
+) -> Result<()> {
+    let mut h = h_stepper;
+    if let Some((_, dt)) = grid {
+        h = Some(h.map_or(dt, |h| h.min(dt)));
+    }
+    // The time scale bounds every step; the larger of its values at the two ends bounds
+    // it over the run when it changes monotonically (a ramp).
+    if let (Some(a), Some(b)) = (scale(t0), scale(t_end)) {
+        let s = a.max(b);
+        h = Some(h.map_or(s, |h| h.min(s)));
+    }
+    let Some(h) = h else { return Ok(()) };
+    let span = to_f64(t_end - t0);
+    let needed = span / to_f64(h);
+    // A margin of one step for the rounding of the last one.
+    if !(needed <= max_steps as f64 + 1.0) {
+        return Err(IntegrateError::WorkExceedsCap {
+            needed,
+            span,
+            h: to_f64(h),
+            max_steps,
+        }
+        .into());
+    }
+    Ok(())
 }
 
 /// The next landing point after `t` on the grid `origin + k·dt` (computed from `k`,
@@ -1054,68 +656,11 @@ pub(crate) fn landing_limit<T: Real>(t: T, t_end: T, grid: Option<(T, T)>) -> T 
     }
 }
 
-/// Each event's side of its surface (+1/−1; 0 = not known yet, for a start exactly on it,
-/// used when g is exactly zero at a step boundary) and whether it is armed (false right
-/// after a reset that left the state on the far side while moving back out). Carried
-/// from step to step.
-#[derive(Debug, Clone, Copy)]
-struct Sides {
-    side: [i8; MAX_EVENTS],
-    armed: [bool; MAX_EVENTS],
-}
-
-/// One step's event data: its ends, each event's value and rate at the end, and the next
-/// crossing found for each (cached while earlier crossings are handled).
-#[derive(Debug, Clone, Copy)]
-struct StepScan<T: Real, const N: usize> {
-    t0: T,
-    t1: T,
-    y0: SVector<T, N>,
-    y1: SVector<T, N>,
-    g_end: [T; MAX_EVENTS],
-    r_end: [Option<T>; MAX_EVENTS],
-    found: [Option<Crossing<T>>; MAX_EVENTS],
-}
-
-/// How a step's crossings ended.
-enum Crossings<T: Real, const N: usize> {
-    /// No crossing stopped the step: its last piece starts at this time and state.
-    Through(T, SVector<T, N>),
-    /// The state was reset or restarted at an event: the next step starts there.
-    Cut,
-    /// The run ends.
-    End(Termination),
-}
-
-/// A crossing found on a step.
-#[derive(Debug, Clone, Copy)]
-struct Crossing<T> {
-    t: T,
-    rising: bool,
-    /// Where to resume scanning this event after it (`None`: nothing more this step).
-    resume: Option<(T, T)>,
-}
-
-#[inline(always)]
-fn signed_tiny<T: Real>(side: i8) -> T {
-    let tiny = T::default_epsilon() * T::default_epsilon();
-    if side < 0 { -tiny } else { tiny }
-}
-
-#[inline(always)]
-fn sign_of<T: Real>(x: T) -> i8 {
-    if x > T::zero() {
-        1
-    } else if x < T::zero() {
-        -1
-    } else {
-        0
-    }
-}
-
 #[cfg(test)]
 mod tests {
+    use super::scan::{sign_of, signed_tiny};
     use super::*;
+    use crate::event::EventError;
     use crate::event::{Event, FnEvent, Level};
     use crate::integrate::{Dopri5, Rk4, Tolerances};
     use crate::testing::HarmonicOscillator;

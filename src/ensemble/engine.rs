@@ -2,43 +2,45 @@
 
 use nalgebra::SVector;
 
-use super::kernel::{ALL, LaneState, StepConsts, StepOut, row};
-use super::math::LaneMath;
-use super::model::{Member, Packed, scalar_rhs};
-use super::{Lanes, Simd};
-use crate::drive::{Control, EventRecord, Observer, Outcome, StepView, Termination, landing_limit};
+use super::kernel::{LaneState, StepConsts, StepOut, row};
+use super::model::Member;
+use crate::LaneDynamics;
+use crate::drive::{Observer, Outcome, Termination};
+use crate::drive::{Scan, Sides, check_work, step_limit, time_scale};
 use crate::error::Result;
-use crate::event::{Direction, Event, EventError, EventFunction, EventHistory, ZenoGuard, locate};
+use crate::event::{Event, EventFunction, EventHistory, EventSet, MAX_EVENTS, ZenoGuard};
 use crate::integrate::{DenseOutput, IntegrateError, Stats, StepOptions, Tolerances};
+use crate::lanes::{LaneMath, Lanes, Simd, TRUE};
 use crate::validate::ParameterError;
 
-/// One trajectory of an ensemble: a [`Member`], its start and end, and an optional landing
-/// grid `origin + i·dt` that every step lands on (the sweeps' sections at `t = i·2π/ω`).
+/// One trajectory of an ensemble: its model (any [`LaneDynamics`] of state size `M`; the
+/// paper's [`Member`] by default), its start and end, and an optional landing grid
+/// `origin + i·dt` that every step lands on (the sweeps' sections at `t = i·2π/ω`).
 ///
 /// The constructors validate; values set through the public fields are validated when a
 /// run starts ([`check`](Self::check)), and an invalid trajectory is an error in its own
 /// result slot of [`Ensemble::run`].
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct MemberRun {
+pub struct MemberRun<D = Member, const M: usize = 2> {
     /// The model.
-    pub member: Member,
+    pub member: D,
     /// Start time.
     pub t0: f64,
-    /// Initial state `(x, ẋ)`.
-    pub y0: SVector<f64, 2>,
+    /// Initial state.
+    pub y0: SVector<f64, M>,
     /// End time.
     pub t_end: f64,
     /// Landing grid `(origin, dt)`.
     pub grid: Option<(f64, f64)>,
 }
 
-impl MemberRun {
+impl<D, const M: usize> MemberRun<D, M> {
     /// From `(t0, y0)` to `t_end`, without a landing grid.
     ///
     /// # Errors
     /// [`IntegrateError::InvalidTimeSpan`] unless `t0 < t_end`, both finite;
     /// [`IntegrateError::NonFiniteState`] for a non-finite `y0`.
-    pub fn new(member: Member, t0: f64, y0: SVector<f64, 2>, t_end: f64) -> Result<Self> {
+    pub fn new(member: D, t0: f64, y0: SVector<f64, M>, t_end: f64) -> Result<Self> {
         if !(t0.is_finite() && t_end.is_finite() && t_end > t0) {
             return Err(IntegrateError::InvalidTimeSpan { t0, t_end }.into());
         }
@@ -52,15 +54,16 @@ impl MemberRun {
         })
     }
 
-    /// `periods` forcing periods from `(0, y0)`, every step landing on `t = i·2π/ω` (the
-    /// sweeps' setting).
+    /// `periods` periods of length `period` from `(0, y0)`, every step landing on
+    /// `t = i·period` (the sweeps' setting: `period` the forcing period).
     ///
     /// # Errors
-    /// As [`new`](Self::new); [`ParameterError`] unless `periods` is finite and > 0.
-    pub fn periods(member: Member, y0: SVector<f64, 2>, periods: f64) -> Result<Self> {
+    /// As [`new`](Self::new); [`ParameterError`] unless `periods` and `period` are finite
+    /// and > 0.
+    pub fn periods_of(member: D, y0: SVector<f64, M>, period: f64, periods: f64) -> Result<Self> {
         crate::validate::positive("periods", periods)?;
-        let tau = member.period();
-        Self::new(member, 0.0, y0, periods * tau)?.with_grid(0.0, tau)
+        crate::validate::positive("period", period)?;
+        Self::new(member, 0.0, y0, periods * period)?.with_grid(0.0, period)
     }
 
     /// Checks what the constructors check, for a trajectory whose public fields were set
@@ -95,30 +98,42 @@ impl MemberRun {
     }
 }
 
+impl MemberRun {
+    /// `periods` forcing periods `2π/ω` of the paper's member from `(0, y0)`, every step
+    /// landing on `t = i·2π/ω` (the sweeps' setting).
+    ///
+    /// # Errors
+    /// As [`new`](Self::new); [`ParameterError`] unless `periods` is finite and > 0.
+    pub fn periods(member: Member, y0: SVector<f64, 2>, periods: f64) -> Result<Self> {
+        let tau = member.period();
+        Self::periods_of(member, y0, tau, periods)
+    }
+}
+
 /// The ensemble integrator: DOPRI5 with the scalar [`Dopri5`](crate::integrate::Dopri5)'s
 /// tableau, error norm, PI controller and first-step heuristic, one trajectory per lane,
 /// with the driver's event location and observers per lane (see the
 /// [module docs](super)).
 #[derive(Debug, Clone)]
-pub struct Ensemble<G = crate::event::Level<f64>> {
-    tol: Tolerances<f64, 2>,
+pub struct Ensemble<E = (), const M: usize = 2> {
+    tol: Tolerances<f64, M>,
     opts: StepOptions<f64>,
     math: LaneMath,
     simd: Simd,
     max_steps: usize,
     event_tol: f64,
     zeno: ZenoGuard<f64>,
-    event: Option<Event<G>>,
+    events: E,
 }
 
-impl Ensemble {
-    /// An ensemble with the given tolerances, default [`StepOptions`], no event,
+impl<const M: usize> Ensemble<(), M> {
+    /// An ensemble of state size `M` with the given tolerances, default [`StepOptions`], no event,
     /// [`LaneMath::Exact`], the driver's defaults (step cap 10⁸ per trajectory, event time
     /// tolerance 10⁻¹², the default [`ZenoGuard`]).
     ///
     /// # Errors
     /// [`ParameterError`] for invalid tolerances (set through the public fields).
-    pub fn new(tol: Tolerances<f64, 2>) -> Result<Self> {
+    pub fn new(tol: Tolerances<f64, M>) -> Result<Self> {
         tol.validate()?;
         Ok(Self {
             tol,
@@ -128,36 +143,30 @@ impl Ensemble {
             max_steps: 100_000_000,
             event_tol: 1e-12,
             zeno: ZenoGuard::default(),
-            event: None,
+            events: (),
         })
     }
 }
 
-impl<G: EventFunction<f64, 2>> Ensemble<G> {
-    /// Adds a detection event, located per lane on the step's dense output exactly as
-    /// [`Simulation`](crate::drive::Simulation) does (sign changes, grazing pairs from the
-    /// event's rate, the same bracketing solver and tolerance).
+impl<E: EventSet<f64, M>, const M: usize> Ensemble<E, M> {
+    /// Sets the events: any [`EventSet`] of the crate's events ([`Event`] with any event
+    /// function, reset and flags, and tuples of them), handled per lane exactly as
+    /// [`Simulation`](crate::drive::Simulation) handles them — the same code: crossings
+    /// and grazing pairs located on each lane's dense output, records, resets (a lane
+    /// restarts from the reset state), restarts, terminal events, the sticking check, the
+    /// Zeno guard, and the events' step bounds.
     ///
     /// # Errors
-    /// [`ParameterError`] for what the lanes do not support: resets, terminal events,
-    /// restarts, interior samples and step bounds (use the scalar driver for those).
-    pub fn with_event<G2: EventFunction<f64, 2>>(self, event: Event<G2>) -> Result<Ensemble<G2>> {
-        let unsupported = |requirement: &'static str| -> Result<Ensemble<G2>> {
-            Err(ParameterError::new("event", 0.0, requirement).into())
+    /// [`EventError`](crate::event::EventError) for invalid event settings (the events'
+    /// own [`check`](EventSet::check)).
+    pub fn with_events<E2: EventSet<f64, M>>(self, events: E2) -> Result<Ensemble<E2, M>> {
+        const {
+            assert!(
+                E2::LEN <= MAX_EVENTS,
+                "an ensemble handles at most MAX_EVENTS events"
+            )
         };
-        if event.terminal {
-            return unsupported("not terminal (terminal events are not supported in lanes)");
-        }
-        if event.restart {
-            return unsupported("without restart (not supported in lanes)");
-        }
-        if event.interior_samples > 0 {
-            return unsupported("without interior samples (not supported in lanes)");
-        }
-        if event.max_step.is_some() {
-            return unsupported("without a step bound (not supported in lanes)");
-        }
-        event.function.check()?;
+        events.check()?;
         Ok(Ensemble {
             tol: self.tol,
             opts: self.opts,
@@ -166,8 +175,24 @@ impl<G: EventFunction<f64, 2>> Ensemble<G> {
             max_steps: self.max_steps,
             event_tol: self.event_tol,
             zeno: self.zeno,
-            event: Some(event),
+            events,
         })
+    }
+
+    /// Sets one detection event ([`with_events`](Self::with_events) of one [`Event`]).
+    ///
+    /// # Errors
+    /// As [`with_events`](Self::with_events).
+    pub fn with_event<G2: EventFunction<f64, M>, R2: crate::event::ResetMap<f64, M>>(
+        self,
+        event: Event<G2, R2>,
+    ) -> Result<Ensemble<Event<G2, R2>, M>> {
+        self.with_events(event)
+    }
+
+    /// The events.
+    pub fn events(&self) -> &E {
+        &self.events
     }
 
     /// Sets how `exp` and `ln` are evaluated.
@@ -214,7 +239,7 @@ impl<G: EventFunction<f64, 2>> Ensemble<G> {
     }
 
     /// The tolerances.
-    pub fn tolerances(&self) -> &Tolerances<f64, 2> {
+    pub fn tolerances(&self) -> &Tolerances<f64, M> {
         &self.tol
     }
 
@@ -230,19 +255,20 @@ impl<G: EventFunction<f64, 2>> Ensemble<G> {
     ///
     /// Every trajectory is checked ([`MemberRun::check`]) before the lanes start: an
     /// invalid one (fields set directly to a reversed time span, a non-finite state, a
-    /// landing grid with `dt ≤ 0`) never enters a lane; its result is the error, and the
-    /// others run as they would without it.
+    /// landing grid with `dt ≤ 0`, a model whose structure differs from the first valid
+    /// one's, [`LaneDynamics::same_structure`]) never enters a lane; its result is the
+    /// error, and the others run as they would without it.
     ///
     /// # Errors
     /// The outer error: [`ParameterError`] if `observers` and `trajectories` differ in
     /// length. Each trajectory's own result is an element of the vector: its
     /// [`Outcome`], or the error that stopped it (the scalar driver's errors, or that of
     /// [`MemberRun::check`]).
-    pub fn run<V: Lanes, O: Observer<f64, 2>>(
+    pub fn run<V: Lanes, D: LaneDynamics<M>, O: Observer<f64, M>>(
         &self,
-        trajectories: &[MemberRun],
+        trajectories: &[MemberRun<D, M>],
         observers: &mut [O],
-    ) -> Result<Vec<Result<Outcome<f64, 2>>>> {
+    ) -> Result<Vec<Result<Outcome<f64, M>>>> {
         if observers.len() != trajectories.len() {
             return Err(ParameterError::new(
                 "observers",
@@ -251,18 +277,32 @@ impl<G: EventFunction<f64, 2>> Ensemble<G> {
             )
             .into());
         }
-        let mut out: Vec<Option<Result<Outcome<f64, 2>>>> = Vec::with_capacity(trajectories.len());
+        let mut out: Vec<Option<Result<Outcome<f64, M>>>> = Vec::with_capacity(trajectories.len());
         out.resize_with(trajectories.len(), || None);
         // The valid trajectories, in order: the lanes' queue.
         let mut queue = Vec::with_capacity(trajectories.len());
+        let mut first: Option<&D> = None;
         for (j, job) in trajectories.iter().enumerate() {
+            let shared = first.is_none_or(|f| f.same_structure(&job.member));
             match job.check() {
-                Ok(()) => queue.push(j),
+                Ok(()) if shared => {
+                    first.get_or_insert(&job.member);
+                    queue.push(j);
+                }
+                Ok(()) => {
+                    let e = ParameterError::new(
+                        "member",
+                        j as f64,
+                        "of the same structure as the first valid member (coordinates, mass \
+                         shape, linear matrices)",
+                    );
+                    out[j] = Some(Err(e.into()));
+                }
                 Err(e) => out[j] = Some(Err(e)),
             }
         }
         if let Some(&first) = queue.first() {
-            Engine::<V, G>::new(self, trajectories, &queue, &trajectories[first])
+            Engine::<V, E, D, M>::new(self, trajectories, &queue, &trajectories[first])
                 .run(observers, &mut out);
         }
         Ok(out
@@ -278,14 +318,14 @@ impl<G: EventFunction<f64, 2>> Ensemble<G> {
     /// # Errors
     /// As [`run`](Self::run); [`ParameterError`] if `chunk == 0`.
     #[cfg(feature = "parallel")]
-    pub fn run_parallel<V: Lanes, O: Observer<f64, 2> + Send>(
+    pub fn run_parallel<V: Lanes, D: LaneDynamics<M> + Sync, O: Observer<f64, M> + Send>(
         &self,
-        trajectories: &[MemberRun],
+        trajectories: &[MemberRun<D, M>],
         observers: &mut [O],
         chunk: usize,
-    ) -> Result<Vec<Result<Outcome<f64, 2>>>>
+    ) -> Result<Vec<Result<Outcome<f64, M>>>>
     where
-        G: Sync,
+        E: Sync,
     {
         use rayon::prelude::*;
         if chunk == 0 {
@@ -299,10 +339,10 @@ impl<G: EventFunction<f64, 2>> Ensemble<G> {
             )
             .into());
         }
-        let parts: Vec<Vec<Result<Outcome<f64, 2>>>> = trajectories
+        let parts: Vec<Vec<Result<Outcome<f64, M>>>> = trajectories
             .par_chunks(chunk)
             .zip(observers.par_chunks_mut(chunk))
-            .map(|(t, o)| self.run::<V, O>(t, o))
+            .map(|(t, o)| self.run::<V, D, O>(t, o))
             .collect::<Result<_>>()?;
         Ok(parts.into_iter().flatten().collect())
     }
@@ -311,35 +351,56 @@ impl<G: EventFunction<f64, 2>> Ensemble<G> {
 /// The dense output of one lane's accepted step (Hairer's continuous extension of
 /// DOPRI5, the same formula as [`Dopri5Dense`](crate::integrate::Dopri5Dense)).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct LaneDense {
+pub struct LaneDense<const M: usize = 2> {
     t0: f64,
     t1: f64,
     h: f64,
-    y0: SVector<f64, 2>,
-    y1: SVector<f64, 2>,
-    f0: SVector<f64, 2>,
-    f1: SVector<f64, 2>,
-    r2: SVector<f64, 2>,
-    r3: SVector<f64, 2>,
-    r4: SVector<f64, 2>,
-    r5: SVector<f64, 2>,
+    y0: SVector<f64, M>,
+    y1: SVector<f64, M>,
+    f0: SVector<f64, M>,
+    f1: SVector<f64, M>,
+    r2: SVector<f64, M>,
+    r3: SVector<f64, M>,
+    r4: SVector<f64, M>,
+    r5: SVector<f64, M>,
 }
 
-impl DenseOutput<f64, 2> for LaneDense {
+impl<const M: usize> LaneDense<M> {
+    /// Lane `i`'s step from the rows of a pass's output.
+    #[inline(always)]
+    fn from_rows(buf: &[[f64; 16]], i: usize) -> Self {
+        let v = |q: usize| SVector::<f64, M>::from_fn(|c, _| buf[row::vector(q, M) + c][i]);
+        Self {
+            t0: buf[row::T0][i],
+            t1: buf[row::T1][i],
+            h: buf[row::H][i],
+            y0: v(row::X0),
+            y1: v(row::X1),
+            f0: v(row::F0),
+            f1: v(row::F1),
+            r2: v(row::R2),
+            r3: v(row::R3),
+            r4: v(row::R4),
+            r5: v(row::R5),
+        }
+    }
+}
+
+impl<const M: usize> DenseOutput<f64, M> for LaneDense<M> {
     fn span(&self) -> (f64, f64) {
         (self.t0, self.t1)
     }
-    fn endpoints(&self) -> (&SVector<f64, 2>, &SVector<f64, 2>) {
+    fn endpoints(&self) -> (&SVector<f64, M>, &SVector<f64, M>) {
         (&self.y0, &self.y1)
     }
-    fn end_derivatives(&self) -> (&SVector<f64, 2>, &SVector<f64, 2>) {
+    fn end_derivatives(&self) -> (&SVector<f64, M>, &SVector<f64, M>) {
         (&self.f0, &self.f1)
     }
     #[inline(always)]
-    fn interpolate_unchecked(&self, t: f64, out: &mut SVector<f64, 2>) {
+    fn interpolate_unchecked(&self, t: f64, out: &mut SVector<f64, M>) {
         let th = (t - self.t0) / self.h;
         let th1 = 1.0 - th;
-        for i in 0..2 {
+        for i in 0..M {
             out[i] = self.y0[i]
                 + th * (self.r2[i] + th1 * (self.r3[i] + th * (self.r4[i] + th1 * self.r5[i])));
         }
@@ -347,19 +408,22 @@ impl DenseOutput<f64, 2> for LaneDense {
 }
 
 /// Per-lane bookkeeping (scalar).
-struct Slot {
+struct Slot<D> {
     job: Option<usize>,
-    member: Option<Member>,
+    member: Option<D>,
     t_end: f64,
     grid: Option<(f64, f64)>,
     steps: usize,
     nonfinite: u32,
-    side: i8,
+    /// Whether the events or the model bound the step (the limit is then recomputed after
+    /// every step, as the driver does).
+    scaled: bool,
+    sides: Option<Sides>,
     history: EventHistory<f64>,
     stats: Stats,
 }
 
-impl Slot {
+impl<D> Slot<D> {
     fn idle() -> Self {
         Self {
             job: None,
@@ -368,7 +432,8 @@ impl Slot {
             grid: None,
             steps: 0,
             nonfinite: 0,
-            side: 0,
+            scaled: false,
+            sides: None,
             history: EventHistory::new(),
             stats: Stats::default(),
         }
@@ -376,31 +441,20 @@ impl Slot {
 }
 
 /// The lanes and their scalar bookkeeping.
-struct Engine<'a, V: Lanes, G> {
-    cfg: &'a Ensemble<G>,
-    jobs: &'a [MemberRun],
+struct Engine<'a, V: Lanes, E, D: LaneDynamics<M>, const M: usize> {
+    cfg: &'a Ensemble<E, M>,
+    jobs: &'a [MemberRun<D, M>],
     /// The indices of the valid trajectories, in order ([`MemberRun::check`]).
     queue: &'a [usize],
     /// The next position in `queue`.
     next: usize,
-    slots: Vec<Slot>,
+    slots: Vec<Slot<D>>,
     /// On the heap, like the step's output: on the stack, the speed of the vector step
     /// depended on where the stack began (the program's path and environment) by up to
     /// 30 % (measured with AVX2, 16 lanes: 0.38–0.50 s for the same binary); boxed, it
     /// stays at the fast end.
-    st: Box<LaneState<V>>,
-    consts: StepConsts,
-}
-
-#[inline(always)]
-fn sign_of(x: f64) -> i8 {
-    if x > 0.0 {
-        1
-    } else if x < 0.0 {
-        -1
-    } else {
-        0
-    }
+    st: Box<LaneState<V, D, M>>,
+    consts: StepConsts<M>,
 }
 
 /// The lanes whose bit is set in `mask`, in increasing order.
@@ -415,18 +469,18 @@ fn lanes_of(mut mask: u32) -> impl Iterator<Item = usize> {
     })
 }
 
-impl<'a, V: Lanes, G: EventFunction<f64, 2>> Engine<'a, V, G> {
+impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engine<'a, V, E, D, M> {
     fn new(
-        cfg: &'a Ensemble<G>,
-        jobs: &'a [MemberRun],
+        cfg: &'a Ensemble<E, M>,
+        jobs: &'a [MemberRun<D, M>],
         queue: &'a [usize],
-        first: &MemberRun,
+        first: &MemberRun<D, M>,
     ) -> Self {
         let z = V::splat(0.0);
-        let packed = Packed::splat(&first.member);
+        let packed = first.member.pack::<V>();
         // Idle lanes step from a benign state (the first valid job's start, h = 1e-6):
         // their results are never used and their state never changes.
-        let (t, x, v) = (first.t0, first.y0[0], first.y0[1]);
+        let t = first.t0;
         Self {
             cfg,
             jobs,
@@ -436,10 +490,8 @@ impl<'a, V: Lanes, G: EventFunction<f64, 2>> Engine<'a, V, G> {
             st: Box::new(LaneState {
                 packed,
                 t: V::splat(t),
-                x: V::splat(x),
-                v: V::splat(v),
-                fx: z,
-                fv: z,
+                y: core::array::from_fn(|c| V::splat(first.y0[c])),
+                f: [z; M],
                 h: V::splat(1e-6),
                 limit: V::splat(t + 1.0),
                 ln_err_old: V::splat(1e-4f64.ln()),
@@ -452,11 +504,11 @@ impl<'a, V: Lanes, G: EventFunction<f64, 2>> Engine<'a, V, G> {
 
     /// Starts the next trajectory of the queue in lane `i` (skipping those that fail at
     /// once); leaves the lane idle when the queue is empty.
-    fn fill<O: Observer<f64, 2>>(
+    fn fill<O: Observer<f64, M>>(
         &mut self,
         i: usize,
         observers: &mut [O],
-        out: &mut [Option<Result<Outcome<f64, 2>>>],
+        out: &mut [Option<Result<Outcome<f64, M>>>],
     ) {
         self.st.active = self.st.active.with_lane(i, 0.0);
         self.slots[i].job = None;
@@ -464,7 +516,7 @@ impl<'a, V: Lanes, G: EventFunction<f64, 2>> Engine<'a, V, G> {
             self.next += 1;
             match self.start(i, j, &mut observers[j]) {
                 Ok(()) => {
-                    self.st.active = self.st.active.with_lane(i, ALL);
+                    self.st.active = self.st.active.with_lane(i, TRUE);
                     return;
                 }
                 Err(e) => out[j] = Some(Err(e)),
@@ -472,7 +524,7 @@ impl<'a, V: Lanes, G: EventFunction<f64, 2>> Engine<'a, V, G> {
         }
     }
 
-    fn start<O: Observer<f64, 2>>(&mut self, i: usize, j: usize, obs: &mut O) -> Result<()> {
+    fn start<O: Observer<f64, M>>(&mut self, i: usize, j: usize, obs: &mut O) -> Result<()> {
         let job = &self.jobs[j];
         let cfg = self.cfg;
         // The time span, state and grid were checked before the run (`MemberRun::check`).
@@ -482,52 +534,27 @@ impl<'a, V: Lanes, G: EventFunction<f64, 2>> Engine<'a, V, G> {
             .map_err(IntegrateError::InvalidSettings)?;
         obs.check()?;
         obs.check_span(t0, t_end)?;
-        // The work bound (the driver's check_work).
-        let mut hb = (cfg.opts.h_max.is_finite() && cfg.opts.h_max > 0.0).then_some(cfg.opts.h_max);
-        if let Some((_, dt)) = job.grid {
-            hb = Some(hb.map_or(dt, |h| h.min(dt)));
-        }
-        if let Some(hb) = hb {
-            let needed = (t_end - t0) / hb;
-            if !(needed <= cfg.max_steps as f64 + 1.0) {
-                return Err(IntegrateError::WorkExceedsCap {
-                    needed,
-                    span: t_end - t0,
-                    h: hb,
-                    max_steps: cfg.max_steps,
-                }
-                .into());
-            }
-        }
-        let m = job.member;
+        let m = &job.member;
+        cfg.events.check()?;
+        let scale = |t: f64| time_scale(m, &cfg.events, t);
+        let h_max = (cfg.opts.h_max.is_finite() && cfg.opts.h_max > 0.0).then_some(cfg.opts.h_max);
+        check_work(t0, t_end, h_max, job.grid, scale, cfg.max_steps)?;
         let mut stats = Stats::default();
         obs.on_start(t0, &y0);
-        // The event's side at the start (the driver's rule).
-        let mut side = 0i8;
-        if let Some(ev) = &cfg.event {
-            let g = ev.function.value(t0, &y0);
-            if !g.is_finite() {
-                return Err(non_finite(t0, g));
-            }
-            side = sign_of(g);
-            if side == 0 {
-                let f = scalar_rhs(&m, t0, &y0);
-                if let Some(r) = ev.function.rate(t0, &y0, &f) {
-                    side = sign_of(r);
-                }
-            }
-        }
+        // The events' sides at the start (the driver's rule).
+        let sides = crate::drive::initial_sides(m, &cfg.events, t0, &y0)?;
         // The stepper's first derivative and first step.
-        let f0 = scalar_rhs(&m, t0, &y0);
+        let f0 = scalar_rhs(m, t0, &y0);
         stats.rhs_evals += 1;
-        if !(f0[0].is_finite() && f0[1].is_finite()) {
+        if !f0.iter().all(|v| v.is_finite()) {
             return Err(IntegrateError::NonFiniteRhs { t: t0 }.into());
         }
-        let limit = landing_limit(t0, t_end, job.grid);
+        let scaled = scale(t0).is_some();
+        let limit = step_limit(t0, t_end, job.grid, scale(t0));
         let h = match cfg.opts.h_init {
             Some(h) => h,
             None => crate::integrate::initial_step(
-                m.scalar(),
+                m,
                 t0,
                 &y0,
                 &f0,
@@ -538,12 +565,12 @@ impl<'a, V: Lanes, G: EventFunction<f64, 2>> Engine<'a, V, G> {
                 &mut stats.rhs_evals,
             ),
         };
-        self.st.packed.set(i, &m);
+        m.pack_lane(&mut self.st.packed, i);
         self.st.t = self.st.t.with_lane(i, t0);
-        self.st.x = self.st.x.with_lane(i, y0[0]);
-        self.st.v = self.st.v.with_lane(i, y0[1]);
-        self.st.fx = self.st.fx.with_lane(i, f0[0]);
-        self.st.fv = self.st.fv.with_lane(i, f0[1]);
+        for c in 0..M {
+            self.st.y[c] = self.st.y[c].with_lane(i, y0[c]);
+            self.st.f[c] = self.st.f[c].with_lane(i, f0[c]);
+        }
         self.st.h = self.st.h.with_lane(i, h);
         self.st.limit = self.st.limit.with_lane(i, limit);
         self.st.ln_err_old = self.st.ln_err_old.with_lane(i, 1e-4f64.ln());
@@ -551,20 +578,21 @@ impl<'a, V: Lanes, G: EventFunction<f64, 2>> Engine<'a, V, G> {
         let s = &mut self.slots[i];
         *s = Slot::idle();
         s.job = Some(j);
-        s.member = Some(m);
+        s.member = Some(m.clone());
         s.t_end = t_end;
         s.grid = job.grid;
-        s.side = side;
+        s.sides = Some(sides);
+        s.scaled = scaled;
         s.stats = stats;
         Ok(())
     }
 
-    fn finish<O: Observer<f64, 2>>(
+    fn finish<O: Observer<f64, M>>(
         &mut self,
         i: usize,
-        result: Result<(f64, SVector<f64, 2>, Termination)>,
+        result: Result<(f64, SVector<f64, M>, Termination)>,
         observers: &mut [O],
-        out: &mut [Option<Result<Outcome<f64, 2>>>],
+        out: &mut [Option<Result<Outcome<f64, M>>>],
     ) {
         if let Some(j) = self.slots[i].job {
             out[j] = Some(result.map(|(t, y, termination)| {
@@ -585,10 +613,10 @@ impl<'a, V: Lanes, G: EventFunction<f64, 2>> Engine<'a, V, G> {
     /// this crate for the instruction set chosen at run time), then the scalar work of each
     /// lane: a failed start or step ends its trajectory, an accepted step goes to the
     /// lane's event search and observer.
-    fn run<O: Observer<f64, 2>>(
+    fn run<O: Observer<f64, M>>(
         &mut self,
         observers: &mut [O],
-        out: &mut [Option<Result<Outcome<f64, 2>>>],
+        out: &mut [Option<Result<Outcome<f64, M>>>],
     ) {
         for i in 0..V::LANES {
             self.fill(i, observers, out);
@@ -600,12 +628,12 @@ impl<'a, V: Lanes, G: EventFunction<f64, 2>> Engine<'a, V, G> {
     /// most half the lanes are busy, the busy ones move to a vector of half the width
     /// ([`compact`](Self::compact)): a pass there costs about half, and each lane computes
     /// what it would have computed here (every operation is lane-wise).
-    fn drive<O: Observer<f64, 2>>(
+    fn drive<O: Observer<f64, M>>(
         &mut self,
         observers: &mut [O],
-        out: &mut [Option<Result<Outcome<f64, 2>>>],
+        out: &mut [Option<Result<Outcome<f64, M>>>],
     ) {
-        let mut step = Box::new(StepOut::new());
+        let mut step = Box::new(StepOut::new(M));
         while self.st.active.bits() != 0 {
             if self.next >= self.queue.len()
                 && <V::Half as Lanes>::LANES < V::LANES
@@ -614,7 +642,7 @@ impl<'a, V: Lanes, G: EventFunction<f64, 2>> Engine<'a, V, G> {
                 self.compact().drive(observers, out);
                 return;
             }
-            V::step_lanes(&mut self.st, &self.consts, &mut step);
+            super::kernel::step(&mut self.st, &self.consts, &mut step);
             if step.too_small != 0 {
                 for i in lanes_of(step.too_small) {
                     let e = IntegrateError::StepSizeTooSmall {
@@ -642,21 +670,7 @@ impl<'a, V: Lanes, G: EventFunction<f64, 2>> Engine<'a, V, G> {
                 }
             }
             for i in lanes_of(step.accepted) {
-                let g = |k: usize| step.buf[k][i];
-                let sv = |k: usize| SVector::<f64, 2>::new(g(k), g(k + 1));
-                let dense = LaneDense {
-                    t0: g(row::T0),
-                    t1: g(row::T1),
-                    h: g(row::H),
-                    y0: sv(row::X0),
-                    y1: sv(row::X1),
-                    f0: sv(row::F0),
-                    f1: sv(row::F1),
-                    r2: sv(row::R2),
-                    r3: sv(row::R3),
-                    r4: sv(row::R4),
-                    r5: sv(row::R5),
-                };
+                let dense = LaneDense::<M>::from_rows(&step.buf, i);
                 self.after_step(i, &dense, observers, out);
             }
         }
@@ -664,42 +678,43 @@ impl<'a, V: Lanes, G: EventFunction<f64, 2>> Engine<'a, V, G> {
 
     /// The busy lanes moved, in order, to an engine with half the lanes (the queue is
     /// empty). Idle lanes there step from the first busy lane's state, never used.
-    fn compact(&mut self) -> Engine<'a, V::Half, G> {
+    fn compact(&mut self) -> Engine<'a, V::Half, E, D, M> {
         type H<V> = <V as Lanes>::Half;
         let busy: Vec<usize> = lanes_of(self.st.active.bits()).collect();
         let st = &self.st;
         let first = busy[0];
         let splat = |x: V| <H<V> as Lanes>::splat(x.lane(first));
-        let member = self.slots[first].member.unwrap_or(self.jobs[0].member);
+        let member = self.slots[first]
+            .member
+            .as_ref()
+            .unwrap_or(&self.jobs[self.queue[0]].member);
         let mut half = Box::new(LaneState {
-            packed: Packed::splat(&member),
+            packed: member.pack::<H<V>>(),
             t: splat(st.t),
-            x: splat(st.x),
-            v: splat(st.v),
-            fx: splat(st.fx),
-            fv: splat(st.fv),
+            y: st.y.map(splat),
+            f: st.f.map(splat),
             h: splat(st.h),
             limit: splat(st.limit),
             ln_err_old: splat(st.ln_err_old),
             rej_last: splat(st.rej_last),
             active: <H<V> as Lanes>::splat(0.0),
         });
-        let mut slots: Vec<Slot> = (0..<H<V> as Lanes>::LANES).map(|_| Slot::idle()).collect();
+        let mut slots: Vec<Slot<D>> = (0..<H<V> as Lanes>::LANES).map(|_| Slot::idle()).collect();
         for (k, &i) in busy.iter().enumerate() {
             let mv = |dst: H<V>, src: V| dst.with_lane(k, src.lane(i));
             half.t = mv(half.t, st.t);
-            half.x = mv(half.x, st.x);
-            half.v = mv(half.v, st.v);
-            half.fx = mv(half.fx, st.fx);
-            half.fv = mv(half.fv, st.fv);
+            for c in 0..M {
+                half.y[c] = mv(half.y[c], st.y[c]);
+                half.f[c] = mv(half.f[c], st.f[c]);
+            }
             half.h = mv(half.h, st.h);
             half.limit = mv(half.limit, st.limit);
             half.ln_err_old = mv(half.ln_err_old, st.ln_err_old);
             half.rej_last = mv(half.rej_last, st.rej_last);
-            half.active = half.active.with_lane(k, ALL);
+            half.active = half.active.with_lane(k, TRUE);
             slots[k] = core::mem::replace(&mut self.slots[i], Slot::idle());
             if let Some(m) = &slots[k].member {
-                half.packed.set(k, m);
+                m.pack_lane(&mut half.packed, k);
             }
         }
         Engine {
@@ -713,46 +728,82 @@ impl<'a, V: Lanes, G: EventFunction<f64, 2>> Engine<'a, V, G> {
         }
     }
 
-    /// A lane's accepted step: events and observers, then the end or the next limit.
-    fn after_step<O: Observer<f64, 2>>(
+    /// A lane's accepted step: the driver's event handling and observer calls
+    /// ([`Scan`]), then the end, a restart where an event reset or cut the step, or the
+    /// next limit.
+    fn after_step<O: Observer<f64, M>>(
         &mut self,
         i: usize,
-        dense: &LaneDense,
+        dense: &LaneDense<M>,
         observers: &mut [O],
-        out: &mut [Option<Result<Outcome<f64, 2>>>],
+        out: &mut [Option<Result<Outcome<f64, M>>>],
     ) {
         let Some(j) = self.slots[i].job else { return };
+        let cfg = self.cfg;
         let slot = &mut self.slots[i];
         slot.stats.rhs_evals += 6;
         slot.stats.accepted += 1;
         slot.steps += 1;
         slot.nonfinite = 0;
-        let obs = &mut observers[j];
-        let res = scan(self.cfg, slot, dense, obs);
+        let (Some(m), Some(sides)) = (&slot.member, &mut slot.sides) else {
+            return;
+        };
+        let mut restart = None;
+        let res = Scan {
+            system: m,
+            events: &cfg.events,
+            zeno: &cfg.zeno,
+            event_tol: cfg.event_tol,
+            history: &mut slot.history,
+            dense,
+            stats: &mut slot.stats,
+            restart: &mut restart,
+        }
+        .scan_step(sides, &mut observers[j]);
+        let (t, y) = restart.unwrap_or((dense.t1, dense.y1));
         match res {
-            Err(e) => self.finish(i, Err(e), observers, out),
-            Ok(Some((t, y))) => {
-                self.finish(i, Ok((t, y, Termination::ObserverStopped)), observers, out)
-            }
+            Err(e) => self.finish(i, Err(e.into()), observers, out),
+            Ok(Some(termination)) => self.finish(i, Ok((t, y, termination)), observers, out),
             Ok(None) => {
+                if restart.is_some() {
+                    // The driver's stepper restarts from the event's state: its derivative
+                    // is evaluated again (one evaluation), the step and controller go on.
+                    let f = scalar_rhs(m, t, &y);
+                    slot.stats.rhs_evals += 1;
+                    if !f.iter().all(|v| v.is_finite()) {
+                        let e = IntegrateError::NonFiniteRhs { t };
+                        self.finish(i, Err(e.into()), observers, out);
+                        return;
+                    }
+                    self.st.t = self.st.t.with_lane(i, t);
+                    for c in 0..M {
+                        self.st.y[c] = self.st.y[c].with_lane(i, y[c]);
+                        self.st.f[c] = self.st.f[c].with_lane(i, f[c]);
+                    }
+                }
                 let slot = &self.slots[i];
-                let (t1, y1) = (dense.t1, dense.y1);
-                if t1 >= slot.t_end {
-                    self.finish(i, Ok((t1, y1, Termination::ReachedEnd)), observers, out);
-                } else if slot.steps >= self.cfg.max_steps {
+                if t >= slot.t_end {
+                    self.finish(i, Ok((t, y, Termination::ReachedEnd)), observers, out);
+                } else if slot.steps >= cfg.max_steps {
                     let e = IntegrateError::MaxSteps {
-                        t: t1,
-                        max_steps: self.cfg.max_steps,
+                        t,
+                        max_steps: cfg.max_steps,
                     };
                     self.finish(i, Err(e.into()), observers, out);
                 } else {
-                    // The driver computes the next landing point after every step. Short of
-                    // the current one (by more than the rounding of that computation) it
-                    // is the current one again, so it is only recomputed near or on it.
+                    // The driver computes the next limit after every step. Without a time
+                    // scale and short of the current limit (by more than the rounding of
+                    // that computation) it is the current one again, so it is then only
+                    // recomputed near or on it, or after a restart.
                     let limit = self.st.limit.lane(i);
-                    let scale = t1.abs() + slot.grid.map_or(0.0, |(o, dt)| o.abs() + dt);
-                    if limit - t1 <= 64.0 * f64::EPSILON * scale {
-                        let l = landing_limit(t1, slot.t_end, slot.grid);
+                    let scale = t.abs() + slot.grid.map_or(0.0, |(o, dt)| o.abs() + dt);
+                    if slot.scaled || restart.is_some() || limit - t <= 64.0 * f64::EPSILON * scale
+                    {
+                        let bound = match (&slot.member, slot.scaled) {
+                            (Some(m), true) => time_scale(m, &cfg.events, t),
+                            _ => None,
+                        };
+                        let l = step_limit(t, slot.t_end, slot.grid, bound);
                         self.st.limit = self.st.limit.with_lane(i, l);
                     }
                 }
@@ -761,182 +812,15 @@ impl<'a, V: Lanes, G: EventFunction<f64, 2>> Engine<'a, V, G> {
     }
 }
 
-fn non_finite(t: f64, g: f64) -> crate::Error {
-    EventError::NonFinite {
-        index: 0,
-        t,
-        value: g,
-    }
-    .into()
-}
-
-/// The driver's event scan and observer calls for one lane's step (one detection event,
-/// no reset). Returns the state to stop at if an observer stopped the run.
-fn scan<G: EventFunction<f64, 2>, O: Observer<f64, 2>>(
-    cfg: &Ensemble<G>,
-    slot: &mut Slot,
-    dense: &LaneDense,
-    obs: &mut O,
-) -> Result<Option<(f64, SVector<f64, 2>)>> {
-    let (ts0, ts1) = (dense.t0, dense.t1);
-    let (y_start, y_end) = (dense.y0, dense.y1);
-    let mut t_lo = ts0;
-    let mut y_lo = y_start;
-    let mut g_end = None;
-    if let (Some(ev), Some(m)) = (&cfg.event, &slot.member) {
-        let fun = &ev.function;
-        let g0 = fun.value(ts0, &y_start);
-        let ge = fun.value(ts1, &y_end);
-        if !(g0.is_finite() && ge.is_finite()) {
-            let (t, g) = if g0.is_finite() { (ts1, ge) } else { (ts0, g0) };
-            return Err(non_finite(t, g));
-        }
-        g_end = Some(ge);
-        if slot.side == 0 {
-            slot.side = if ge != 0.0 { sign_of(ge) } else { 1 };
-        }
-        let st_g = if g0 == 0.0 {
-            let tiny = f64::EPSILON * f64::EPSILON;
-            if slot.side < 0 { -tiny } else { tiny }
-        } else {
-            g0
-        };
-        let st_r = fun.rate(ts0, &y_start, &dense.f0);
-        let r_end = fun.rate(ts1, &y_end, &dense.f1);
-        let tol = cfg.event_tol.max(4.0 * f64::EPSILON * ts1.abs());
-        let mut found = find_crossing(fun, m, dense, tol, ts0, st_g, st_r, ts1, ge, r_end);
-        while let Some(c) = found {
-            found = match c.resume {
-                Some((tr, gr)) => find_crossing(fun, m, dense, tol, tr, gr, None, ts1, ge, r_end),
-                None => None,
-            };
-            slot.side = if c.rising { 1 } else { -1 };
-            if !ev.direction.accepts(c.rising) {
-                continue;
-            }
-            let tc = c.t;
-            let mut yc = SVector::zeros();
-            dense.interpolate_unchecked(tc, &mut yc);
-            let view = StepView {
-                t0: t_lo,
-                t1: tc,
-                y0: y_lo,
-                y1: yc,
-                dense,
-            };
-            let stop_obs = obs.on_step(&view) == Control::Stop;
-            slot.stats.events += 1;
-            if let Some((count, last)) = slot.history.push(tc, &cfg.zeno) {
-                return Err(EventError::Zeno {
-                    t: tc,
-                    count,
-                    last_interval: last,
-                    state: yc.iter().copied().collect(),
-                }
-                .into());
-            }
-            let rec = EventRecord {
-                index: 0,
-                t: tc,
-                y: yc,
-                y_after: None,
-                direction: if c.rising {
-                    Direction::Rising
-                } else {
-                    Direction::Falling
-                },
-            };
-            let stop_ev = obs.on_event(&rec) == Control::Stop;
-            if stop_obs || stop_ev {
-                return Ok(Some((tc, yc)));
-            }
-            t_lo = tc;
-            y_lo = yc;
-        }
-    }
-    let view = StepView {
-        t0: t_lo,
-        t1: ts1,
-        y0: y_lo,
-        y1: y_end,
-        dense,
-    };
-    let stop = obs.on_step(&view) == Control::Stop;
-    if let Some(ge) = g_end {
-        if ge != 0.0 {
-            slot.side = sign_of(ge);
-        }
-    }
-    Ok(stop.then_some((ts1, y_end)))
-}
-
-/// A crossing found on a step.
-#[derive(Debug, Clone, Copy)]
-struct Crossing {
+/// The scalar right-hand side of a lane's model (used where one lane is handled alone: its
+/// first derivative, the initial step, the event rates).
+#[inline(always)]
+fn scalar_rhs<D: LaneDynamics<M>, const M: usize>(
+    m: &D,
     t: f64,
-    rising: bool,
-    resume: Option<(f64, f64)>,
-}
-
-/// The earliest crossing of the event in `(t_lo, t1]`: [`Simulation`]'s search without
-/// interior samples (`drive::crossing_between`) written for `f64` — through the generic
-/// function the ensemble's throughput was 3–4 % lower.
-///
-/// [`Simulation`]: crate::drive::Simulation
-#[allow(clippy::too_many_arguments)]
-fn find_crossing<G: EventFunction<f64, 2>>(
-    ev: &G,
-    m: &Member,
-    dense: &LaneDense,
-    tol: f64,
-    t_lo: f64,
-    g_lo: f64,
-    r_lo: Option<f64>,
-    t1: f64,
-    g1: f64,
-    r1: Option<f64>,
-) -> Option<Crossing> {
-    let g_at = |t: f64| {
-        let mut y = SVector::<f64, 2>::zeros();
-        dense.interpolate_unchecked(t, &mut y);
-        ev.value(t, &y)
-    };
-    let s = sign_of(g_lo);
-    if g1 != 0.0 && sign_of(g1) != s {
-        let (tc, _) = locate(g_at, t_lo, t1, g_lo, g1, tol);
-        return Some(Crossing {
-            t: tc,
-            rising: g1 > 0.0,
-            resume: None,
-        });
-    }
-    let r_lo = match r_lo {
-        Some(r) => Some(r),
-        None => {
-            let mut y = SVector::zeros();
-            dense.interpolate_unchecked(t_lo, &mut y);
-            let f = scalar_rhs(m, t_lo, &y);
-            ev.rate(t_lo, &y, &f)
-        }
-    };
-    let (Some(r_lo), Some(r1)) = (r_lo, r1) else {
-        return None;
-    };
-    let towards = if s > 0 { r_lo < 0.0 } else { r_lo > 0.0 };
-    let away = if s > 0 { r1 > 0.0 } else { r1 < 0.0 };
-    if !(towards && (away || g1 == 0.0)) {
-        return None;
-    }
-    let sg = if s > 0 { 1.0 } else { -1.0 };
-    let (te, neg) = crate::roots::golden_max(|t| -sg * g_at(t), t_lo, t1, tol);
-    let ge = -neg * sg;
-    if ge == 0.0 || sign_of(ge) == s {
-        return None;
-    }
-    let (tc, _) = locate(g_at, t_lo, te, g_lo, ge, tol);
-    Some(Crossing {
-        t: tc,
-        rising: ge > 0.0,
-        resume: Some((te, ge)),
-    })
+    y: &SVector<f64, M>,
+) -> SVector<f64, M> {
+    let mut dy = SVector::zeros();
+    m.rhs(t, y, &mut dy);
+    dy
 }

@@ -43,7 +43,7 @@ pub fn tle_independent<V: Lanes>(
 ) -> Result<Vec<DiagramPoint<f64>>> {
     estimate(members, y0, d0, norm, settings, |jobs| {
         let mut obs = vec![(); jobs.len()];
-        ensemble.run::<V, _>(jobs, &mut obs)
+        ensemble.run::<V, _, _>(jobs, &mut obs)
     })
 }
 
@@ -64,7 +64,7 @@ pub fn tle_independent_parallel<V: Lanes>(
 ) -> Result<Vec<DiagramPoint<f64>>> {
     estimate(members, y0, d0, norm, settings, |jobs| {
         let mut obs = vec![(); jobs.len()];
-        ensemble.run_parallel::<V, _>(jobs, &mut obs, chunk)
+        ensemble.run_parallel::<V, _, _>(jobs, &mut obs, chunk)
     })
 }
 

@@ -102,7 +102,7 @@
 //!     .map(|i| MemberRun::periods(Member::paper(17.5 + i as f64)?, y0, 5.0))
 //!     .collect::<nonsmooth::Result<_>>()?;
 //! let mut observers = vec![(); jobs.len()];
-//! let out = Ensemble::new(tol)?.run::<F64x4, _>(&jobs, &mut observers)?;
+//! let out = Ensemble::new(tol)?.run::<F64x4, _, _>(&jobs, &mut observers)?;
 //! // The same as the scalar path, to the bit.
 //! let j = &jobs[3];
 //! let scalar = Simulation::new(*j.member.scalar(), Dopri5::new(tol))
@@ -114,21 +114,16 @@
 
 mod engine;
 mod kernel;
-mod lanes;
 mod lyapunov;
-pub mod math;
 mod model;
-mod simd;
 mod sweep;
 
+pub use crate::lanes::{F64x2, F64x4, F64x8, F64x16, LaneMath, Lanes, Simd};
 pub use engine::{Ensemble, LaneDense, MemberRun};
-pub use lanes::{F64x2, F64x4, F64x8, F64x16, Lanes};
 pub use lyapunov::tle_independent;
 #[cfg(feature = "parallel")]
 pub use lyapunov::tle_independent_parallel;
-pub use math::LaneMath;
 pub use model::Member;
-pub use simd::Simd;
 #[cfg(feature = "parallel")]
 pub use sweep::sweep_independent_parallel;
 pub use sweep::{IndependentSweep, sweep_independent, sweep_starts};

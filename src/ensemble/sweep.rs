@@ -312,11 +312,11 @@ fn run_starts<V: Lanes>(
     }
     if !jobs.is_empty() {
         let out = match chunk {
-            None => e.run::<V, _>(&jobs, &mut obs),
+            None => e.run::<V, _, _>(&jobs, &mut obs),
             #[cfg(feature = "parallel")]
-            Some(c) => e.run_parallel::<V, _>(&jobs, &mut obs, c),
+            Some(c) => e.run_parallel::<V, _, _>(&jobs, &mut obs, c),
             #[cfg(not(feature = "parallel"))]
-            Some(_) => e.run::<V, _>(&jobs, &mut obs),
+            Some(_) => e.run::<V, _, _>(&jobs, &mut obs),
         }
         .map_err(batch_error)?;
         for ((k, o), r) in slot.into_iter().zip(&obs).zip(out) {

@@ -1,5 +1,7 @@
 //! Compliant contact: the generalized Hertz law with nonlinear damping.
 
+use crate::lanes::math::pow_masked;
+use crate::lanes::{LaneMath, Lanes, mask};
 use crate::scalar::{Exponent, lit};
 use crate::validate::ParameterError;
 use crate::validate::{finite, non_negative, positive};
@@ -310,6 +312,148 @@ impl<T: Real> ForceLaw<T> for HertzContact<T> {
             }
         };
         (clamp(self.k_i * fd), clamp(self.k_i * fw))
+    }
+}
+
+/// An [`Exponent`] per lane: masks of its kind and its value.
+#[derive(Debug, Clone, Copy)]
+pub struct ExponentLanes<V> {
+    one: V,
+    three_halves: V,
+    two: V,
+    general: V,
+    p: V,
+}
+
+impl<V: Lanes> ExponentLanes<V> {
+    fn zero() -> Self {
+        let z = V::splat(0.0);
+        Self {
+            one: z,
+            three_halves: z,
+            two: z,
+            general: z,
+            p: z,
+        }
+    }
+
+    fn set(&mut self, i: usize, e: Exponent<f64>) {
+        self.one = self.one.with_lane(i, mask(e == Exponent::One));
+        self.three_halves = self
+            .three_halves
+            .with_lane(i, mask(e == Exponent::ThreeHalves));
+        self.two = self.two.with_lane(i, mask(e == Exponent::Two));
+        self.general = self
+            .general
+            .with_lane(i, mask(matches!(e, Exponent::General(_))));
+        self.p = self.p.with_lane(i, e.value());
+    }
+
+    /// `d^p` where `inside` (`d > 0`), 0 elsewhere: [`Exponent::pow`] lane by lane (the
+    /// general power only if some lane needs it).
+    #[inline(always)]
+    fn pow(&self, math: LaneMath, inside: V, d: V) -> V {
+        let z = V::splat(0.0);
+        let ds = inside.select(d, V::splat(1.0));
+        let mut v = self.three_halves.select(d * ds.sqrt(), z);
+        v = self.one.select(d, v);
+        v = self.two.select(d * d, v);
+        let g = self.general & inside;
+        if g.bits() != 0 {
+            v = g.select(pow_masked(math, g, ds, self.p), v);
+        }
+        inside.select(v, z)
+    }
+}
+
+/// The parameters of [`HertzContact`] per lane.
+#[derive(Debug, Clone, Copy)]
+pub struct HertzLanes<V> {
+    x_i: V,
+    lower: V,
+    k_i: V,
+    b: V,
+    b_zero: V,
+    n1: ExponentLanes<V>,
+    n2: ExponentLanes<V>,
+    n2_is_n1: V,
+    n3: V,
+    half_n3m1: V,
+    eta2: V,
+    eta_pos: V,
+}
+
+impl super::LaneLaw for HertzContact<f64> {
+    type Packed<V: Lanes> = HertzLanes<V>;
+    fn pack<V: Lanes>(&self) -> HertzLanes<V> {
+        let z = V::splat(0.0);
+        let mut p = HertzLanes {
+            x_i: z,
+            lower: z,
+            k_i: z,
+            b: z,
+            b_zero: z,
+            n1: ExponentLanes::zero(),
+            n2: ExponentLanes::zero(),
+            n2_is_n1: z,
+            n3: z,
+            half_n3m1: z,
+            eta2: z,
+            eta_pos: z,
+        };
+        for i in 0..V::LANES {
+            self.pack_lane(&mut p, i);
+        }
+        p
+    }
+    fn pack_lane<V: Lanes>(&self, p: &mut HertzLanes<V>, i: usize) {
+        p.x_i = p.x_i.with_lane(i, self.x_i);
+        p.lower = p.lower.with_lane(i, mask(self.side == Side::Lower));
+        p.k_i = p.k_i.with_lane(i, self.k_i);
+        p.b = p.b.with_lane(i, self.b);
+        p.b_zero = p.b_zero.with_lane(i, mask(self.b == 0.0));
+        p.n1.set(i, self.n1);
+        p.n2.set(i, self.n2);
+        p.n2_is_n1 = p.n2_is_n1.with_lane(i, mask(self.n1 == self.n2));
+        p.n3 = p.n3.with_lane(i, self.n3);
+        p.half_n3m1 = p.half_n3m1.with_lane(i, self.half_n3_minus_1);
+        p.eta2 = p.eta2.with_lane(i, self.eta * self.eta);
+        p.eta_pos = p.eta_pos.with_lane(i, mask(self.eta > 0.0));
+    }
+    /// The scalar law's terms in its order; lanes out of contact cost a compare (and
+    /// nothing more when no lane is in contact).
+    #[inline(always)]
+    fn force_lanes<V: Lanes>(p: &HertzLanes<V>, math: LaneMath, x: V, v: V) -> V {
+        let z = V::splat(0.0);
+        // The penetration and its rate: (x − x_I, v) above, (x_I − x, −v) below.
+        let d = p.lower.select(p.x_i - x, x - p.x_i);
+        let inside = !d.le(z);
+        if inside.bits() == 0 {
+            return z;
+        }
+        let w = p.lower.select(-v, v);
+        let p1 = p.n1.pow(math, inside, d);
+        let p2 = if (p.n2_is_n1 & inside).bits() == inside.bits() {
+            p1
+        } else {
+            p.n2_is_n1.select(p1, p.n2.pow(math, inside, d))
+        };
+        // g(w): w·(w²+η²)^{(n3−1)/2} for η > 0, sgn(w)|w|^{n3} for η = 0.
+        let damped = inside & !p.b_zero;
+        let s = w * w + p.eta2;
+        let reg = damped & p.eta_pos;
+        let g_reg = w * pow_masked(math, reg, s, p.half_n3m1);
+        let exact = damped & !p.eta_pos & !w.eq(z);
+        let g = if exact.bits() == 0 {
+            g_reg
+        } else {
+            let m = pow_masked(math, exact, w.abs(), p.n3);
+            let g_ex = w.gt(z).select(m, -m);
+            exact.select(g_ex, p.eta_pos.select(g_reg, z))
+        };
+        let f = p.b_zero.select(p1, p1 + p.b * p2 * g);
+        let kf = p.k_i * f;
+        (inside & !f.le(z)).select(p.lower.select(-p.k_i * f, kf), z)
     }
 }
 

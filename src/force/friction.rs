@@ -1,5 +1,6 @@
 //! Regularized dry (Coulomb) friction.
 
+use crate::lanes::{LaneMath, Lanes, mask};
 use crate::validate::ParameterError;
 use crate::validate::{non_negative, normal_square, positive};
 use crate::{ForceLaw, Real};
@@ -137,6 +138,63 @@ impl<T: Real> ForceLaw<T> for DryFriction<T> {
             }
         };
         (T::zero(), dv)
+    }
+}
+
+/// `(T, ε, ε², tanh mask)` per lane.
+#[derive(Debug, Clone, Copy)]
+pub struct DryFrictionLanes<V> {
+    t: V,
+    eps: V,
+    eps2: V,
+    tanh: V,
+}
+
+impl super::LaneLaw for DryFriction<f64> {
+    type Packed<V: Lanes> = DryFrictionLanes<V>;
+    fn pack<V: Lanes>(&self) -> DryFrictionLanes<V> {
+        let z = V::splat(0.0);
+        let mut p = DryFrictionLanes {
+            t: z,
+            eps: z,
+            eps2: z,
+            tanh: z,
+        };
+        for i in 0..V::LANES {
+            self.pack_lane(&mut p, i);
+        }
+        p
+    }
+    fn pack_lane<V: Lanes>(&self, p: &mut DryFrictionLanes<V>, lane: usize) {
+        p.t = p.t.with_lane(lane, self.t);
+        p.eps = p.eps.with_lane(lane, self.eps);
+        p.eps2 = p.eps2.with_lane(lane, self.eps * self.eps);
+        p.tanh = p
+            .tanh
+            .with_lane(lane, mask(self.reg == Regularization::Tanh));
+    }
+    /// The scalar law's operations; its overflow branch (`v/hypot(v, ε)`) and the `tanh`
+    /// form are evaluated lane by lane for the lanes that need them.
+    #[inline(always)]
+    fn force_lanes<V: Lanes>(p: &DryFrictionLanes<V>, _math: LaneMath, _x: V, v: V) -> V {
+        let s = v * v + p.eps2;
+        let mut f = p.t * v / s.sqrt();
+        let slow = p.tanh | !(s.finite() & f.finite());
+        let bits = slow.bits();
+        if bits != 0 {
+            for i in 0..V::LANES {
+                if bits & (1 << i) != 0 {
+                    let (t, eps, vi) = (p.t.lane(i), p.eps.lane(i), v.lane(i));
+                    let fi = if p.tanh.lane(i) != 0.0 {
+                        t * (vi / eps).tanh()
+                    } else {
+                        t * (vi / vi.hypot(eps))
+                    };
+                    f = f.with_lane(i, fi);
+                }
+            }
+        }
+        f
     }
 }
 

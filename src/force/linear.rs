@@ -1,5 +1,6 @@
 //! Linear spring and viscous damper.
 
+use crate::lanes::{LaneMath, Lanes};
 use crate::validate::ParameterError;
 use crate::validate::non_negative;
 use crate::{ForceLaw, Real};
@@ -109,6 +110,37 @@ impl<T: Real> ForceLaw<T> for ViscousDamper<T> {
     #[inline(always)]
     fn partials(&self, _x: T, _v: T) -> (T, T) {
         (T::zero(), self.c)
+    }
+}
+
+impl super::LaneLaw for LinearSpring<f64> {
+    /// `(k, x0)` per lane.
+    type Packed<V: Lanes> = (V, V);
+    fn pack<V: Lanes>(&self) -> (V, V) {
+        (V::splat(self.k), V::splat(self.x0))
+    }
+    fn pack_lane<V: Lanes>(&self, p: &mut (V, V), lane: usize) {
+        p.0 = p.0.with_lane(lane, self.k);
+        p.1 = p.1.with_lane(lane, self.x0);
+    }
+    #[inline(always)]
+    fn force_lanes<V: Lanes>(p: &(V, V), _math: LaneMath, x: V, _v: V) -> V {
+        p.0 * (x - p.1)
+    }
+}
+
+impl super::LaneLaw for ViscousDamper<f64> {
+    /// `c` per lane.
+    type Packed<V: Lanes> = V;
+    fn pack<V: Lanes>(&self) -> V {
+        V::splat(self.c)
+    }
+    fn pack_lane<V: Lanes>(&self, p: &mut V, lane: usize) {
+        *p = p.with_lane(lane, self.c);
+    }
+    #[inline(always)]
+    fn force_lanes<V: Lanes>(p: &V, _math: LaneMath, _x: V, v: V) -> V {
+        *p * v
     }
 }
 

@@ -39,13 +39,14 @@ mod linear;
 mod piecewise;
 mod polynomial;
 
-pub use contact::{HertzContact, Side};
-pub use friction::{DryFriction, Regularization};
+pub use contact::{ExponentLanes, HertzContact, HertzLanes, Side};
+pub use friction::{DryFriction, DryFrictionLanes, Regularization};
 pub use linear::{LinearSpring, ViscousDamper};
 pub use piecewise::Bilinear;
 pub use polynomial::{CubicSpring, Polynomial};
 
 use crate::Real;
+use crate::lanes::{LaneMath, Lanes};
 use crate::scalar::{epsilon, lit};
 
 /// A force term `F(x, ẋ)` on the left-hand side of `m·ẍ + ΣF = f(t)`.
@@ -87,6 +88,106 @@ pub trait ForceLaw<T: Real> {
         None
     }
 }
+
+/// The lane form of a [`ForceLaw`]: the force of `L` laws of the same type at once, one
+/// per lane of a [`Lanes`] vector, each lane with its own parameters (what lets a model
+/// built from the law run in the ensemble's SIMD lanes,
+/// [`ensemble`](crate::ensemble)).
+///
+/// Every built-in law implements it, and so do `()`, [`Sum`] and tuples of lane laws. The
+/// parameters are *packed*: [`pack`](Self::pack) sets every lane to `self`,
+/// [`pack_lane`](Self::pack_lane) one lane; [`force_lanes`](Self::force_lanes) evaluates
+/// them. A branch of the scalar law becomes a mask and [`Lanes::select`] (see
+/// [`lanes`](crate::lanes)).
+///
+/// # Contract
+/// In every lane `i`, `force_lanes` returns [`force`](ForceLaw::force) of the law packed
+/// into lane `i` at that lane's `(x, v)`. With [`LaneMath::Exact`] the built-in laws
+/// perform the scalar operations in the scalar order: the value is the scalar one to the
+/// bit (tested per law over free, contact and sticking states). A law of one's own that
+/// cannot promise that still runs in lanes through [`LaneByLane`](crate::LaneByLane).
+///
+/// ```
+/// use nonsmooth::force::{LaneLaw, LinearSpring, ViscousDamper};
+/// use nonsmooth::lanes::{F64x4, LaneMath, Lanes};
+/// use nonsmooth::ForceLaw;
+///
+/// let law = (LinearSpring::new(2.0)?, ViscousDamper::new(0.5)?);
+/// let mut p = law.pack::<F64x4>();
+/// (LinearSpring::new(3.0)?, ViscousDamper::new(0.5)?).pack_lane(&mut p, 1);
+/// let x = F64x4::splat(1.0);
+/// let v = F64x4::splat(2.0);
+/// let f = <(LinearSpring<f64>, ViscousDamper<f64>)>::force_lanes(&p, LaneMath::Exact, x, v);
+/// assert_eq!(f.lane(0), law.force(1.0, 2.0));
+/// assert_eq!(f.lane(1), 3.0 + 1.0);
+/// # Ok::<(), nonsmooth::ParameterError>(())
+/// ```
+pub trait LaneLaw: ForceLaw<f64> {
+    /// The law's parameters in `L` lanes.
+    type Packed<V: Lanes>: Copy + core::fmt::Debug + Send + Sync;
+
+    /// Every lane set to this law.
+    fn pack<V: Lanes>(&self) -> Self::Packed<V>;
+
+    /// Lane `lane` of `packed` set to this law (the other lanes unchanged).
+    fn pack_lane<V: Lanes>(&self, packed: &mut Self::Packed<V>, lane: usize);
+
+    /// The force in every lane at `(x, v)`.
+    fn force_lanes<V: Lanes>(packed: &Self::Packed<V>, math: LaneMath, x: V, v: V) -> V;
+}
+
+impl LaneLaw for () {
+    type Packed<V: Lanes> = ();
+    fn pack<V: Lanes>(&self) {}
+    fn pack_lane<V: Lanes>(&self, _packed: &mut (), _lane: usize) {}
+    #[inline(always)]
+    fn force_lanes<V: Lanes>(_packed: &(), _math: LaneMath, _x: V, _v: V) -> V {
+        V::splat(0.0)
+    }
+}
+
+impl<A: LaneLaw, B: LaneLaw> LaneLaw for Sum<A, B> {
+    type Packed<V: Lanes> = (A::Packed<V>, B::Packed<V>);
+    fn pack<V: Lanes>(&self) -> Self::Packed<V> {
+        (self.0.pack(), self.1.pack())
+    }
+    fn pack_lane<V: Lanes>(&self, packed: &mut Self::Packed<V>, lane: usize) {
+        self.0.pack_lane(&mut packed.0, lane);
+        self.1.pack_lane(&mut packed.1, lane);
+    }
+    #[inline(always)]
+    fn force_lanes<V: Lanes>(packed: &Self::Packed<V>, math: LaneMath, x: V, v: V) -> V {
+        A::force_lanes(&packed.0, math, x, v) + B::force_lanes(&packed.1, math, x, v)
+    }
+}
+
+macro_rules! tuple_lane_law {
+    ($($name:ident $idx:tt),+) => {
+        impl<$($name: LaneLaw),+> LaneLaw for ($($name,)+) {
+            type Packed<V: Lanes> = ($($name::Packed<V>,)+);
+            fn pack<V: Lanes>(&self) -> Self::Packed<V> {
+                ($(self.$idx.pack(),)+)
+            }
+            fn pack_lane<V: Lanes>(&self, packed: &mut Self::Packed<V>, lane: usize) {
+                $(self.$idx.pack_lane(&mut packed.$idx, lane);)+
+            }
+            /// The terms summed from `0` in order, as [`ForceLaw::force`] of the tuple.
+            #[inline(always)]
+            fn force_lanes<V: Lanes>(packed: &Self::Packed<V>, math: LaneMath, x: V, v: V) -> V {
+                V::splat(0.0) $(+ $name::force_lanes(&packed.$idx, math, x, v))+
+            }
+        }
+    };
+}
+
+tuple_lane_law!(A 0);
+tuple_lane_law!(A 0, B 1);
+tuple_lane_law!(A 0, B 1, C 2);
+tuple_lane_law!(A 0, B 1, C 2, D 3);
+tuple_lane_law!(A 0, B 1, C 2, D 3, E 4);
+tuple_lane_law!(A 0, B 1, C 2, D 3, E 4, F 5);
+tuple_lane_law!(A 0, B 1, C 2, D 3, E 4, F 5, G 6);
+tuple_lane_law!(A 0, B 1, C 2, D 3, E 4, F 5, G 6, H 7);
 
 /// The onset of a contact force: `F ∝ δ^n` near `δ = 0⁺`, with the penetration
 /// `δ = x − x_I` ([`Side::Upper`]) or `δ = x_I − x` ([`Side::Lower`]), and no force for

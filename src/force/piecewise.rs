@@ -1,5 +1,6 @@
 //! Piecewise-linear stiffness with a gap: backlash (dead zone) and bilinear stops.
 
+use crate::lanes::{LaneMath, Lanes};
 use crate::validate::ParameterError;
 use crate::validate::non_negative;
 use crate::{ForceLaw, Real};
@@ -124,6 +125,32 @@ impl<T: Real> ForceLaw<T> for Bilinear<T> {
         } else {
             (self.k_in, T::zero())
         }
+    }
+}
+
+impl super::LaneLaw for Bilinear<f64> {
+    /// `(k_in, k_out, lo, hi)` per lane.
+    type Packed<V: Lanes> = [V; 4];
+    fn pack<V: Lanes>(&self) -> [V; 4] {
+        [self.k_in, self.k_out, self.lo, self.hi].map(V::splat)
+    }
+    fn pack_lane<V: Lanes>(&self, p: &mut [V; 4], lane: usize) {
+        for (v, x) in p.iter_mut().zip([self.k_in, self.k_out, self.lo, self.hi]) {
+            *v = v.with_lane(lane, x);
+        }
+    }
+    #[inline(always)]
+    fn force_lanes<V: Lanes>(p: &[V; 4], _math: LaneMath, x: V, _v: V) -> V {
+        let [k_in, k_out, lo, hi] = *p;
+        let zero = V::splat(0.0);
+        let above = x - hi;
+        let below = lo - x;
+        let f = k_in * x;
+        // The scalar branches: above the upper limit, else below the lower one.
+        let up = above.gt(zero);
+        let down = !up & below.gt(zero);
+        let f = up.select(f + k_out * above, f);
+        down.select(f - k_out * below, f)
     }
 }
 

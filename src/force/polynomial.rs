@@ -1,5 +1,6 @@
 //! Polynomial springs: the cubic (Duffing) spring and any polynomial stiffness.
 
+use crate::lanes::{LaneMath, Lanes};
 use crate::validate::ParameterError;
 use crate::validate::finite;
 use crate::{ForceLaw, Real};
@@ -156,6 +157,47 @@ impl<T: Real, const D: usize> ForceLaw<T> for Polynomial<T, D> {
             acc = acc * u + c * crate::scalar::lit::<T>((i + 1) as f64);
         }
         (acc, T::zero())
+    }
+}
+
+impl super::LaneLaw for CubicSpring<f64> {
+    /// `(k₁, k₃, x₀)` per lane.
+    type Packed<V: Lanes> = [V; 3];
+    fn pack<V: Lanes>(&self) -> [V; 3] {
+        [self.k1, self.k3, self.x0].map(V::splat)
+    }
+    fn pack_lane<V: Lanes>(&self, p: &mut [V; 3], lane: usize) {
+        for (v, x) in p.iter_mut().zip([self.k1, self.k3, self.x0]) {
+            *v = v.with_lane(lane, x);
+        }
+    }
+    #[inline(always)]
+    fn force_lanes<V: Lanes>(p: &[V; 3], _math: LaneMath, x: V, _v: V) -> V {
+        let u = x - p[2];
+        u * (p[0] + p[1] * u * u)
+    }
+}
+
+impl<const D: usize> super::LaneLaw for Polynomial<f64, D> {
+    /// The coefficients and `x₀` per lane.
+    type Packed<V: Lanes> = ([V; D], V);
+    fn pack<V: Lanes>(&self) -> ([V; D], V) {
+        (self.c.map(V::splat), V::splat(self.x0))
+    }
+    fn pack_lane<V: Lanes>(&self, p: &mut ([V; D], V), lane: usize) {
+        for (v, &c) in p.0.iter_mut().zip(&self.c) {
+            *v = v.with_lane(lane, c);
+        }
+        p.1 = p.1.with_lane(lane, self.x0);
+    }
+    #[inline(always)]
+    fn force_lanes<V: Lanes>(p: &([V; D], V), _math: LaneMath, x: V, _v: V) -> V {
+        let u = x - p.1;
+        let mut acc = V::splat(0.0);
+        for &c in p.0.iter().rev() {
+            acc = acc * u + c;
+        }
+        acc * u
     }
 }
 

@@ -10,6 +10,9 @@ use crate::validate::ParameterError;
 use crate::validate::finite;
 use crate::{Dynamics, ForceLaw, Real};
 
+mod lanes;
+pub use lanes::{LaneElements, LaneLoads, MechanicalLanes, MechanicalPacked};
+
 /// Why a model could not be assembled or analysed.
 #[derive(Debug, Clone, PartialEq, Error)]
 #[non_exhaustive]

@@ -16,5 +16,8 @@ mod mechanical;
 mod oscillator;
 
 pub(crate) use mechanical::shorter;
-pub use mechanical::{Coordinate, Element, Elements, Load, Loads, Mechanical, ModelError};
+pub use mechanical::{
+    Coordinate, Element, Elements, LaneElements, LaneLoads, Load, Loads, Mechanical,
+    MechanicalLanes, MechanicalPacked, ModelError,
+};
 pub use oscillator::Oscillator;

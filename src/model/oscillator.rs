@@ -193,6 +193,47 @@ where
     }
 }
 
+/// The lane form: the one-DOF [`Mechanical`] the oscillator is (its right-hand side is
+/// the same to the bit, and so is the lane form's, lane by lane).
+impl<L, E> crate::LaneDynamics<2> for Oscillator<f64, L, E>
+where
+    L: crate::force::LaneLaw + Clone + core::fmt::Debug + Send + Sync,
+    E: crate::excite::LaneExcitation + Clone + core::fmt::Debug + Send + Sync,
+{
+    type Packed<V: crate::lanes::Lanes> =
+        crate::model::MechanicalPacked<V, 1, Element<f64, 1, L>, Load<f64, 1, E>>;
+    type Time<V: crate::lanes::Lanes> = [V; 1];
+
+    fn pack<V: crate::lanes::Lanes>(&self) -> Self::Packed<V> {
+        <OneDof<f64, L, E> as crate::LaneDynamics<2>>::pack(&self.model)
+    }
+    fn pack_lane<V: crate::lanes::Lanes>(&self, packed: &mut Self::Packed<V>, lane: usize) {
+        <OneDof<f64, L, E> as crate::LaneDynamics<2>>::pack_lane(&self.model, packed, lane)
+    }
+    fn same_structure(&self, other: &Self) -> bool {
+        <OneDof<f64, L, E> as crate::LaneDynamics<2>>::same_structure(&self.model, &other.model)
+    }
+    #[inline(always)]
+    fn time_lanes<V: crate::lanes::Lanes>(
+        packed: &Self::Packed<V>,
+        math: crate::lanes::LaneMath,
+        t: V,
+    ) -> [V; 1] {
+        <OneDof<f64, L, E> as crate::LaneDynamics<2>>::time_lanes(packed, math, t)
+    }
+    #[inline(always)]
+    fn rhs_lanes<V: crate::lanes::Lanes>(
+        packed: &Self::Packed<V>,
+        math: crate::lanes::LaneMath,
+        t: V,
+        time: &[V; 1],
+        y: &[V; 2],
+        dy: &mut [V; 2],
+    ) {
+        <OneDof<f64, L, E> as crate::LaneDynamics<2>>::rhs_lanes(packed, math, t, time, y, dy)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

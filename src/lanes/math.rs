@@ -1,4 +1,4 @@
-//! Lane forms of the math functions of the built-in laws: `sin` of the forcing, `exp` and
+//! Lane forms of the math functions of the built-in parts: `sin` of the forcing, `exp` and
 //! `ln` of the contact law's exponents and of the step-size controller.
 //!
 //! # `sin`
@@ -124,7 +124,7 @@ pub fn ln<V: Lanes>(math: LaneMath, x: V) -> V {
 /// `e^{c·ln x}` in the lanes of `mask` (others: 0); `Exact` calls the platform's
 /// functions only for those lanes.
 #[inline(always)]
-pub(crate) fn pow_masked<V: Lanes>(math: LaneMath, mask: V, x: V, c: V) -> V {
+pub fn pow_masked<V: Lanes>(math: LaneMath, mask: V, x: V, c: V) -> V {
     match math {
         LaneMath::Exact => {
             let bits = mask.bits();

@@ -4,13 +4,9 @@ use core::fmt::Debug;
 use core::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
 
 pub(crate) mod sealed {
-    use super::super::kernel::{LaneState, StepConsts, StepOut};
-
-    /// What only the crate's lane types provide: the vector step of the ensemble, compiled
-    /// once in this crate per lane type (see [`kernel`](super::super::kernel)).
+    /// What only the crate's lane types provide: bit operations the vector math relies on
+    /// (and the seal: every operation of a lane type must be lane-wise and IEEE-exact).
     pub trait Sealed: Sized {
-        /// One trial step in every lane ([`kernel::step`](super::super::kernel::step)).
-        fn step_lanes(st: &mut LaneState<Self>, k: &StepConsts, out: &mut StepOut);
         /// `2^k` from `y = k + 1.5·2⁵²` (`k` an integer in `[−1022, 1023]`, held in the low
         /// bits of `y`): the bits `(bits(y) + 1023) << 52`, lane-wise.
         fn pow2_from_rounded(self) -> Self;
@@ -22,14 +18,17 @@ pub(crate) mod sealed {
     }
 }
 
-/// `L` lanes of `f64`: [`F64x2`], [`F64x4`] (the default) and [`F64x8`].
+/// `L` lanes of `f64`: [`F64x2`], [`F64x4`], [`F64x8`] and [`F64x16`].
 ///
 /// Every operation acts lane by lane; comparisons return a *mask* of the same type (all
 /// bits set where true, zero where false), which [`Lanes::select`] consumes. The types
 /// compile to one register per vector where the instruction set in use has one (`F64x4`
 /// on AVX2, `F64x8` on AVX-512F), and to pairs of narrower registers otherwise; the
 /// ensemble picks the instruction set at run time ([`Simd`](super::Simd)). The trait is
-/// sealed: the engine relies on each operation being lane-wise and IEEE-exact.
+/// sealed: the engine relies on each operation being lane-wise and IEEE-exact. Lane forms
+/// of force laws, excitations and models ([`LaneLaw`](crate::force::LaneLaw),
+/// [`LaneExcitation`](crate::excite::LaneExcitation),
+/// [`LaneDynamics`](crate::LaneDynamics)) are written with these operations.
 pub trait Lanes:
     Copy
     + Send
@@ -184,16 +183,6 @@ macro_rules! lanes_type {
         }
 
         impl sealed::Sealed for $name {
-            // Not inlined: the step is compiled here, once per lane type, and not again in
-            // every crate or for every observer that runs an ensemble.
-            #[inline(never)]
-            fn step_lanes(
-                st: &mut super::kernel::LaneState<Self>,
-                k: &super::kernel::StepConsts,
-                out: &mut super::kernel::StepOut,
-            ) {
-                super::kernel::step(st, k, out)
-            }
             #[inline(always)]
             fn pow2_from_rounded(self) -> Self {
                 self.map(|y| f64::from_bits(y.to_bits().wrapping_add(1023) << 52))

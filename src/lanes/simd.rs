@@ -7,7 +7,7 @@
 /// `RUSTFLAGS` says otherwise), with AVX2 and FMA enabled, and with AVX-512F enabled (the
 /// `pulp` crate's `V3` and `V4` tokens, created only where the CPU has the features, run
 /// the inlined loop under those target features without `unsafe` in this crate). At
-/// the start of every [`Ensemble::run`](super::Ensemble::run) the variant is picked by
+/// the start of every [`Ensemble::run`](crate::ensemble::Ensemble::run) the variant is picked by
 /// [`resolve`](Self::resolve): [`Simd::Auto`] (the default) takes the widest the CPU
 /// reports (`is_x86_feature_detected!`); on other architectures there is only the
 /// baseline. The default build therefore gets the AVX2 or AVX-512 code without

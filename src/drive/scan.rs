@@ -1,0 +1,570 @@
+//! The driver's event handling after a step: every event's crossings on the step's dense
+//! output in time order, their records, resets, restarts and terminal stops, the sticking
+//! check, and the observer's view of the step. [`Simulation`](super::Simulation) runs it
+//! after each step of its stepper, and the ensemble after each accepted step of each lane
+//! ([`ensemble`](crate::ensemble)): one implementation of the event contract for both.
+
+use nalgebra::SVector;
+
+use super::error::Result;
+use super::{Control, EventRecord, Observer, RunError, StepView, Termination};
+use crate::event::{Direction, EventError, EventHistory, EventSet, MAX_EVENTS, ZenoGuard, locate};
+use crate::integrate::{DenseOutput, Stats};
+use crate::scalar::{lit, to_f64};
+use crate::{Dynamics, Real};
+
+/// The event handling of one step of one trajectory: the system and events, the Zeno
+/// guard and history, the step's dense output, and where its work and a restart go.
+///
+/// A reset, a restart, a terminal event or an error at an event leaves the state the
+/// trajectory continues from (or stops at) in `restart`; the caller moves its stepper
+/// there. The events and right-hand side evaluations made here are added to `stats`.
+pub(crate) struct Scan<'a, T: Real, const N: usize, S, E, D> {
+    pub(crate) system: &'a S,
+    pub(crate) events: &'a E,
+    pub(crate) zeno: &'a ZenoGuard<T>,
+    pub(crate) event_tol: T,
+    pub(crate) history: &'a mut EventHistory<T>,
+    pub(crate) dense: &'a D,
+    pub(crate) stats: &'a mut Stats,
+    pub(crate) restart: &'a mut Option<(T, SVector<T, N>)>,
+}
+
+/// Each event's side at the current state, every event armed.
+pub(crate) fn initial_sides<T: Real, const N: usize, S: Dynamics<T, N>, E: EventSet<T, N>>(
+    system: &S,
+    events: &E,
+    t: T,
+    y: &SVector<T, N>,
+) -> Result<Sides> {
+    let mut sides = Sides {
+        side: [0; MAX_EVENTS],
+        armed: [true; MAX_EVENTS],
+    };
+    let mut f = SVector::zeros();
+    let mut have_f = false;
+    for (i, s) in sides.side.iter_mut().enumerate().take(E::LEN) {
+        let g = events.value(i, t, y);
+        if !g.is_finite() {
+            return Err(non_finite(i, t, g));
+        }
+        *s = sign_of(g);
+        if *s == 0 {
+            // Start on the surface: it has not been crossed; the side is the one
+            // the trajectory moves to (from the rate, else from the first step).
+            if !have_f {
+                system.rhs(t, y, &mut f);
+                have_f = true;
+            }
+            if let Some(r) = events.rate(i, t, y, &f) {
+                *s = sign_of(r);
+            }
+        }
+    }
+    Ok(sides)
+}
+
+impl<T: Real, const N: usize, S: Dynamics<T, N>, E: EventSet<T, N>, D: DenseOutput<T, N>>
+    Scan<'_, T, N, S, E, D>
+{
+    /// The events and observer calls of the step just taken: its crossings in time order
+    /// ([`crossings`](Self::crossings)), the sticking check, then the observer's view of
+    /// the rest of the step. Returns how the run ends, if it ends here.
+    pub(crate) fn scan_step<O: Observer<T, N>>(
+        &mut self,
+        sides: &mut Sides,
+        observer: &mut O,
+    ) -> Result<Option<Termination>> {
+        let mut scan = self.start_scan(sides)?;
+        let (t_lo, y_lo) = match self.crossings(&mut scan, sides, observer)? {
+            Crossings::Through(t_lo, y_lo) => (t_lo, y_lo),
+            // The state was reset or cut at an event: the next step starts there.
+            Crossings::Cut => return Ok(None),
+            Crossings::End(t) => return Ok(Some(t)),
+        };
+        self.check_sticking(&scan, sides, t_lo, y_lo, observer)?;
+        let dense = self.dense;
+        let view = StepView {
+            t0: t_lo,
+            t1: scan.t1,
+            y0: y_lo,
+            y1: scan.y1,
+            dense,
+        };
+        let stop = observer.on_step(&view) == Control::Stop;
+        for (i, s) in sides.side.iter_mut().enumerate().take(E::LEN) {
+            if scan.g_end[i] != T::zero() {
+                *s = sign_of(scan.g_end[i]);
+            }
+        }
+        Ok(stop.then_some(Termination::ObserverStopped))
+    }
+
+    /// Every event's values and rates at both ends of the step and its first crossing.
+    fn start_scan(&self, sides: &mut Sides) -> Result<StepScan<T, N>> {
+        let dense = self.dense;
+        let (ts0, ts1) = dense.span();
+        let (y_start, y_end) = dense.endpoints();
+        let (f_start, f_end) = dense.end_derivatives();
+        let (y_start, y_end, f_start, f_end) = (*y_start, *y_end, *f_start, *f_end);
+        let mut scan = StepScan {
+            t0: ts0,
+            t1: ts1,
+            y0: y_start,
+            y1: y_end,
+            g_end: [T::zero(); MAX_EVENTS],
+            r_end: [None; MAX_EVENTS],
+            found: [None; MAX_EVENTS],
+        };
+        for i in 0..E::LEN {
+            let g0 = self.events.value(i, ts0, &y_start);
+            let ge = self.events.value(i, ts1, &y_end);
+            scan.g_end[i] = ge;
+            if !(g0.is_finite() && ge.is_finite()) {
+                let (t, g) = if g0.is_finite() { (ts1, ge) } else { (ts0, g0) };
+                return Err(non_finite(i, t, g));
+            }
+            if sides.side[i] == 0 {
+                // Started on the surface with no rate: the side is where it goes.
+                sides.side[i] = if ge != T::zero() { sign_of(ge) } else { 1 };
+            }
+            let st_g = if g0 == T::zero() {
+                signed_tiny(sides.side[i])
+            } else {
+                g0
+            };
+            let st_r = self.events.rate(i, ts0, &y_start, &f_start);
+            scan.r_end[i] = self.events.rate(i, ts1, &y_end, &f_end);
+            scan.found[i] = self.find_crossing(i, ts0, st_g, st_r, ts1, ge, scan.r_end[i]);
+        }
+        Ok(scan)
+    }
+
+    /// The step's crossings, earliest first: the observer's view up to each accepted one,
+    /// its record, its reset (which ends the step there), a restart, a terminal event or
+    /// an observer's stop. Returns where the step's last piece starts if it goes on to the
+    /// step's end.
+    fn crossings<O: Observer<T, N>>(
+        &mut self,
+        scan: &mut StepScan<T, N>,
+        sides: &mut Sides,
+        observer: &mut O,
+    ) -> Result<Crossings<T, N>> {
+        let n_ev = E::LEN;
+        let mut t_lo = scan.t0;
+        let mut y_lo = scan.y0;
+        loop {
+            let mut best: Option<(usize, Crossing<T>)> = None;
+            for (i, f) in scan.found.iter().enumerate().take(n_ev) {
+                if let Some(c) = f {
+                    if best.is_none_or(|(_, b)| c.t < b.t) {
+                        best = Some((i, *c));
+                    }
+                }
+            }
+            let Some((i, c)) = best else {
+                return Ok(Crossings::Through(t_lo, y_lo));
+            };
+            // Where the scan of event i resumes (None: no further crossing this step).
+            scan.found[i] = match c.resume {
+                Some((tr, gr)) => {
+                    self.find_crossing(i, tr, gr, None, scan.t1, scan.g_end[i], scan.r_end[i])
+                }
+                None => None,
+            };
+            let was_armed = sides.armed[i];
+            sides.armed[i] = true;
+            sides.side[i] = if c.rising { 1 } else { -1 };
+            if !was_armed || !self.events.direction(i).accepts(c.rising) {
+                // Re-arming crossing (the exit after a reset) or an unwanted direction.
+                continue;
+            }
+            let tc = c.t;
+            let dense = self.dense;
+            let mut yc = SVector::zeros();
+            dense.interpolate_unchecked(tc, &mut yc);
+            let view = StepView {
+                t0: t_lo,
+                t1: tc,
+                y0: y_lo,
+                y1: yc,
+                dense,
+            };
+            let stop_obs = observer.on_step(&view) == Control::Stop;
+            let direction = if c.rising {
+                Direction::Rising
+            } else {
+                Direction::Falling
+            };
+            self.stats.events += 1;
+            if let Some((count, last)) = self.history.push(tc, self.zeno) {
+                // Leave the simulation at the event (after its reset) so that the
+                // caller can change the model and continue from there.
+                let mut ya = yc;
+                if self.events.resets(i) {
+                    self.events.apply_reset(i, tc, &mut ya);
+                }
+                *self.restart = Some((tc, ya));
+                return Err(EventError::Zeno {
+                    t: to_f64(tc),
+                    count,
+                    last_interval: to_f64(last),
+                    state: ya.iter().map(|&v| to_f64(v)).collect(),
+                }
+                .into());
+            }
+            let terminal = self.events.is_terminal(i);
+            if self.events.resets(i) {
+                // An impact moves into the surface. A located crossing where the rate does
+                // not (the far end of a bracket past the top of a graze of zero normal
+                // velocity: the arrival of a chattering sequence) is no impact: the body
+                // stays on the surface, reported as sticking, not as an event.
+                let mut fc = SVector::zeros();
+                self.system.rhs(tc, &yc, &mut fc);
+                self.stats.rhs_evals += 1;
+                let into = if c.rising { T::one() } else { -T::one() };
+                if let Some(r) = self.events.rate(i, tc, &yc, &fc) {
+                    if !(into * r > T::zero()) {
+                        self.stats.events -= 1;
+                        *self.restart = Some((tc, yc));
+                        return Err(EventError::Sticking {
+                            index: i,
+                            t: to_f64(tc),
+                            depth: to_f64(self.events.value(i, tc, &yc).abs()),
+                            state: yc.iter().map(|&v| to_f64(v)).collect(),
+                        }
+                        .into());
+                    }
+                }
+                let mut ya = yc;
+                self.events.apply_reset(i, tc, &mut ya);
+                let rec = EventRecord {
+                    index: i,
+                    t: tc,
+                    y: yc,
+                    y_after: Some(ya),
+                    direction,
+                };
+                let stop_ev = observer.on_event(&rec) == Control::Stop;
+                *self.restart = Some((tc, ya));
+                self.after_reset(i, tc, &ya, sides);
+                return Ok(if terminal {
+                    Crossings::End(Termination::TerminalEvent(i))
+                } else if stop_obs || stop_ev {
+                    Crossings::End(Termination::ObserverStopped)
+                } else {
+                    Crossings::Cut
+                });
+            }
+            let rec = EventRecord {
+                index: i,
+                t: tc,
+                y: yc,
+                y_after: None,
+                direction,
+            };
+            let stop_ev = observer.on_event(&rec) == Control::Stop;
+            if self.events.restarts(i) && !(terminal || stop_obs || stop_ev) {
+                // A switching point: cut the step here and start the next one on it.
+                *self.restart = Some((tc, yc));
+                return Ok(Crossings::Cut);
+            }
+            if terminal || stop_obs || stop_ev {
+                // Rewind the stepper to the event.
+                *self.restart = Some((tc, yc));
+                return Ok(Crossings::End(if terminal {
+                    Termination::TerminalEvent(i)
+                } else {
+                    Termination::ObserverStopped
+                }));
+            }
+            t_lo = tc;
+            y_lo = yc;
+        }
+    }
+
+    /// The sides after event `i`'s reset to `ya` at `tc`; event `i` is disarmed if the
+    /// reset left the state on the far side while moving back out.
+    fn after_reset(&mut self, i: usize, tc: T, ya: &SVector<T, N>, sides: &mut Sides) {
+        let mut fa = SVector::zeros();
+        self.system.rhs(tc, ya, &mut fa);
+        self.stats.rhs_evals += 1;
+        for (j, s) in sides.side.iter_mut().enumerate().take(E::LEN) {
+            let g = self.events.value(j, tc, ya);
+            if g != T::zero() {
+                *s = sign_of(g);
+            }
+            if j == i {
+                // Left on the far side but moving back out: disarmed until it has
+                // crossed back.
+                let r = self.events.rate(j, tc, ya, &fa).unwrap_or(T::zero());
+                sides.armed[j] = !(g != T::zero() && r != T::zero() && sign_of(g) != sign_of(r));
+                if g == T::zero() && r != T::zero() {
+                    *s = sign_of(r);
+                }
+            }
+        }
+    }
+
+    /// Sticking: an event disarmed after a reset (or an impact event on its far side),
+    /// still on the far side at the step end and moving deeper again, never left the
+    /// surface: the reset could not separate the trajectory from it. Never silent: stops
+    /// where it turned (the extremum of g on the dense output), with the state to go on
+    /// from, and an [`EventError::Sticking`].
+    fn check_sticking<O: Observer<T, N>>(
+        &mut self,
+        scan: &StepScan<T, N>,
+        sides: &Sides,
+        t_lo: T,
+        y_lo: SVector<T, N>,
+        observer: &mut O,
+    ) -> Result<()> {
+        for i in 0..E::LEN {
+            // For an impact (a resetting event with a direction) the far side is the
+            // wrong side at any step end: its crossings are reset away from it.
+            let wrong_side = match self.events.direction(i) {
+                Direction::Rising => 1,
+                Direction::Falling => -1,
+                Direction::Either => 0,
+            };
+            let (ge, re) = (scan.g_end[i], scan.r_end[i]);
+            let stuck = !sides.armed[i] || (self.events.resets(i) && sign_of(ge) == wrong_side);
+            if !(stuck
+                && ge != T::zero()
+                && re.is_some_and(|r| r != T::zero() && sign_of(r) == sign_of(ge)))
+            {
+                continue;
+            }
+            let dense = self.dense;
+            let tol = self
+                .event_tol
+                .max(lit::<T>(4.0) * T::default_epsilon() * scan.t1.abs());
+            let sg = if ge > T::zero() { T::one() } else { -T::one() };
+            let events = &self.events;
+            let (te, _) = crate::roots::golden_max(
+                |t| {
+                    let mut y = SVector::<T, N>::zeros();
+                    dense.interpolate_unchecked(t, &mut y);
+                    -sg * events.value(i, t, &y)
+                },
+                t_lo,
+                scan.t1,
+                tol,
+            );
+            let mut ye = SVector::zeros();
+            dense.interpolate_unchecked(te, &mut ye);
+            let view = StepView {
+                t0: t_lo,
+                t1: te,
+                y0: y_lo,
+                y1: ye,
+                dense,
+            };
+            observer.on_step(&view);
+            let depth = self.events.value(i, te, &ye).abs();
+            *self.restart = Some((te, ye));
+            return Err(EventError::Sticking {
+                index: i,
+                t: to_f64(te),
+                depth: to_f64(depth),
+                state: ye.iter().map(|&v| to_f64(v)).collect(),
+            }
+            .into());
+        }
+        Ok(())
+    }
+
+    /// The earliest crossing (any direction) of event `i` in `(t_lo, t1]`, starting from
+    /// `g_lo ≠ 0` (rate `r_lo` if known) and ending at `g1` (rate `r1`).
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn find_crossing(
+        &self,
+        i: usize,
+        t_lo: T,
+        g_lo: T,
+        r_lo: Option<T>,
+        t1: T,
+        g1: T,
+        r1: Option<T>,
+    ) -> Option<Crossing<T>> {
+        let ev = &self.events;
+        let dense = self.dense;
+        let tol = self
+            .event_tol
+            .max(lit::<T>(4.0) * T::default_epsilon() * t1.abs());
+        let g_at = |t: T| {
+            let mut y = SVector::<T, N>::zeros();
+            dense.interpolate_unchecked(t, &mut y);
+            ev.value(i, t, &y)
+        };
+        // Interior samples (grazing safety for functions without a rate).
+        let k = ev.interior_samples(i);
+        if k > 0 {
+            let mut ta = t_lo;
+            let mut ga = g_lo;
+            for m in 1..=(k + 1) {
+                let (tb, gb) = if m == k + 1 {
+                    (t1, g1)
+                } else {
+                    let tb = t_lo + (t1 - t_lo) * lit::<T>(m as f64 / (k as f64 + 1.0));
+                    (tb, g_at(tb))
+                };
+                if !gb.is_finite() {
+                    // Not a crossing (the step ends are checked to be finite).
+                    continue;
+                }
+                if gb != T::zero() && sign_of(gb) != sign_of(ga) {
+                    let (tc, _) = locate(g_at, ta, tb, ga, gb, tol);
+                    let resume = if m == k + 1 { None } else { Some((tb, gb)) };
+                    return Some(Crossing {
+                        t: tc,
+                        rising: gb > T::zero(),
+                        resume,
+                    });
+                }
+                if gb != T::zero() {
+                    ta = tb;
+                    ga = gb;
+                }
+            }
+            return None;
+        }
+        let rate_lo = || {
+            r_lo.or_else(|| {
+                let mut y = SVector::zeros();
+                dense.interpolate_unchecked(t_lo, &mut y);
+                let mut f = SVector::zeros();
+                self.system.rhs(t_lo, &y, &mut f);
+                ev.rate(i, t_lo, &y, &f)
+            })
+        };
+        crossing_between(g_at, rate_lo, tol, t_lo, g_lo, t1, g1, r1)
+    }
+}
+
+/// The earliest crossing of `g` (its value on the step's dense output: `g_at`) in
+/// `(t_lo, t1]`, from `g_lo ≠ 0` to `g1` with the rate `r1` at `t1`: a sign change of the
+/// ends, located by the bracketing solver; else, with the same sign at both ends (or
+/// `g1 = 0`), a grazing pair when the rates show an interior extremum that reaches the
+/// other side (`rate_lo`, the rate at `t_lo`, is evaluated only then): the extremum by
+/// golden-section search, the crossing before it, and the extremum as where the scan
+/// resumes.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn crossing_between<T: Real>(
+    g_at: impl Fn(T) -> T + Copy,
+    rate_lo: impl FnOnce() -> Option<T>,
+    tol: T,
+    t_lo: T,
+    g_lo: T,
+    t1: T,
+    g1: T,
+    r1: Option<T>,
+) -> Option<Crossing<T>> {
+    let s = sign_of(g_lo);
+    if g1 != T::zero() && sign_of(g1) != s {
+        let (tc, _) = locate(g_at, t_lo, t1, g_lo, g1, tol);
+        return Some(Crossing {
+            t: tc,
+            rising: g1 > T::zero(),
+            resume: None,
+        });
+    }
+    let (Some(r_lo), Some(r1)) = (rate_lo(), r1) else {
+        return None;
+    };
+    let towards = if s > 0 {
+        r_lo < T::zero()
+    } else {
+        r_lo > T::zero()
+    };
+    let away = if s > 0 {
+        r1 > T::zero()
+    } else {
+        r1 < T::zero()
+    };
+    if !(towards && (away || g1 == T::zero())) {
+        return None;
+    }
+    let sg = if s > 0 { T::one() } else { -T::one() };
+    let (te, neg) = crate::roots::golden_max(|t| -sg * g_at(t), t_lo, t1, tol);
+    let ge = -neg * sg;
+    if ge == T::zero() || sign_of(ge) == s {
+        return None;
+    }
+    let (tc, _) = locate(g_at, t_lo, te, g_lo, ge, tol);
+    Some(Crossing {
+        t: tc,
+        rising: ge > T::zero(),
+        resume: Some((te, ge)),
+    })
+}
+
+fn non_finite<T: Real>(index: usize, t: T, g: T) -> RunError {
+    EventError::NonFinite {
+        index,
+        t: to_f64(t),
+        value: to_f64(g),
+    }
+    .into()
+}
+
+/// Each event's side of its surface (+1/−1; 0 = not known yet, for a start exactly on it,
+/// used when g is exactly zero at a step boundary) and whether it is armed (false right
+/// after a reset that left the state on the far side while moving back out). Carried
+/// from step to step.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Sides {
+    pub(crate) side: [i8; MAX_EVENTS],
+    pub(crate) armed: [bool; MAX_EVENTS],
+}
+
+/// One step's event data: its ends, each event's value and rate at the end, and the next
+/// crossing found for each (cached while earlier crossings are handled).
+#[derive(Debug, Clone, Copy)]
+struct StepScan<T: Real, const N: usize> {
+    t0: T,
+    t1: T,
+    y0: SVector<T, N>,
+    y1: SVector<T, N>,
+    g_end: [T; MAX_EVENTS],
+    r_end: [Option<T>; MAX_EVENTS],
+    found: [Option<Crossing<T>>; MAX_EVENTS],
+}
+
+/// How a step's crossings ended.
+enum Crossings<T: Real, const N: usize> {
+    /// No crossing stopped the step: its last piece starts at this time and state.
+    Through(T, SVector<T, N>),
+    /// The state was reset or restarted at an event: the next step starts there.
+    Cut,
+    /// The run ends.
+    End(Termination),
+}
+
+/// A crossing found on a step.
+#[derive(Debug, Clone, Copy)]
+struct Crossing<T> {
+    t: T,
+    rising: bool,
+    /// Where to resume scanning this event after it (`None`: nothing more this step).
+    resume: Option<(T, T)>,
+}
+
+#[inline(always)]
+pub(crate) fn signed_tiny<T: Real>(side: i8) -> T {
+    let tiny = T::default_epsilon() * T::default_epsilon();
+    if side < 0 { -tiny } else { tiny }
+}
+
+#[inline(always)]
+pub(crate) fn sign_of<T: Real>(x: T) -> i8 {
+    if x > T::zero() {
+        1
+    } else if x < T::zero() {
+        -1
+    } else {
+        0
+    }
+}
