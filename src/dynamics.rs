@@ -61,13 +61,26 @@ pub trait Dynamics<T: Real, const N: usize> {
     /// [`ForceLaw::velocity_exponent`](crate::ForceLaw::velocity_exponent)). A
     /// [`TurningPoints`](crate::integrate::TurningPoints) stepper crosses `ẋ = 0` in the
     /// variable `u = sgn(ẋ)|ẋ|^q` when it is declared. Default `None`.
+    ///
+    /// [`Oscillator`](crate::model::Oscillator) and the one-degree-of-freedom
+    /// [`Mechanical`](crate::model::Mechanical) system return their laws' smallest; a
+    /// `Mechanical` system of several degrees of freedom returns `None` (its state is not
+    /// `(x, ẋ)`; see [`Elements`](crate::model::Elements) for its laws' declarations per
+    /// coordinate). Declare it only where it holds for the state's second component: the
+    /// stepper trusts it.
     fn velocity_exponent(&self) -> Option<T> {
         None
     }
 
     /// For a one-degree-of-freedom system with state `(x, ẋ)`: where a contact force starts
     /// as a power of the penetration, if it does (see
-    /// [`ForceLaw::contact_onset`](crate::ForceLaw::contact_onset)). Default `None`.
+    /// [`ForceLaw::contact_onset`](crate::ForceLaw::contact_onset)), with the stop and the
+    /// penetration in `x`. Default `None`.
+    ///
+    /// [`Oscillator`](crate::model::Oscillator) and the one-degree-of-freedom
+    /// [`Mechanical`](crate::model::Mechanical) system return their laws' first stop (for a
+    /// `Mechanical` law on the coordinate `g = w·x + o`, mapped to `x`); a `Mechanical`
+    /// system of several degrees of freedom returns `None`.
     fn contact_onset(&self) -> Option<crate::force::ContactOnset<T>> {
         None
     }

@@ -62,6 +62,22 @@
 //! work–precision gain over time stepping is 0.95–1.69× (median 1.33×) against 1.02–1.47×
 //! (median 1.28×) without it. It is off by default.
 //!
+//! # Which systems declare
+//! The one-degree-of-freedom models declare what their force laws declare
+//! ([`ForceLaw::velocity_exponent`](crate::ForceLaw::velocity_exponent),
+//! [`ForceLaw::contact_onset`](crate::ForceLaw::contact_onset)):
+//! [`Oscillator`](crate::model::Oscillator) and
+//! [`Mechanical`](crate::model::Mechanical) with `N = 1` (state `(x, ẋ)`), the smallest
+//! exponent and the first stop of their laws. A `Mechanical` law on another coordinate of
+//! its one degree of freedom, `g = w·x + o` (reversed, offset or scaled), has its cusp at
+//! `ẋ = 0` too, and its stop `g_I` is mapped to `x_I = (g_I − o)/w` (the other side for
+//! `w < 0`). A `Mechanical` system of `N > 1` degrees of freedom declares nothing: its
+//! state is not `(x, ẋ)`, and this stepper steps two components. Its elements report their
+//! declarations per coordinate ([`Elements`](crate::model::Elements)) for a stepper that
+//! crosses `ġ = 0` of one coordinate among several. A system of one's own declares with
+//! [`Dynamics::velocity_exponent`] and [`Dynamics::contact_onset`] (a reference `&S`
+//! forwards them).
+//!
 //! # When a segment is not used, or is left
 //! - The system declares no exponent, or its `f₀ ≠ ẋ` (not a one-degree-of-freedom system in
 //!   `(x, ẋ)`): the time stepper alone (the generic path).

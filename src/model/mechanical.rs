@@ -4,6 +4,7 @@ use nalgebra::{SMatrix, SVector};
 use thiserror::Error;
 
 use crate::excite::Excitation;
+use crate::force::{ContactOnset, Side, min_exponent};
 use crate::linalg::Lu;
 use crate::scalar::{lit, to_f64};
 use crate::validate::ParameterError;
@@ -338,12 +339,71 @@ impl<T: Real, const N: usize, L: ForceLaw<T>> Element<T, N, L> {
 /// A set of elements whose generalized forces and tangent matrices add up: an [`Element`],
 /// `()`, tuples of up to twelve sets and arrays `[E; K]` of sets (e.g. the links of a
 /// chain). Implemented by value, no `dyn`.
+///
+/// # Cusp declarations
+/// [`velocity_exponent_on`](Elements::velocity_exponent_on) and
+/// [`contact_onset_on`](Elements::contact_onset_on) report what the elements' laws declare
+/// ([`ForceLaw::velocity_exponent`], [`ForceLaw::contact_onset`]) together with the
+/// coordinate each law acts on: a law's declaration is about its own coordinate `g`, and
+/// only the caller knows what it means for the state it steps. The one-DOF [`Mechanical`]
+/// system maps them to its `(x, ẋ)` (see its [`Dynamics`] impl); a stepper for `N`
+/// degrees of freedom can read them per coordinate. Both are provided (`None` by
+/// default): an implementation of its own that does not override them declares nothing.
 pub trait Elements<T: Real, const N: usize> {
     /// Adds `Σ w·F(g, ġ)` to `out`.
     fn add_forces(&self, q: &[T], qd: &[T], out: &mut SVector<T, N>);
 
     /// Adds the tangent stiffness `Σ F_g·w wᵀ` to `k` and damping `Σ F_ġ·w wᵀ` to `c`.
     fn add_tangent(&self, q: &[T], qd: &[T], k: &mut SMatrix<T, N, N>, c: &mut SMatrix<T, N, N>);
+
+    /// The smallest of the velocity exponents that the elements' laws declare
+    /// ([`ForceLaw::velocity_exponent`], the exponent `q` of a term `∝ sgn(ġ)|ġ|^q` in the
+    /// rate of the law's coordinate `g`), each passed through `map` with the coordinate
+    /// the law acts on: `map` returns the exponent in the caller's terms, or `None` to
+    /// leave that element out. `None` if no element's law declares one (or `map` leaves
+    /// them all out).
+    ///
+    /// ```
+    /// use nonsmooth::force::{HertzContact, LinearSpring};
+    /// use nonsmooth::model::{Coordinate, Element, Elements};
+    ///
+    /// let stop = HertzContact::new(1e-3, 1e7)?.with_damping(0.5, 1.5, 0.25)?;
+    /// let elements = (
+    ///     Element::<f64, 2, _>::on_dof(0, LinearSpring::new(100.0)?)?,
+    ///     Element::between(1, 0, stop)?,
+    /// );
+    /// // The cusp is in the rate of q₁ − q₀, with q = 0.25.
+    /// let relative = Coordinate::relative(1, 0)?;
+    /// assert_eq!(elements.velocity_exponent_on(&|_, q| Some(q)), Some(0.25));
+    /// let on = |c: &Coordinate<f64, 2>, q| (*c == relative).then_some(q);
+    /// assert_eq!(elements.velocity_exponent_on(&on), Some(0.25));
+    /// let off = |c: &Coordinate<f64, 2>, q| (*c != relative).then_some(q);
+    /// assert_eq!(elements.velocity_exponent_on(&off), None);
+    /// // The stop, in the terms of q₁ − q₀.
+    /// let stop_at = elements.contact_onset_on(&|_, o| Some(o.position));
+    /// assert_eq!(stop_at, Some(1e-3));
+    /// # Ok::<(), nonsmooth::Error>(())
+    /// ```
+    fn velocity_exponent_on<Map>(&self, _map: &Map) -> Option<T>
+    where
+        Self: Sized,
+        Map: Fn(&Coordinate<T, N>, T) -> Option<T>,
+    {
+        None
+    }
+
+    /// The first contact onset, in element order, that the elements' laws declare
+    /// ([`ForceLaw::contact_onset`], a stop `g_I` and side of the law's coordinate `g`) and
+    /// `map` accepts: `map` receives the coordinate the law acts on and the onset in that
+    /// coordinate's terms, and returns it in the caller's terms, or `None` to skip it. One
+    /// stop is reported, as for a sum of laws.
+    fn contact_onset_on<R, Map>(&self, _map: &Map) -> Option<R>
+    where
+        Self: Sized,
+        Map: Fn(&Coordinate<T, N>, ContactOnset<T>) -> Option<R>,
+    {
+        None
+    }
 }
 
 impl<T: Real, const N: usize> Elements<T, N> for () {
@@ -384,6 +444,24 @@ impl<T: Real, const N: usize, L: ForceLaw<T>> Elements<T, N> for Element<T, N, L
             }
         }
     }
+
+    fn velocity_exponent_on<Map>(&self, map: &Map) -> Option<T>
+    where
+        Map: Fn(&Coordinate<T, N>, T) -> Option<T>,
+    {
+        self.law
+            .velocity_exponent()
+            .and_then(|q| map(&self.coordinate, q))
+    }
+
+    fn contact_onset_on<R, Map>(&self, map: &Map) -> Option<R>
+    where
+        Map: Fn(&Coordinate<T, N>, ContactOnset<T>) -> Option<R>,
+    {
+        self.law
+            .contact_onset()
+            .and_then(|o| map(&self.coordinate, o))
+    }
 }
 
 impl<T: Real, const N: usize, E: Elements<T, N>, const K: usize> Elements<T, N> for [E; K] {
@@ -398,6 +476,19 @@ impl<T: Real, const N: usize, E: Elements<T, N>, const K: usize> Elements<T, N> 
             e.add_tangent(q, qd, k, c);
         }
     }
+    fn velocity_exponent_on<Map>(&self, map: &Map) -> Option<T>
+    where
+        Map: Fn(&Coordinate<T, N>, T) -> Option<T>,
+    {
+        self.iter()
+            .fold(None, |q, e| min_exponent(q, e.velocity_exponent_on(map)))
+    }
+    fn contact_onset_on<R, Map>(&self, map: &Map) -> Option<R>
+    where
+        Map: Fn(&Coordinate<T, N>, ContactOnset<T>) -> Option<R>,
+    {
+        self.iter().find_map(|e| e.contact_onset_on(map))
+    }
 }
 
 macro_rules! element_tuple {
@@ -409,6 +500,22 @@ macro_rules! element_tuple {
             }
             fn add_tangent(&self, q: &[T], qd: &[T], k: &mut SMatrix<T, N, N>, c: &mut SMatrix<T, N, N>) {
                 $(self.$idx.add_tangent(q, qd, k, c);)+
+            }
+            fn velocity_exponent_on<Map>(&self, map: &Map) -> Option<T>
+            where
+                Map: Fn(&Coordinate<T, N>, T) -> Option<T>,
+            {
+                let mut q = None;
+                $(q = min_exponent(q, self.$idx.velocity_exponent_on(map));)+
+                q
+            }
+            fn contact_onset_on<R, Map>(&self, map: &Map) -> Option<R>
+            where
+                Map: Fn(&Coordinate<T, N>, ContactOnset<T>) -> Option<R>,
+            {
+                let mut o = None;
+                $(o = o.or_else(|| self.$idx.contact_onset_on(map));)+
+                o
             }
         }
     };
@@ -1046,6 +1153,78 @@ impl<T: Real, const N: usize, const M: usize, El: Elements<T, N>, Ld: Loads<T, N
         }
         Some(out)
     }
+
+    /// For one degree of freedom (state `(x, ẋ)`): the smallest velocity exponent that the
+    /// elements' laws declare ([`Elements::velocity_exponent_on`]). A law on the coordinate
+    /// `g = w·x + o` has its cusp in `ġ = w·ẋ`, so at `ẋ = 0` with the same exponent
+    /// (`|ġ|^q = |w|^q·|ẋ|^q`): every coordinate of one degree of freedom counts, the
+    /// degree of freedom itself, reversed (`w = −1`), offset or scaled. Loads do not
+    /// matter.
+    ///
+    /// `None` for `N > 1`: [`TurningPoints`](crate::integrate::TurningPoints) crosses
+    /// `ẋ = 0` of a one-degree-of-freedom system with state `(x, ẋ)`; a cusp in the rate of
+    /// one coordinate of several degrees of freedom is no turning point of the state's
+    /// second component (read the declarations per coordinate with
+    /// [`Elements::velocity_exponent_on`]).
+    fn velocity_exponent(&self) -> Option<T> {
+        state_size::<N, M>();
+        if N != 1 {
+            return None;
+        }
+        self.elements
+            .velocity_exponent_on(&|c: &Coordinate<T, N>, q| {
+                let w = c.weights()[0];
+                (w != T::zero() && w.is_finite()).then_some(q)
+            })
+    }
+
+    /// For one degree of freedom (state `(x, ẋ)`): the first contact onset that the
+    /// elements' laws declare ([`Elements::contact_onset_on`]), mapped from the law's
+    /// coordinate `g = w·x + o` to `x`. A stop `g_I` on the side `Upper` (`δ_g = g − g_I`)
+    /// is the stop `x_I = (g_I − o)/w` in `x`, on the same side for `w > 0` and on the other
+    /// side for `w < 0`: a law on the reversed degree of freedom (`w = −1`, e.g. a stop put
+    /// on the other side with [`Coordinate::reversed`]) or with an offset is crossed as
+    /// well. The exponent is the law's; the penetration is measured in `x`,
+    /// `δ = δ_g/|w|` (exactly `δ_g` for `w = ±1`, up to the rounding of `g_I − o` with an
+    /// offset), so the stepper's onset band is a band in `x`. For `w = 1`, `o = 0` (a law
+    /// on the degree of freedom itself) the onset is the law's unchanged. An onset whose
+    /// mapped stop is not finite is skipped. Loads do not matter.
+    ///
+    /// `None` for `N > 1` (as [`velocity_exponent`](Dynamics::velocity_exponent); read the
+    /// declarations per coordinate with [`Elements::contact_onset_on`]).
+    fn contact_onset(&self) -> Option<ContactOnset<T>> {
+        state_size::<N, M>();
+        if N != 1 {
+            return None;
+        }
+        self.elements
+            .contact_onset_on(&|c: &Coordinate<T, N>, onset: ContactOnset<T>| {
+                one_dof_onset(c.weights()[0], c.offset(), onset)
+            })
+    }
+}
+
+/// The onset of a contact on the coordinate `g = w·x + o` of one degree of freedom, as an
+/// onset in `x` (see [`Mechanical`]'s `contact_onset`); `None` if `w` is zero or not
+/// finite, or the stop in `x` is not finite.
+fn one_dof_onset<T: Real>(w: T, o: T, onset: ContactOnset<T>) -> Option<ContactOnset<T>> {
+    if !(w != T::zero() && w.is_finite()) {
+        return None;
+    }
+    if w == T::one() && o == T::zero() {
+        return Some(onset);
+    }
+    let position = (onset.position - o) / w;
+    let side = match (onset.side, w > T::zero()) {
+        (side, true) => side,
+        (Side::Upper, false) => Side::Lower,
+        (Side::Lower, false) => Side::Upper,
+    };
+    position.is_finite().then_some(ContactOnset {
+        position,
+        side,
+        exponent: onset.exponent,
+    })
 }
 
 #[cfg(test)]

@@ -32,10 +32,10 @@ use crate::{Dynamics, ForceLaw, Real};
 ///
 /// # Implementation
 /// The oscillator is the one-DOF [`Mechanical`] system with the laws as one element on
-/// `q₀` and the excitation as one load on it (a thin layer: its Jacobian and `∂f/∂t` are
-/// the system's; its right-hand side is the system's written out for one DOF, the same
-/// values to the bit); it keeps the scalar constructor, the accessors and the bracketing
-/// static equilibrium.
+/// `q₀` and the excitation as one load on it (a thin layer: its Jacobian, `∂f/∂t` and cusp
+/// declarations are the system's; its right-hand side is the system's written out for one
+/// DOF, the same values to the bit); it keeps the scalar constructor, the accessors and the
+/// bracketing static equilibrium.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Oscillator<T: Real, L, E> {
     model: OneDof<T, L, E>,
@@ -135,14 +135,15 @@ impl<T: Real, L: ForceLaw<T>, E: Excitation<T>> Dynamics<T, 2> for Oscillator<T,
         self.model.time_derivative(t, y)
     }
 
-    /// The laws' declared cusp exponent (the smallest of them).
+    /// The laws' declared cusp exponent (the smallest of them): the one-DOF system's.
     fn velocity_exponent(&self) -> Option<T> {
-        self.laws().velocity_exponent()
+        Dynamics::<T, 2>::velocity_exponent(&self.model)
     }
 
-    /// The laws' declared contact onset (the first of them).
+    /// The laws' declared contact onset (the first of them): the one-DOF system's (the
+    /// laws act on `x` itself, so the onset is theirs unchanged).
     fn contact_onset(&self) -> Option<crate::force::ContactOnset<T>> {
-        self.laws().contact_onset()
+        Dynamics::<T, 2>::contact_onset(&self.model)
     }
 }
 
