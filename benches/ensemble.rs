@@ -6,19 +6,28 @@
 //! measured in this run, is printed as `throughput ratio ensemble/scalar: R`; the line before
 //! it gives the same ratio with the lane loop capped at AVX2 (`Simd::Avx2`, the `_avx2`
 //! configurations; equal to the first on a machine without AVX-512).
+//!
+//! The group `ensemble_any_64x20_periods` runs models built generically from the parts
+//! (their lane forms): the Duffing–Ueda oscillator (64 amplitudes) and the 2-DOF impact
+//! system of the catalogue (64 frequencies, state of size 4, its stop as an event), each
+//! on the scalar path and in lanes of 8 and 16 (exact math); after it, the ratio
+//! ensemble/scalar of each is printed as `throughput ratio <model> ensemble/scalar: R`.
 
 use std::hint::black_box;
 use std::time::Instant;
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use nalgebra::SVector;
 use nalgebra::Vector2;
+use nonsmooth::LaneDynamics;
 use nonsmooth::drive::Simulation;
 use nonsmooth::ensemble::{
     Ensemble, F64x4, F64x8, F64x16, LaneMath, Lanes, Member, MemberRun, Simd,
 };
-use nonsmooth::event::{Direction, Event, Stop};
+use nonsmooth::event::{Direction, Event, EventSet, Stop};
 use nonsmooth::integrate::{Dopri5, Tolerances};
 use nonsmooth::systems::paper::PAPER;
+use nonsmooth::systems::{DuffingUeda, TwoDofImpact};
 
 struct Setup {
     jobs: Vec<MemberRun>,
@@ -144,5 +153,122 @@ fn bench(c: &mut Criterion) {
     println!("throughput ratio ensemble/scalar: {best:.2}");
 }
 
-criterion_group!(benches, bench);
+/// A generic model's trajectories and events.
+struct Any<D, E, const M: usize> {
+    jobs: Vec<MemberRun<D, M>>,
+    tol: Tolerances<f64, M>,
+    events: E,
+}
+
+fn any_scalar<D: LaneDynamics<M>, E: EventSet<f64, M> + Clone, const M: usize>(
+    s: &Any<D, E, M>,
+) -> u64 {
+    s.jobs
+        .iter()
+        .map(|j| {
+            Simulation::new(j.member.clone(), Dopri5::new(s.tol))
+                .with_events(s.events.clone())
+                .landing_grid(j.grid)
+                .unwrap()
+                .run(j.t0, j.y0, j.t_end, &mut ())
+                .unwrap()
+                .stats
+                .rhs_evals
+        })
+        .sum()
+}
+
+fn any_lanes<V: Lanes, D: LaneDynamics<M>, E: EventSet<f64, M> + Clone, const M: usize>(
+    s: &Any<D, E, M>,
+) -> u64 {
+    let e = Ensemble::new(s.tol)
+        .unwrap()
+        .with_events(s.events.clone())
+        .unwrap();
+    let mut obs = vec![(); s.jobs.len()];
+    e.run::<V, _, _>(&s.jobs, &mut obs)
+        .unwrap()
+        .into_iter()
+        .map(|o| o.unwrap().stats.rhs_evals)
+        .sum()
+}
+
+fn bench_any(c: &mut Criterion) {
+    let duffing = Any {
+        jobs: (0..64)
+            .map(|i| {
+                let p = DuffingUeda {
+                    b: 5.0 + 7.0 * i as f64 / 63.0,
+                    ..DuffingUeda::default()
+                };
+                MemberRun::<_, 2>::periods_of(
+                    p.model::<f64>().unwrap(),
+                    SVector::from([1.0, 0.0]),
+                    p.period(),
+                    20.0,
+                )
+                .unwrap()
+            })
+            .collect(),
+        tol: Tolerances::new(1e-8, 1e-10).unwrap(),
+        events: (),
+    };
+    let p = TwoDofImpact::default();
+    let two_dof = Any {
+        jobs: (0..64)
+            .map(|i| {
+                let w = 0.3 + i as f64 / 63.0;
+                MemberRun::<_, 4>::periods_of(
+                    p.model::<f64>(w).unwrap(),
+                    SVector::zeros(),
+                    TwoDofImpact::period(w),
+                    20.0,
+                )
+                .unwrap()
+            })
+            .collect(),
+        tol: Tolerances::new(1e-8, 1e-10).unwrap(),
+        events: Event::new(p.stop::<f64>().unwrap(), Direction::Rising),
+    };
+    let mut g = c.benchmark_group("ensemble_any_64x20_periods");
+    g.sample_size(10);
+    g.bench_function("duffing_scalar", |b| {
+        b.iter(|| black_box(any_scalar(&duffing)))
+    });
+    g.bench_function("duffing_lanes8", |b| {
+        b.iter(|| black_box(any_lanes::<F64x8, _, _, 2>(&duffing)))
+    });
+    g.bench_function("duffing_lanes16", |b| {
+        b.iter(|| black_box(any_lanes::<F64x16, _, _, 2>(&duffing)))
+    });
+    g.bench_function("two_dof_scalar", |b| {
+        b.iter(|| black_box(any_scalar(&two_dof)))
+    });
+    g.bench_function("two_dof_lanes8", |b| {
+        b.iter(|| black_box(any_lanes::<F64x8, _, _, 4>(&two_dof)))
+    });
+    g.bench_function("two_dof_lanes16", |b| {
+        b.iter(|| black_box(any_lanes::<F64x16, _, _, 4>(&two_dof)))
+    });
+    g.finish();
+    let best = |f: &dyn Fn() -> u64| {
+        (0..5)
+            .map(|_| {
+                let t = Instant::now();
+                black_box(f());
+                t.elapsed().as_secs_f64()
+            })
+            .fold(f64::INFINITY, f64::min)
+    };
+    let d = best(&|| any_scalar(&duffing))
+        / best(&|| any_lanes::<F64x8, _, _, 2>(&duffing))
+            .min(best(&|| any_lanes::<F64x16, _, _, 2>(&duffing)));
+    println!("throughput ratio duffing_ueda ensemble/scalar: {d:.2}");
+    let t = best(&|| any_scalar(&two_dof))
+        / best(&|| any_lanes::<F64x8, _, _, 4>(&two_dof))
+            .min(best(&|| any_lanes::<F64x16, _, _, 4>(&two_dof)));
+    println!("throughput ratio two_dof_impact ensemble/scalar: {t:.2}");
+}
+
+criterion_group!(benches, bench, bench_any);
 criterion_main!(benches);

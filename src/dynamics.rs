@@ -187,7 +187,7 @@ pub trait LaneDynamics<const M: usize>: Dynamics<f64, M> + Clone {
 /// use nonsmooth::lanes::{F64x4, LaneMath, Lanes};
 /// use nonsmooth::{Dynamics, LaneByLane, LaneDynamics};
 ///
-/// #[derive(Clone)]
+/// #[derive(Clone, Debug)]
 /// struct Decay(f64);
 /// impl Dynamics<f64, 1> for Decay {
 ///     fn rhs(&self, _t: f64, y: &SVector<f64, 1>, dy: &mut SVector<f64, 1>) {

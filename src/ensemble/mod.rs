@@ -6,15 +6,35 @@
 //! lanes of a [`Lanes`] vector ([`F64x2`], [`F64x4`], [`F64x8`], [`F64x16`]) and steps them
 //! together with DOPRI5.
 //!
+//! # Which models
+//! Any model with a lane form ([`LaneDynamics`](crate::LaneDynamics)), of any state size
+//! `M`, each trajectory with its own parameters:
+//! * [`Oscillator`](crate::model::Oscillator) and the `N`-DOF
+//!   [`Mechanical`](crate::model::Mechanical) (state `2N`) built from laws and
+//!   excitations with lane forms — every built-in one
+//!   ([`LaneLaw`](crate::force::LaneLaw), [`LaneExcitation`](crate::excite::LaneExcitation)),
+//!   tuples and arrays of them, any coordinates, mass matrix, `K` and `C`;
+//! * the paper's oscillator family as a [`Member`] (the same lane form);
+//! * any other [`Dynamics`](crate::Dynamics), a law of one's own included, through
+//!   [`LaneByLane`](crate::LaneByLane): the right-hand side is then evaluated lane by lane
+//!   (correct, and slower by the share of the right-hand side in a step), everything else
+//!   in lanes.
+//!
+//! The events are any [`EventSet`](crate::event::EventSet) of the crate
+//! ([`Ensemble::with_events`]): level crossings, stops, gaps on fixed or moving surfaces,
+//! resets ([`Restitution`](crate::event::Restitution),
+//! [`NewtonImpact`](crate::event::NewtonImpact)), restarts and terminal events, handled
+//! per lane by the scalar driver's own code.
+//!
 //! # The lane method
-//! Every lane carries its own `t`, state `(x, ẋ)`, cached derivative (first same as last),
+//! Every lane carries its own `t`, state `y`, cached derivative (first same as last),
 //! proposed step `h`, step limit (the next landing point or its end) and controller memory
 //! (`ln` of the last accepted error, whether the last trial was rejected). One pass of the
 //! loop is one *trial* step in every lane: with `h_s = h` cut to the lane's limit
 //! (`h_s = t_limit − t` when `h ≥ 0.99·(t_limit − t)`), the six stages
 //! $$k_i = f\Bigl(t + c_i h_s,\; y + h_s\sum_{j<i} a_{ij}k_j\Bigr)$$
 //! of Dormand and Prince are evaluated in all lanes at once, then the error norm
-//! $$\|e\| = \sqrt{\tfrac12\sum_i \bigl(e_i/(a_i + r_i\max(|y_{0,i}|,|y_{1,i}|))\bigr)^2}$$
+//! $$\|e\| = \sqrt{\tfrac1M\sum_i \bigl(e_i/(a_i + r_i\max(|y_{0,i}|,|y_{1,i}|))\bigr)^2}$$
 //! and the PI controller `h_new = h_s / min(max(‖e‖^{α}‖e_old‖^{−β}/0.9, 1/10), 5)` on
 //! acceptance, `h_s / min(‖e‖^{α}/0.9, 5)` on rejection (the scalar
 //! [`Dopri5`](crate::integrate::Dopri5)'s constants, `α = 1/5 − 0.75β`, `β = 0.04`).
@@ -27,10 +47,13 @@
 //! smaller step on the next pass. A rejected lane therefore costs the others nothing but
 //! the slot it occupies for one pass: no lane waits for another. Accepted lanes are then
 //! visited one by one (a scalar loop over the set bits of `A`): their dense output is
-//! taken out of the lanes, events are located on it with the scalar driver's search (sign
-//! changes and grazing pairs, the same bracketing solver, tolerance `max(10⁻¹², 4ε|t|)`),
-//! and the observer of the lane's trajectory receives the step and its events exactly as
-//! from [`Simulation`](crate::drive::Simulation). A lane whose trajectory ends takes the
+//! taken out of the lanes and handed to the scalar driver's event handling — the same
+//! code as [`Simulation`](crate::drive::Simulation)'s, not a copy: crossings and grazing
+//! pairs located by the same search and tolerance `max(10⁻¹², 4ε|t|)`, records, resets,
+//! restarts, terminal events, the sticking check and the Zeno guard — and the observer of
+//! the lane's trajectory receives the step and its events exactly as from the driver. A
+//! reset or restart moves the lane to the event's state (its derivative evaluated again,
+//! its step and controller kept, as the scalar stepper does). A lane whose trajectory ends takes the
 //! next one of the batch (a work queue), so the vectors stay full until the queue runs
 //! dry. Events and observers are scalar work per accepted step and per event, a small
 //! part of a step's six vector evaluations.
@@ -59,11 +82,10 @@
 //! # Which width
 //! The step is a chain of dependent operations (the polynomials of `sin`, `exp`, `ln`, the
 //! stages), so more lanes than one register holds still pay: the extra registers are
-//! independent work that fills the pipeline while a chain waits. Measured on the paper's
-//! model (rtol 1e-8, one thread, a 2-core AMD EPYC with AVX-512, `examples/ensemble_throughput`):
-//! [`F64x16`] with [`LaneMath::Vector`] is the fastest on AVX-512, [`F64x8`] on AVX2; four
-//! lanes reach about 1.8× the scalar path and two about 1.3×. With few trajectories per
-//! thread, wide types leave lanes idle at the end of the queue.
+//! independent work that fills the pipeline while a chain waits: the widest types are
+//! usually the fastest (the README gives the measured ratios per model and width,
+//! `examples/ensemble_throughput` and `examples/ensemble_any` measure them on a machine).
+//! With few trajectories per thread, wide types leave lanes idle at the end of the queue.
 //!
 //! # Where ensembles are used
 //! * [`sweep_independent`] (and [`sweep_independent_parallel`]): a bifurcation sweep with
