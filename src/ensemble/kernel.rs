@@ -227,7 +227,9 @@ fn body<V: Lanes, D: LaneDynamics<M>, const M: usize>(
     let mut kk = [[zero; M]; 7];
     kk[0] = st.f;
     let mut yn = y;
-    let mut time = D::time_lanes(p, math, t);
+    // Stage 2's time terms; stages 3 to 6 compute theirs in the loop, stage 7 shares
+    // stage 6's (both at t_new).
+    let mut time = D::time_lanes(p, math, t + c2 * hs);
     for stage in 1..7 {
         let mut ys = [zero; M];
         let ts = match stage {
@@ -271,8 +273,7 @@ fn body<V: Lanes, D: LaneDynamics<M>, const M: usize>(
                 t_new
             }
         };
-        // Stages 6 and 7 are both at t_new: their time terms (the loads) are computed once.
-        if stage != 6 {
+        if stage != 1 && stage != 6 {
             time = D::time_lanes(p, math, ts);
         }
         let mut f = [zero; M];
