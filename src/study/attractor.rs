@@ -88,7 +88,8 @@ fn orbit(r: &PointRecord) -> &[[f64; 2]] {
 /// Whether `r` reached the attractor of `rep`.
 fn same(r: &PointRecord, rep: &PointRecord, study: &Study) -> bool {
     let a = &study.spec().attractors;
-    let scales = a.scales.unwrap_or(study.kind().scales());
+    let s = study.scales();
+    let scales = [s[0], s[1]];
     if r.period > 0 && r.period == rep.period {
         (r.impacts_per_period - rep.impacts_per_period).abs() < 1e-9
             && hausdorff(orbit(r), orbit(rep), scales) <= a.tol

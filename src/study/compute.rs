@@ -4,17 +4,14 @@ use std::collections::BTreeMap;
 
 use nalgebra::{SVector, Vector2};
 
-use super::model::{ModelKind, ParameterSet};
+use super::catalogue::Paper;
 use super::record::PointRecord;
 use super::shard::{Shard, shard_indices};
 use super::spec::{Study, apply_axis};
-use crate::Dynamics;
-use crate::ensemble::{Ensemble, F64x8, F64x16, IndependentSweep, Member, Simd, sweep_starts};
+use super::system::{ParameterPoint, PointRun, RunSettings, fill};
+use crate::ensemble::{Ensemble, F64x8, F64x16, Member, Simd, sweep_starts};
 use crate::entropy::{Histogram, QRange, entropy_index};
-use crate::integrate::{Dopri5, Tolerances};
-use crate::lyapunov::{Norm, TwoTrajectory};
-use crate::sample::Regime;
-use crate::sweep::{Stop, SweepError, SweepPoint, SweepSystem, run_point};
+use crate::sweep::SweepError;
 use crate::systems::paper::PaperParameters;
 
 /// Computes grid point `index` of `study` (a failure is recorded in the point's `status`,
@@ -27,35 +24,16 @@ pub fn compute_point(study: &Study, index: usize) -> PointRecord {
 }
 
 fn try_point(study: &Study, index: usize) -> Result<PointRecord, String> {
-    let (set, y0) = point_setup(study, index)?;
-    match study.kind() {
-        ModelKind::Paper => {
-            let (p, omega, y0) = paper_start(&set, y0)?;
-            run_model(
-                study,
-                index,
-                || Ok(p.oscillator::<f64>(omega)?),
-                std::f64::consts::TAU / omega,
-                Some(impact_stop(&p)),
-                y0,
-            )
-        }
-        ModelKind::DuffingUeda => {
-            let d = set.duffing().ok_or("internal: not Duffing–Ueda")?;
-            run_model(
-                study,
-                index,
-                || d.model::<f64>(),
-                d.period(),
-                None,
-                fill(y0, [0.0, 0.0]),
-            )
-        }
-    }
+    let (point, given) = point_setup(study, index)?;
+    let system = study.system();
+    let rest = system.rest_state(&point)?;
+    let y0 = fill(given.as_deref(), &rest);
+    let run = system.run(&point, &y0, &run_settings(study))?;
+    Ok(record(study, index, run))
 }
 
-/// The parameters and the given initial components of point `index`.
-fn point_setup(study: &Study, index: usize) -> Result<(ParameterSet, Option<[f64; 2]>), String> {
+/// The parameters and the given initial components (NaN: not given) of point `index`.
+fn point_setup(study: &Study, index: usize) -> Result<(ParameterPoint, Option<Vec<f64>>), String> {
     let spec = study.spec();
     if index >= study.points() {
         return Err(format!(
@@ -63,121 +41,77 @@ fn point_setup(study: &Study, index: usize) -> Result<(ParameterSet, Option<[f64
             study.points()
         ));
     }
-    let mut set = ParameterSet::new(study.kind(), &spec.system.parameters);
-    let mut y0 = spec.initial.state;
+    let system = study.system();
+    let mut point = system
+        .point(&spec.system.parameters)
+        .map_err(|e| e.to_string())?;
+    let mut y0 = spec.initial.state.map(|s| s.to_vec());
     let (xv, yv) = study.values(index);
-    apply_axis(&mut set, &mut y0, &spec.grid.x.parameter, xv);
+    apply_axis(system, &mut point, &mut y0, &spec.grid.x.parameter, xv);
     if let Some(y) = &spec.grid.y {
-        apply_axis(&mut set, &mut y0, &y.parameter, yv);
+        apply_axis(system, &mut point, &mut y0, &y.parameter, yv);
     }
-    Ok((set, y0))
+    Ok((point, y0))
+}
+
+/// The run settings of every point of `study`.
+pub(crate) fn run_settings(study: &Study) -> RunSettings {
+    let spec = study.spec();
+    let system = study.system();
+    let rtol = spec.integration.rtol;
+    let atol = match &spec.integration.atol {
+        Some(a) => a.to_vec(),
+        None => system.atol_per_rtol().iter().map(|a| a * rtol).collect(),
+    };
+    RunSettings {
+        rtol,
+        atol,
+        max_steps: spec.integration.max_steps,
+        transient: spec.periods.transient,
+        record: spec.periods.record,
+        period_tol: spec.record.period_tol,
+        max_period: spec.record.max_period,
+        lyapunov: spec
+            .record
+            .lyapunov
+            .as_ref()
+            .map(|l| (l.periods, l.d0.unwrap_or(system.d0()))),
+        scales: study.scales(),
+    }
 }
 
 /// The paper model's parameters, ω and initial state (the rest state where not given).
 fn paper_start(
-    set: &ParameterSet,
-    y0: Option<[f64; 2]>,
+    point: &ParameterPoint,
+    given: Option<Vec<f64>>,
 ) -> Result<(PaperParameters, f64, Vector2<f64>), String> {
-    let (p, omega) = set.paper().ok_or("internal: not the paper's model")?;
+    let (p, omega) = Paper::at(point);
     let rest = [p.static_equilibrium().map_err(|e| e.to_string())?, 0.0];
-    Ok((p, omega, fill(y0, rest)))
+    let y = fill(given.as_deref(), &rest);
+    Ok((p, omega, Vector2::new(y[0], y[1])))
 }
 
-/// Impacts: rising crossings of `x = x_I`.
-fn impact_stop(p: &PaperParameters) -> Stop {
-    Stop {
-        position: 0,
-        velocity: 1,
-        level: p.x_i,
-    }
-}
-
-/// The initial state: given components, the rest state for the others.
-fn fill(y0: Option<[f64; 2]>, rest: [f64; 2]) -> Vector2<f64> {
-    let s = y0.unwrap_or(rest);
-    let pick = |k: usize| if s[k].is_nan() { rest[k] } else { s[k] };
-    Vector2::new(pick(0), pick(1))
-}
-
-/// The integration tolerances and the sweep settings of every point.
-fn integration(study: &Study) -> Result<(Tolerances<f64, 2>, IndependentSweep), String> {
+/// The point's record from its run: period, sections, fingerprint, `q` and the top
+/// Lyapunov exponent.
+fn record(study: &Study, index: usize, run: PointRun) -> PointRecord {
     let spec = study.spec();
-    let s = |e: &dyn std::fmt::Display| e.to_string();
-    let rtol = spec.integration.rtol;
-    let atol = spec.integration.atol.unwrap_or({
-        let a = study.kind().atol_per_rtol();
-        [a[0] * rtol, a[1] * rtol]
-    });
-    let tol = Tolerances::per_component(rtol, atol).map_err(|e| s(&e))?;
-    let settings = IndependentSweep::new(spec.periods.transient, spec.periods.record)
-        .and_then(|c| c.period_detection(spec.record.period_tol, spec.record.max_period))
-        .map_err(|e| s(&e))?
-        .max_steps(spec.integration.max_steps);
-    Ok((tol, settings))
-}
-
-fn run_model<S, F>(
-    study: &Study,
-    index: usize,
-    make: F,
-    period: f64,
-    stop: Option<Stop>,
-    y0: Vector2<f64>,
-) -> Result<PointRecord, String>
-where
-    S: Dynamics<f64, 2>,
-    F: Fn() -> crate::Result<S>,
-{
-    let s = |e: &dyn std::fmt::Display| e.to_string();
-    let (tol, settings) = integration(study)?;
-    let cfg = settings.config(vec![0.0]).map_err(|e| s(&e))?;
-    let system = make().map_err(|e| s(&e))?;
-    let pt = run_point(
-        &cfg,
-        0.0,
-        SweepSystem {
-            system,
-            period,
-            stop,
-        },
-        Dopri5::new(tol),
-        y0,
-        settings.transient,
-    )
-    .map_err(|e| s(&e))?;
-    Ok(record(study, index, make, period, &tol, &pt))
-}
-
-/// The point's record from its run: period, sections, fingerprint, `q` and (a second,
-/// scalar run from the end state) the top Lyapunov exponent.
-fn record<S, F>(
-    study: &Study,
-    index: usize,
-    make: F,
-    period: f64,
-    tol: &Tolerances<f64, 2>,
-    pt: &SweepPoint<2>,
-) -> PointRecord
-where
-    S: Dynamics<f64, 2>,
-    F: Fn() -> crate::Result<S>,
-{
-    let spec = study.spec();
-    let kind = study.kind();
-    let period_n = match pt.regime {
-        Regime::Periodic(p) => p,
-        Regime::NotPeriodic => 0,
-    };
-    let keep = spec.record.poincare.max(period_n).min(pt.poincare.len());
-    let sections: Vec<[f64; 2]> = pt.poincare[pt.poincare.len() - keep..]
+    let period_n = run.period;
+    let keep = spec.record.poincare.max(period_n).min(run.poincare.len());
+    let sections: Vec<[f64; 2]> = run.poincare[run.poincare.len() - keep..]
         .iter()
         .map(|p| [p[0], p[1]])
         .collect();
-    let scales = spec.attractors.scales.unwrap_or(kind.scales());
+    let scales = study.scales();
+    let scales = [scales[0], scales[1]];
     // Fingerprints are compared only between points of the same system parameters, which
     // exist only on a grid with an initial-condition axis.
     let cells = if study.has_initial_condition_axis() {
-        fingerprint(&pt.poincare, scales, spec.attractors.cell)
+        let points: Vec<SVector<f64, 2>> = run
+            .poincare
+            .iter()
+            .map(|p| SVector::<f64, 2>::new(p[0], p[1]))
+            .collect();
+        fingerprint(&points, scales, spec.attractors.cell)
     } else {
         Vec::new()
     };
@@ -185,7 +119,7 @@ where
         index,
         status: "ok".into(),
         period: period_n,
-        impacts_per_period: pt.impacts_per_period,
+        impacts_per_period: run.impacts_per_period,
         tle: f64::NAN,
         tle_spread: f64::NAN,
         q: f64::NAN,
@@ -195,33 +129,17 @@ where
     if let Some(q) = &spec.record.q {
         rec.q = Histogram::new(q.lo, q.hi, q.step)
             .ok()
-            .and_then(|h| h.estimate(&pt.intervals).ok())
+            .and_then(|h| h.estimate(&run.intervals).ok())
             .and_then(|est| entropy_index(&est.probabilities, &QRange::default()).ok())
             .map_or(f64::NAN, |i| i.q);
     }
-    if let Some(l) = &spec.record.lyapunov {
-        let tle = (|| -> crate::Result<(f64, f64)> {
-            let norm = Norm::weighted(scales)?;
-            let d0 = l.d0.unwrap_or(kind.d0());
-            let mut est = TwoTrajectory::<f64, 2, 4, _, _>::with_tolerances(
-                make()?,
-                Dopri5::new,
-                tol,
-                d0,
-                norm,
-            )?;
-            // The run ended after a whole number of periods: t = 0 has the same phase.
-            est.start(0.0, pt.end_state)?;
-            let e = est.estimate(period, l.periods)?;
-            Ok((e.exponent, e.spread))
-        })();
-        match tle {
-            Ok((l, sp)) => {
-                rec.tle = l;
-                rec.tle_spread = sp;
-            }
-            Err(e) => rec.status = format!("lyapunov: {e}"),
+    match run.lyapunov {
+        Some(Ok((l, sp))) => {
+            rec.tle = l;
+            rec.tle_spread = sp;
         }
+        Some(Err(e)) => rec.status = format!("lyapunov: {e}"),
+        None => {}
     }
     rec
 }
@@ -262,6 +180,14 @@ fn fingerprint(points: &[SVector<f64, 2>], scales: [f64; 2], cell: f64) -> Vec<(
 /// Points per batch of the paper model's lanes (a batch runs on one thread).
 const BATCH: usize = 64;
 
+/// THE DISPATCH TO LANES: the system of `study` if its points run in SIMD lanes — today the
+/// paper's model only ([`sweep_starts`] over [`Member`], the paper's oscillator family);
+/// every other system runs point by point on the scalar path ([`compute_point`]). Lanes
+/// for other systems are added here.
+fn lanes(study: &Study) -> Option<&Paper> {
+    study.system().as_any().downcast_ref::<Paper>()
+}
+
 /// Computes the points of `shard` in parallel (rayon, in the current pool), calling
 /// `progress` after each point; returned in index order. The result does not depend on the
 /// number of threads: each point depends only on the spec and its index.
@@ -270,12 +196,12 @@ const BATCH: usize = 64;
 /// [`LaneMath::Exact`](crate::ensemble::LaneMath::Exact), batches of 64 points per
 /// task), which gives each point's run to the bit as [`compute_point`] does (tested); the
 /// Lyapunov exponent, where recorded, is the scalar two-trajectory estimate from the run's
-/// end state. Duffing–Ueda points run on the scalar path.
+/// end state. The points of every other system run on the scalar path.
 pub fn run_shard<F: Fn() + Sync>(study: &Study, shard: Shard, progress: F) -> Vec<PointRecord> {
     use rayon::prelude::*;
     let idx: Vec<usize> = shard_indices(study.points(), shard).collect();
-    match study.kind() {
-        ModelKind::Paper => idx
+    match lanes(study) {
+        Some(_) => idx
             .par_chunks(BATCH)
             .flat_map_iter(|batch| {
                 let recs = paper_batch(study, batch);
@@ -283,7 +209,7 @@ pub fn run_shard<F: Fn() + Sync>(study: &Study, shard: Shard, progress: F) -> Ve
                 recs
             })
             .collect(),
-        ModelKind::DuffingUeda => idx
+        None => idx
             .par_iter()
             .map(|&i| {
                 let r = compute_point(study, i);
@@ -297,7 +223,8 @@ pub fn run_shard<F: Fn() + Sync>(study: &Study, shard: Shard, progress: F) -> Ve
 /// The paper model's points `indices` in lanes: the records of [`compute_point`], to the
 /// bit, with the same messages for what fails.
 fn paper_batch(study: &Study, indices: &[usize]) -> Vec<PointRecord> {
-    let (tol, settings) = match integration(study) {
+    let run_settings = run_settings(study);
+    let (tol, settings) = match Paper::integration(&run_settings) {
         Ok(v) => v,
         Err(m) => {
             return indices
@@ -311,7 +238,7 @@ fn paper_batch(study: &Study, indices: &[usize]) -> Vec<PointRecord> {
     // move it).
     let mut groups: BTreeMap<u64, Vec<(usize, Member, Vector2<f64>)>> = BTreeMap::new();
     for (k, &i) in indices.iter().enumerate() {
-        let start = point_setup(study, i).and_then(|(set, y0)| paper_start(&set, y0));
+        let start = point_setup(study, i).and_then(|(point, y0)| paper_start(&point, y0));
         match start {
             Err(m) => recs[k] = Some(PointRecord::failed(i, m)),
             Ok((p, omega, y0)) => match Member::new(p, omega) {
@@ -328,7 +255,7 @@ fn paper_batch(study: &Study, indices: &[usize]) -> Vec<PointRecord> {
         sweep_starts::<F64x8>
     };
     for group in groups.values() {
-        let stop = impact_stop(group[0].1.params());
+        let stop = Paper::impact_stop(group[0].1.params());
         let starts: Vec<(Member, Vector2<f64>)> = group.iter().map(|(_, m, y)| (*m, *y)).collect();
         let run = Ensemble::new(tol)
             .map_err(|e| SweepError::failed(0.0, e))
@@ -344,7 +271,17 @@ fn paper_batch(study: &Study, indices: &[usize]) -> Vec<PointRecord> {
                     let i = indices[*k];
                     recs[*k] = Some(match r {
                         Err(e) => PointRecord::failed(i, SweepError::failed(0.0, e).to_string()),
-                        Ok(pt) => record(study, i, || Ok(*m.scalar()), m.period(), &tol, &pt),
+                        Ok(pt) => record(
+                            study,
+                            i,
+                            Paper::point_run(
+                                &run_settings,
+                                || Ok(*m.scalar()),
+                                m.period(),
+                                &tol,
+                                &pt,
+                            ),
+                        ),
                     });
                 }
             }

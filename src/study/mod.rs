@@ -89,13 +89,15 @@
 //! section points, the attractor summary and the PNG figure ([`Merged::figure`]).
 
 mod attractor;
+mod catalogue;
 mod compute;
 mod merge;
-mod model;
 mod plan;
 mod record;
+mod scalar;
 mod shard;
 mod spec;
+mod system;
 
 pub use attractor::{AttractorSummary, identify, regime_class};
 pub use compute::{MAX_CELLS, compute_point, run_shard};

@@ -6,8 +6,11 @@ use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
 
+use std::sync::Arc;
+
 use super::StudyError;
-use super::model::{ModelKind, ParameterSet};
+use super::catalogue;
+use super::system::{ParameterPoint, StudySystem};
 
 /// The most grid points of one study (10⁸: a 10⁴ × 10⁴ plane).
 pub const MAX_POINTS: usize = 100_000_000;
@@ -129,10 +132,26 @@ impl Axis {
         }
     }
 
-    /// Whether the axis is an initial-condition component.
+    /// Whether the axis is an initial-condition component: `x0`, `v0` (one degree of
+    /// freedom) or `xK_0`, `vK_0` (degree of freedom `K ≥ 1` of several).
     pub fn is_initial_condition(&self) -> bool {
-        self.parameter == "x0" || self.parameter == "v0"
+        is_initial_name(&self.parameter)
     }
+}
+
+/// Whether `name` has the form of an initial-condition component: `x0`, `v0`, `xK_0`,
+/// `vK_0` (`K` a positive integer without leading zeros).
+pub(crate) fn is_initial_name(name: &str) -> bool {
+    if name == "x0" || name == "v0" {
+        return true;
+    }
+    let Some(rest) = name.strip_prefix('x').or_else(|| name.strip_prefix('v')) else {
+        return false;
+    };
+    let Some(k) = rest.strip_suffix("_0") else {
+        return false;
+    };
+    !k.is_empty() && !k.starts_with('0') && k.bytes().all(|b| b.is_ascii_digit())
 }
 
 /// The initial state.
@@ -332,17 +351,24 @@ impl StudySpec {
     /// # Errors
     /// [`StudyError::InvalidSpec`].
     pub fn validate(&self) -> Result<(), StudyError> {
+        self.checked().map(|_| ())
+    }
+
+    /// Checks every field and returns the system.
+    fn checked(&self) -> Result<Arc<dyn StudySystem>, StudyError> {
         self.validate_name()?;
-        let kind = ModelKind::parse(&self.system.model)?;
-        self.validate_system(kind)?;
+        let system = catalogue::system(&self.system.model)?;
+        let sys = &*system;
+        self.validate_system(sys)?;
         let axes = self.axes();
-        self.validate_grid(kind, &axes)?;
+        self.validate_grid(sys, &axes)?;
         self.validate_initial()?;
         self.validate_integration()?;
         self.validate_periods()?;
         self.validate_record()?;
         self.validate_attractors()?;
-        self.validate_axis_models(kind, &axes)
+        self.validate_axis_models(sys, &axes)?;
+        Ok(system)
     }
 
     /// The number of grid points.
@@ -398,15 +424,15 @@ impl StudySpec {
     }
 
     /// The fixed parameters: known to the model and finite.
-    fn validate_system(&self, kind: ModelKind) -> Result<(), StudyError> {
+    fn validate_system(&self, system: &dyn StudySystem) -> Result<(), StudyError> {
         for (name, &v) in &self.system.parameters {
-            if !kind.parameter_names().contains(&name.as_str()) {
+            if !system.has_parameter(name) {
                 return Err(invalid(
                     format!("system.parameters.{name}"),
                     format!(
                         "unknown parameter of model {:?}; known: {}",
                         self.system.model,
-                        kind.parameter_names().join(", ")
+                        system.parameter_list()
                     ),
                 ));
             }
@@ -429,11 +455,15 @@ impl StudySpec {
         axes
     }
 
-    /// Each axis on its own, two distinct axes, the number of points, and the forcing
-    /// frequency given somewhere if the model needs one.
-    fn validate_grid(&self, kind: ModelKind, axes: &[(&str, &Axis)]) -> Result<(), StudyError> {
+    /// Each axis on its own, two distinct axes, the number of points, and every parameter
+    /// without a default (the paper's forcing frequency) given somewhere.
+    fn validate_grid(
+        &self,
+        system: &dyn StudySystem,
+        axes: &[(&str, &Axis)],
+    ) -> Result<(), StudyError> {
         for (field, a) in axes {
-            self.validate_axis(kind, field, a)?;
+            self.validate_axis(system, field, a)?;
         }
         if let Some(y) = &self.grid.y {
             if y.parameter == self.grid.x.parameter {
@@ -451,30 +481,52 @@ impl StudySpec {
                 format!("{total} points; at most {MAX_POINTS}"),
             ));
         }
-        if !axes.iter().any(|(_, a)| a.parameter == "omega")
-            && kind.requires_omega()
-            && !self.system.parameters.contains_key("omega")
-        {
-            return Err(invalid(
-                "system.parameters.omega",
-                "the forcing frequency must be given (here or as a grid axis)",
-            ));
+        for d in system.parameters() {
+            if d.default.is_none() && !self.is_given(&d.name, axes) {
+                return Err(invalid(
+                    format!("system.parameters.{}", d.name),
+                    format!(
+                        "{} has no default: it must be given (here or as a grid axis)",
+                        d.name
+                    ),
+                ));
+            }
         }
         Ok(())
     }
 
+    /// Whether parameter `name` is given in `system.parameters` or as an axis.
+    fn is_given(&self, name: &str, axes: &[(&str, &Axis)]) -> bool {
+        self.system.parameters.contains_key(name) || axes.iter().any(|(_, a)| a.parameter == name)
+    }
+
+    /// Whether parameter `name` has no default and is not a fixed parameter of the spec.
+    fn unset_required(&self, system: &dyn StudySystem, name: &str) -> bool {
+        !self.system.parameters.contains_key(name)
+            && system
+                .parameters()
+                .iter()
+                .any(|d| d.name == name && d.default.is_none())
+    }
+
     /// One axis: a known parameter, at least one point, finite and increasing ends.
-    fn validate_axis(&self, kind: ModelKind, field: &str, a: &Axis) -> Result<(), StudyError> {
-        let known =
-            a.is_initial_condition() || kind.parameter_names().contains(&a.parameter.as_str());
+    fn validate_axis(
+        &self,
+        system: &dyn StudySystem,
+        field: &str,
+        a: &Axis,
+    ) -> Result<(), StudyError> {
+        let initial = system.initial_names();
+        let known = initial.contains(&a.parameter) || system.has_parameter(&a.parameter);
         if !known {
             return Err(invalid(
                 format!("{field}.parameter"),
                 format!(
-                    "unknown parameter {:?} of model {:?}; known: {}, x0, v0",
+                    "unknown parameter {:?} of model {:?}; known: {}, {}",
                     a.parameter,
                     self.system.model,
-                    kind.parameter_names().join(", ")
+                    system.parameter_list(),
+                    initial.join(", ")
                 ),
             ));
         }
@@ -598,10 +650,10 @@ impl StudySpec {
     /// at fault; a parameter without a default (the paper's `omega`) takes its axis start.
     fn validate_axis_models(
         &self,
-        kind: ModelKind,
+        system: &dyn StudySystem,
         axes: &[(&str, &Axis)],
     ) -> Result<(), StudyError> {
-        let set = ParameterSet::new(kind, &self.system.parameters);
+        let set = system.point(&self.system.parameters)?;
         for (field, a) in axes {
             for k in 0..a.points {
                 let v = a.value(k);
@@ -616,18 +668,15 @@ impl StudySpec {
                     ));
                 }
                 let mut p = set.clone();
-                let mut y0 = self.initial.state;
+                let mut y0 = self.initial.state.map(|s| s.to_vec());
                 for (_, b) in axes {
                     if b.parameter == a.parameter {
-                        apply_axis(&mut p, &mut y0, &b.parameter, v);
-                    } else if b.parameter == "omega"
-                        && kind.requires_omega()
-                        && !self.system.parameters.contains_key("omega")
-                    {
-                        apply_axis(&mut p, &mut y0, &b.parameter, b.start);
+                        apply_axis(system, &mut p, &mut y0, &b.parameter, v);
+                    } else if self.unset_required(system, &b.parameter) {
+                        apply_axis(system, &mut p, &mut y0, &b.parameter, b.start);
                     }
                 }
-                p.check().map_err(|e| {
+                system.check(&p).map_err(|e| {
                     invalid(
                         field.to_string(),
                         format!(
@@ -696,24 +745,40 @@ pub(crate) fn fnv1a(bytes: &[u8]) -> u64 {
     h
 }
 
-/// Sets an axis value: a model parameter or an initial-condition component.
-pub(crate) fn apply_axis(p: &mut ParameterSet, y0: &mut Option<[f64; 2]>, name: &str, value: f64) {
-    match name {
-        "x0" | "v0" => {
-            let mut s = y0.unwrap_or([f64::NAN, f64::NAN]);
-            s[usize::from(name == "v0")] = value;
-            *y0 = Some(s);
+/// Sets an axis value: a model parameter or an initial-condition component (`y0` holds the
+/// given components, NaN for the others). Names are checked by the spec.
+pub(crate) fn apply_axis(
+    system: &dyn StudySystem,
+    p: &mut ParameterPoint,
+    y0: &mut Option<Vec<f64>>,
+    name: &str,
+    value: f64,
+) {
+    match system.initial_names().iter().position(|n| n == name) {
+        Some(k) => {
+            let s = y0.get_or_insert_with(|| vec![f64::NAN; system.dimension()]);
+            if let Some(c) = s.get_mut(k) {
+                *c = value;
+            }
         }
-        _ => p.set(name, value),
+        None => {
+            let _ = p.set(name, value);
+        }
     }
 }
 
-/// A validated study: the spec, its hash and its grid.
-#[derive(Debug, Clone, PartialEq)]
+/// A validated study: the spec, its hash, its system and its grid.
+#[derive(Debug, Clone)]
 pub struct Study {
     spec: StudySpec,
     hash: String,
-    kind: ModelKind,
+    system: Arc<dyn StudySystem>,
+}
+
+impl PartialEq for Study {
+    fn eq(&self, other: &Self) -> bool {
+        self.spec == other.spec && self.hash == other.hash
+    }
 }
 
 impl Study {
@@ -722,10 +787,9 @@ impl Study {
     /// # Errors
     /// As [`StudySpec::validate`].
     pub fn new(spec: StudySpec) -> Result<Self, StudyError> {
-        spec.validate()?;
+        let system = spec.checked()?;
         let hash = spec.hash()?;
-        let kind = ModelKind::parse(&spec.system.model)?;
-        Ok(Self { spec, hash, kind })
+        Ok(Self { spec, hash, system })
     }
 
     /// Reads a study from TOML text.
@@ -756,9 +820,17 @@ impl Study {
         &self.hash
     }
 
-    /// The model.
-    pub(crate) fn kind(&self) -> ModelKind {
-        self.kind
+    /// The system.
+    pub(crate) fn system(&self) -> &dyn StudySystem {
+        &*self.system
+    }
+
+    /// The scales of the state components: `attractors.scales`, or the system's.
+    pub(crate) fn scales(&self) -> Vec<f64> {
+        match &self.spec.attractors.scales {
+            Some(s) => s.to_vec(),
+            None => self.system.scales(),
+        }
     }
 
     /// The number of grid points.
