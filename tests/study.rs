@@ -1003,3 +1003,96 @@ fn plan_rejects_or_quotes_every_hostile_value() {
     assert!(err.contains("--partition"), "{err}");
     assert!(!pwned.exists());
 }
+
+/// A system of two degrees of freedom (the catalogue's 2-DOF impact oscillator: a state of
+/// four components, one impact surface) over the forcing frequency and the initial position
+/// of the secondary mass.
+const TWO_DOF: &str = r#"
+name = "two_dof"
+[system]
+model = "two_dof_impact"
+[grid]
+x = { parameter = "omega", start = 0.5, end = 0.9, points = 4 }
+y = { parameter = "x2_0", start = -0.3, end = 0.3, points = 3 }
+[periods]
+transient = 40
+record = 16
+[record]
+poincare = 4
+lyapunov = { periods = 10 }
+"#;
+
+#[test]
+fn a_two_dof_study_records_whole_states_and_merges_identically_in_shards() {
+    let study = Study::from_toml(TWO_DOF).unwrap();
+    let mut results = Vec::new();
+    for n in [1, 3] {
+        let d = scratch(&format!("two-dof-{n}"));
+        run_in_shards(&study, &d, n);
+        let (_, recs) = read_shards(&d).unwrap();
+        // What the shard files hold is what the points computed.
+        for r in &recs {
+            assert_eq!(
+                format!("{r:?}"),
+                format!("{:?}", compute_point(&study, r.index))
+            );
+        }
+        results.push(merged_bytes(&d));
+        if n == 1 {
+            let m = Merged::from_dir(&d).unwrap();
+            m.write(&d.join("merged.csv")).unwrap();
+            let sections = fs::read_to_string(d.join("merged.sections.csv")).unwrap();
+            assert!(sections.starts_with("index,k,x1,x2,v1,v2\n"), "{sections}");
+            let attractors = fs::read_to_string(d.join("merged.attractors.csv")).unwrap();
+            assert!(
+                attractors
+                    .lines()
+                    .next()
+                    .unwrap()
+                    .ends_with(",centroid_x1,centroid_x2,centroid_v1,centroid_v2"),
+                "{attractors}"
+            );
+            assert!(d.join("merged.png").exists());
+        }
+        for r in &recs {
+            assert!(r.is_ok(), "point {}: {}", r.index, r.status);
+            assert!(!r.sections.is_empty());
+            assert!(r.sections.iter().all(|s| s.len() == 4));
+            // An initial-condition axis: fingerprints of four integers per cell.
+            assert!(!r.cells.is_empty() && r.cells.iter().all(|c| c.len() == 4));
+            // One surface: no per-surface columns.
+            assert!(r.impacts_per_surface.is_empty());
+        }
+        // The secondary mass hits its stop at every frequency of the map.
+        assert!(recs.iter().all(|r| r.impacts_per_period > 0.0));
+        // The axis of the secondary mass's start moves it: its first sections differ.
+        let (a, b) = (&recs[0].sections, &recs[8].sections);
+        assert_eq!(study.values(8).1, 0.3);
+        assert!(a != b || recs[0].period == 1);
+    }
+    assert_eq!(results[0], results[1], "1 vs 3 shards");
+    // Settings of the wrong size are rejected, naming the field.
+    expect_spec_error(
+        &TWO_DOF.replace("[periods]", "[initial]\nstate = [0.0, 0.0]\n[periods]"),
+        "initial.state",
+    );
+    expect_spec_error(
+        &TWO_DOF.replace(
+            "[periods]",
+            "[attractors]\nscales = [1.0, 1.0, 1.0]\n[periods]",
+        ),
+        "attractors.scales",
+    );
+    expect_spec_error(
+        &TWO_DOF.replace(
+            "[periods]",
+            "[integration]\natol = [1e-9, 1e-9, 1e-9, -1.0]\n[periods]",
+        ),
+        "integration.atol[3]",
+    );
+    // `x0` is the initial-condition axis of one degree of freedom, not of two.
+    expect_spec_error(
+        &TWO_DOF.replace("parameter = \"x2_0\"", "parameter = \"x0\""),
+        "grid.y.parameter",
+    );
+}

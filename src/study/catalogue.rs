@@ -19,7 +19,7 @@ use crate::lyapunov::{Norm, TwoTrajectory};
 use crate::sample::Regime;
 use crate::sweep::{SweepPoint, SweepSystem, run_point};
 use crate::systems::paper::{PAPER, PaperParameters};
-use crate::systems::{BouncingBallTable, DuffingUeda};
+use crate::systems::{BouncingBallTable, DuffingUeda, TwoDofImpact};
 use crate::{Dynamics, ParameterError};
 
 /// A system of the catalogue, made on demand.
@@ -29,6 +29,7 @@ type Make = fn() -> Arc<dyn StudySystem>;
 const CATALOGUE: &[(&str, Make)] = &[
     ("paper", || Arc::new(Paper::new())),
     ("duffing_ueda", || Arc::new(Duffing::new())),
+    ("two_dof_impact", || Arc::new(TwoDof::new())),
     ("bouncing_ball", || Arc::new(Ball::new())),
 ];
 
@@ -220,16 +221,17 @@ impl StudySystem for Paper {
     fn d0(&self) -> f64 {
         crate::systems::paper::lyapunov::D0
     }
-    fn check(&self, p: &ParameterPoint) -> Result<(), crate::Error> {
+    fn check(&self, p: &ParameterPoint) -> Result<(), String> {
         let (q, omega) = Self::at(p);
-        q.oscillator::<f64>(omega)?;
+        q.oscillator::<f64>(omega)
+            .map_err(|e| crate::Error::from(e).to_string())?;
         if !(q.m0e > 0.0) {
-            return Err(ParameterError::new(
+            let e = ParameterError::new(
                 "amplitude_factor",
                 q.m0e,
                 "such that m0e·amplitude_factor > 0",
-            )
-            .into());
+            );
+            return Err(crate::Error::from(e).to_string());
         }
         Ok(())
     }
@@ -325,8 +327,11 @@ impl StudySystem for Duffing {
     fn d0(&self) -> f64 {
         1e-6
     }
-    fn check(&self, p: &ParameterPoint) -> Result<(), crate::Error> {
-        Self::at(p).model::<f64>().map(|_| ())
+    fn check(&self, p: &ParameterPoint) -> Result<(), String> {
+        Self::at(p)
+            .model::<f64>()
+            .map(|_| ())
+            .map_err(|e| e.to_string())
     }
     fn rest_state(&self, _p: &ParameterPoint) -> Result<Vec<f64>, String> {
         Ok(vec![0.0, 0.0])
@@ -334,7 +339,101 @@ impl StudySystem for Duffing {
     fn run(&self, p: &ParameterPoint, y0: &[f64], s: &RunSettings) -> Result<PointRun, String> {
         let d = Self::at(p);
         let model = d.model::<f64>().map_err(|e| e.to_string())?;
-        scalar::run_smooth::<2, _, Stop>(s, model, Vec::new(), d.period(), y0)
+        scalar::run_smooth::<2, 4, _, Stop>(s, model, Vec::new(), d.period(), y0)
+    }
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// The 2-DOF impact oscillator.
+
+/// The 2-DOF impact oscillator ([`TwoDofImpact`]; `omega` the forcing frequency, default
+/// 0.7 near the primary resonance; `amplitude_factor` a factor on `force`). One surface:
+/// the stop of the secondary mass.
+#[derive(Debug)]
+struct TwoDof {
+    params: Vec<ParameterDef>,
+}
+
+impl TwoDof {
+    fn new() -> Self {
+        let d = TwoDofImpact::default();
+        Self {
+            params: defs(&[
+                ("omega", Some(0.7)),
+                ("amplitude_factor", Some(1.0)),
+                ("m1", Some(d.m1)),
+                ("m2", Some(d.m2)),
+                ("k1", Some(d.k1)),
+                ("k2", Some(d.k2)),
+                ("c1", Some(d.c1)),
+                ("c2", Some(d.c2)),
+                ("force", Some(d.force)),
+                ("gap", Some(d.gap)),
+                ("k_contact", Some(d.k_contact)),
+                ("b_contact", Some(d.b_contact)),
+            ]),
+        }
+    }
+
+    fn at(p: &ParameterPoint) -> (TwoDofImpact, f64) {
+        (
+            TwoDofImpact {
+                m1: p.get("m1"),
+                m2: p.get("m2"),
+                k1: p.get("k1"),
+                k2: p.get("k2"),
+                c1: p.get("c1"),
+                c2: p.get("c2"),
+                force: p.get("force") * p.get("amplitude_factor"),
+                gap: p.get("gap"),
+                k_contact: p.get("k_contact"),
+                b_contact: p.get("b_contact"),
+            },
+            p.get("omega"),
+        )
+    }
+}
+
+impl StudySystem for TwoDof {
+    fn name(&self) -> &str {
+        "two_dof_impact"
+    }
+    fn parameters(&self) -> &[ParameterDef] {
+        &self.params
+    }
+    fn dimension(&self) -> usize {
+        4
+    }
+    fn surfaces(&self) -> usize {
+        1
+    }
+    fn scales(&self) -> Vec<f64> {
+        vec![0.1; 4]
+    }
+    fn atol_per_rtol(&self) -> Vec<f64> {
+        vec![0.01; 4]
+    }
+    fn d0(&self) -> f64 {
+        1e-6
+    }
+    fn check(&self, p: &ParameterPoint) -> Result<(), String> {
+        let (d, omega) = Self::at(p);
+        let e = |e: crate::Error| e.to_string();
+        d.model::<f64>(omega).map_err(e)?;
+        d.stop::<f64>().map(|_| ()).map_err(e)
+    }
+    fn rest_state(&self, _p: &ParameterPoint) -> Result<Vec<f64>, String> {
+        Ok(vec![0.0; 4])
+    }
+    fn run(&self, p: &ParameterPoint, y0: &[f64], s: &RunSettings) -> Result<PointRun, String> {
+        let (d, omega) = Self::at(p);
+        let e = |e: crate::Error| e.to_string();
+        let model = d.model::<f64>(omega).map_err(e)?;
+        let stop = d.stop::<f64>().map_err(e)?;
+        scalar::run_smooth::<4, 8, _, _>(s, model, vec![stop], TwoDofImpact::period(omega), y0)
     }
     fn as_any(&self) -> &dyn std::any::Any {
         self
@@ -399,10 +498,11 @@ impl StudySystem for Ball {
     fn d0(&self) -> f64 {
         1e-6
     }
-    fn check(&self, p: &ParameterPoint) -> Result<(), crate::Error> {
+    fn check(&self, p: &ParameterPoint) -> Result<(), String> {
         let b = Self::at(p);
-        b.model::<f64>()?;
-        b.impact::<f64>().map(|_| ())
+        let e = |e: crate::Error| e.to_string();
+        b.model::<f64>().map_err(e)?;
+        b.impact::<f64>().map(|_| ()).map_err(e)
     }
     fn rest_state(&self, p: &ParameterPoint) -> Result<Vec<f64>, String> {
         Ok(vec![0.0, Self::at(p).table_motion(0.0).1 + 2.0])

@@ -2,7 +2,7 @@
 
 use std::collections::BTreeMap;
 
-use nalgebra::{SVector, Vector2};
+use nalgebra::Vector2;
 
 use super::catalogue::Paper;
 use super::record::PointRecord;
@@ -19,7 +19,7 @@ use crate::systems::paper::PaperParameters;
 pub fn compute_point(study: &Study, index: usize) -> PointRecord {
     match try_point(study, index) {
         Ok(r) => r,
-        Err(m) => PointRecord::failed(index, m),
+        Err(m) => failed(study, index, m),
     }
 }
 
@@ -45,7 +45,7 @@ fn point_setup(study: &Study, index: usize) -> Result<(ParameterPoint, Option<Ve
     let mut point = system
         .point(&spec.system.parameters)
         .map_err(|e| e.to_string())?;
-    let mut y0 = spec.initial.state.map(|s| s.to_vec());
+    let mut y0 = spec.initial.state.clone();
     let (xv, yv) = study.values(index);
     apply_axis(system, &mut point, &mut y0, &spec.grid.x.parameter, xv);
     if let Some(y) = &spec.grid.y {
@@ -97,21 +97,16 @@ fn record(study: &Study, index: usize, run: PointRun) -> PointRecord {
     let spec = study.spec();
     let period_n = run.period;
     let keep = spec.record.poincare.max(period_n).min(run.poincare.len());
-    let sections: Vec<[f64; 2]> = run.poincare[run.poincare.len() - keep..]
-        .iter()
-        .map(|p| [p[0], p[1]])
-        .collect();
-    let scales = study.scales();
-    let scales = [scales[0], scales[1]];
+    let sections: Vec<Vec<f64>> = run.poincare[run.poincare.len() - keep..].to_vec();
     // Fingerprints are compared only between points of the same system parameters, which
     // exist only on a grid with an initial-condition axis.
     let cells = if study.has_initial_condition_axis() {
-        let points: Vec<SVector<f64, 2>> = run
-            .poincare
-            .iter()
-            .map(|p| SVector::<f64, 2>::new(p[0], p[1]))
-            .collect();
-        fingerprint(&points, scales, spec.attractors.cell)
+        fingerprint(&run.poincare, &study.scales(), spec.attractors.cell)
+    } else {
+        Vec::new()
+    };
+    let impacts_per_surface = if study.system().surfaces() >= 2 {
+        run.impacts_per_surface
     } else {
         Vec::new()
     };
@@ -120,6 +115,7 @@ fn record(study: &Study, index: usize, run: PointRun) -> PointRecord {
         status: "ok".into(),
         period: period_n,
         impacts_per_period: run.impacts_per_period,
+        impacts_per_surface,
         tle: f64::NAN,
         tle_spread: f64::NAN,
         q: f64::NAN,
@@ -149,19 +145,19 @@ pub const MAX_CELLS: usize = 256;
 
 /// The cells of side `cell·scale` visited by the section points, at most [`MAX_CELLS`] of
 /// them (the most visited; ties by cell), sorted.
-fn fingerprint(points: &[SVector<f64, 2>], scales: [f64; 2], cell: f64) -> Vec<(i64, i64)> {
-    let mut all: Vec<(i64, i64)> = points
+fn fingerprint(points: &[Vec<f64>], scales: &[f64], cell: f64) -> Vec<Vec<i64>> {
+    let mut all: Vec<Vec<i64>> = points
         .iter()
         .map(|p| {
             // `as` saturates: a far-out point lands in an edge cell instead of wrapping.
-            (
-                (p[0] / (scales[0] * cell)).floor() as i64,
-                (p[1] / (scales[1] * cell)).floor() as i64,
-            )
+            p.iter()
+                .zip(scales)
+                .map(|(x, s)| (x / (s * cell)).floor() as i64)
+                .collect()
         })
         .collect();
     all.sort_unstable();
-    let mut counted: Vec<((i64, i64), usize)> = Vec::new();
+    let mut counted: Vec<(Vec<i64>, usize)> = Vec::new();
     for c in all {
         match counted.last_mut() {
             Some((last, n)) if *last == c => *n += 1,
@@ -172,9 +168,19 @@ fn fingerprint(points: &[SVector<f64, 2>], scales: [f64; 2], cell: f64) -> Vec<(
         counted.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
         counted.truncate(MAX_CELLS);
     }
-    let mut cells: Vec<(i64, i64)> = counted.into_iter().map(|(c, _)| c).collect();
+    let mut cells: Vec<Vec<i64>> = counted.into_iter().map(|(c, _)| c).collect();
     cells.sort_unstable();
     cells
+}
+
+/// A point whose run failed: with NaN impacts on each surface of a system with two or more.
+fn failed(study: &Study, index: usize, message: String) -> PointRecord {
+    let mut r = PointRecord::failed(index, message);
+    let n = study.system().surfaces();
+    if n >= 2 {
+        r.impacts_per_surface = vec![f64::NAN; n];
+    }
+    r
 }
 
 /// Points per batch of the paper model's lanes (a batch runs on one thread).

@@ -1,7 +1,8 @@
 //! The scalar path of a study point for any system: one [`Simulation`] (or a run through
 //! rigid contact with sticking, [`run_with_sticking`]) with a stroboscopic sampler and the
 //! impacts on each surface, then the top Lyapunov exponent by two trajectories
-//! ([`HybridTwoTrajectory`], which carries the resets of rigid impacts).
+//! ([`TwoTrajectory`] in one augmented state for smooth systems; [`HybridTwoTrajectory`],
+//! which carries the resets, for rigid impacts).
 //!
 //! The paper's model does not come here: its points run in lanes, and its scalar reference
 //! is [`sweep::run_point`](crate::sweep::run_point) (see `catalogue::Paper`).
@@ -14,7 +15,7 @@ use crate::drive::{Control, EventRecord, Observer, RunError, Simulation, run_wit
 use crate::event::{Direction, Event, EventError, EventFunction, EventSet, NewtonImpact};
 use crate::excite::Excitation;
 use crate::integrate::{Dopri5, Tolerances};
-use crate::lyapunov::{HybridTwoTrajectory, Norm};
+use crate::lyapunov::{HybridTwoTrajectory, Norm, TwoTrajectory};
 use crate::model::{Elements, Loads, Mechanical};
 use crate::sample::{Regime, Stroboscopic, detect_period};
 
@@ -192,39 +193,34 @@ impl<const M: usize> Recording<M> {
     }
 }
 
-/// The top Lyapunov exponent from `end` (phase 0) by two trajectories with `events`.
-fn lyapunov<const M: usize, S, E>(
+/// The top Lyapunov exponent from the end state of a run (phase 0): `estimate(tol, norm,
+/// d0, periods)` runs the estimator.
+fn lyapunov<const M: usize>(
     s: &RunSettings,
-    system: S,
-    events: E,
-    period: f64,
-    end: SVector<f64, M>,
-) -> Option<Result<(f64, f64), String>>
-where
-    S: Dynamics<f64, M> + Clone,
-    E: EventSet<f64, M> + Clone,
-{
+    estimate: impl FnOnce(Tolerances<f64, M>, Norm<f64, M>, f64, usize) -> crate::Result<(f64, f64)>,
+) -> Option<Result<(f64, f64), String>> {
     let (periods, d0) = s.lyapunov?;
     let run = || -> crate::Result<(f64, f64)> {
         let scales: [f64; M] = s.scales.as_slice().try_into().map_err(|_| {
             crate::ParameterError::new("scales", s.scales.len() as f64, "one per component")
         })?;
-        let tol = tolerances::<M>(s).map_err(crate::Error::Output)?;
-        let norm = Norm::weighted(scales)?;
-        let mut est = HybridTwoTrajectory::new(system, Dopri5::new(tol), events, d0, norm)?;
-        est.start(0.0, end)?;
-        let e = est.estimate(period, periods)?;
-        Ok((e.exponent, e.spread))
+        let atol: [f64; M] = s.atol.as_slice().try_into().map_err(|_| {
+            crate::ParameterError::new("atol", s.atol.len() as f64, "one per component")
+        })?;
+        let tol = Tolerances::per_component(s.rtol, atol)?;
+        estimate(tol, Norm::weighted(scales)?, d0, periods)
     };
     Some(run().map_err(|e| e.to_string()))
 }
 
 /// Runs `system` with impacts counted on `surfaces` (compliant contacts: events without
-/// resets), sections every `period`, and the exponent if asked for.
+/// resets), sections every `period`, and the exponent if asked for: two trajectories in one
+/// augmented state of dimension `M2 = 2M` ([`TwoTrajectory`], which integrates both with
+/// the same steps, as for the paper's model).
 ///
 /// # Errors
 /// The run's error, as the point's status.
-pub(crate) fn run_smooth<const M: usize, S, G>(
+pub(crate) fn run_smooth<const M: usize, const M2: usize, S, G>(
     s: &RunSettings,
     system: S,
     surfaces: Vec<G>,
@@ -254,7 +250,19 @@ where
     let mut obs = (&mut rec.strobe, &mut rec.impacts);
     let out = sim.run(0.0, y0, rec.t_end, &mut obs).map_err(fail)?;
     let mut run = rec.finish(s, period);
-    run.lyapunov = lyapunov(s, system, (), period, out.y);
+    run.lyapunov = lyapunov::<M>(s, |tol, norm, d0, periods| {
+        let mut est = TwoTrajectory::<f64, M, M2, _, _>::with_tolerances(
+            system,
+            Dopri5::new,
+            &tol,
+            d0,
+            norm,
+        )?;
+        // The run ended after a whole number of periods: t = 0 has the same phase.
+        est.start(0.0, out.y)?;
+        let e = est.estimate(period, periods)?;
+        Ok((e.exponent, e.spread))
+    });
     Ok(run)
 }
 
@@ -295,7 +303,12 @@ where
     .map_err(|e| e.to_string())?;
     let mut run = rec.finish(s, period);
     let events = Event::new(impact.gap().clone(), Direction::Rising).with_reset(impact);
-    run.lyapunov = lyapunov(s, model, events, period, out.y);
+    run.lyapunov = lyapunov::<M>(s, |tol, norm, d0, periods| {
+        let mut est = HybridTwoTrajectory::new(model, Dopri5::new(tol), events, d0, norm)?;
+        est.start(0.0, out.y)?;
+        let e = est.estimate(period, periods)?;
+        Ok((e.exponent, e.spread))
+    });
     Ok(run)
 }
 

@@ -42,8 +42,9 @@ pub const MAX_PERIODS: u64 = crate::sample::MAX_SECTIONS_PER_RUN - 1;
 /// record = 50                     # forcing periods recorded
 /// ```
 ///
-/// Optional tables: `[initial] state = [x, v]` (default: the model's rest state),
-/// `[integration] rtol, atol = [a_x, a_v], max_steps`, `[record] poincare, period_tol,
+/// Optional tables: `[initial] state = [x, v]` (the whole state: `[x1, …, xN, v1, …, vN]`
+/// for `N` degrees of freedom; default the model's rest state), `[integration] rtol, atol =
+/// [a_x, a_v] (one per state component), max_steps`, `[record] poincare, period_tol,
 /// max_period, lyapunov = { periods, d0 }, q = { lo, hi, step }`, `[attractors] scales,
 /// tol, cell, overlap` (see [`AttractorSpec`]). Unknown keys are errors, so a misspelt
 /// field is never silently ignored.
@@ -76,10 +77,19 @@ pub struct StudySpec {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SystemSpec {
-    /// `"paper"` (the paper's cart; parameters as in
-    /// [`PaperParameters`](crate::systems::paper::PaperParameters) plus `omega` and
-    /// `amplitude_factor`, a factor on the unbalance `m0e`) or `"duffing_ueda"` (`k`, `b`,
-    /// `omega`, `amplitude_factor` on `b`).
+    /// A model of the catalogue:
+    /// - `"paper"`: the paper's cart; parameters as in
+    ///   [`PaperParameters`](crate::systems::paper::PaperParameters) plus `omega` (no
+    ///   default) and `amplitude_factor`, a factor on the unbalance `m0e`;
+    /// - `"duffing_ueda"`: [`DuffingUeda`](crate::systems::DuffingUeda), `k`, `b`, `omega`,
+    ///   `amplitude_factor` on `b`;
+    /// - `"two_dof_impact"`: [`TwoDofImpact`](crate::systems::TwoDofImpact), `m1`, `m2`,
+    ///   `k1`, `k2`, `c1`, `c2`, `force`, `gap`, `k_contact`, `b_contact`, `omega` (default
+    ///   0.7), `amplitude_factor` on `force`; state `(x1, x2, v1, v2)`, one surface;
+    /// - `"bouncing_ball"`: [`BouncingBallTable`](crate::systems::BouncingBallTable),
+    ///   `gamma = Aω²/g` (default 1.5), `e` (0.9), `omega` (2π), `g` (9.81),
+    ///   `amplitude_factor` on the table's amplitude; rigid impacts with chattering and
+    ///   sticking, starting 2 m/s above the table's velocity.
     pub model: String,
     /// Parameters that differ from the model's defaults.
     #[serde(default)]
@@ -158,10 +168,11 @@ pub(crate) fn is_initial_name(name: &str) -> bool {
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct InitialSpec {
-    /// `[x, v]`; default the model's rest state (the paper: the static equilibrium against
-    /// the stop; Duffing–Ueda: the origin).
+    /// The state `[x, v]` (`[x1, …, xN, v1, …, vN]` for `N` degrees of freedom); default
+    /// the model's rest state (the paper: the static equilibrium against the stop;
+    /// Duffing–Ueda: the origin).
     #[serde(default)]
-    pub state: Option<[f64; 2]>,
+    pub state: Option<Vec<f64>>,
 }
 
 /// Integration settings (DOPRI5 with event location).
@@ -171,9 +182,10 @@ pub struct IntegrationSpec {
     /// Relative tolerance.
     #[serde(default = "default_rtol")]
     pub rtol: f64,
-    /// Absolute tolerances `[position, velocity]`; default the model's scale × `rtol`.
+    /// Absolute tolerances, one per state component (`[position, velocity]` for one degree
+    /// of freedom); default the model's scale × `rtol`.
     #[serde(default)]
-    pub atol: Option<[f64; 2]>,
+    pub atol: Option<Vec<f64>>,
     /// Step cap per run.
     #[serde(default = "default_max_steps")]
     pub max_steps: usize,
@@ -281,9 +293,10 @@ pub struct QSpec {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct AttractorSpec {
-    /// Scales `[x, v]` of the section coordinates; default the model's.
+    /// Scales of the section coordinates, one per state component (`[x, v]` for one
+    /// degree of freedom); default the model's.
     #[serde(default)]
-    pub scales: Option<[f64; 2]>,
+    pub scales: Option<Vec<f64>>,
     /// Periodic orbits coincide when their section points are within `tol` (scaled, max
     /// norm) of each other.
     #[serde(default = "default_attractor_tol")]
@@ -362,11 +375,12 @@ impl StudySpec {
         self.validate_system(sys)?;
         let axes = self.axes();
         self.validate_grid(sys, &axes)?;
-        self.validate_initial()?;
-        self.validate_integration()?;
+        self.validate_fixed(sys, &axes)?;
+        self.validate_initial(sys)?;
+        self.validate_integration(sys)?;
         self.validate_periods()?;
         self.validate_record()?;
-        self.validate_attractors()?;
+        self.validate_attractors(sys)?;
         self.validate_axis_models(sys, &axes)?;
         Ok(system)
     }
@@ -554,8 +568,9 @@ impl StudySpec {
         Ok(())
     }
 
-    fn validate_initial(&self) -> Result<(), StudyError> {
-        if let Some(s) = self.initial.state {
+    fn validate_initial(&self, system: &dyn StudySystem) -> Result<(), StudyError> {
+        if let Some(s) = &self.initial.state {
+            components("initial.state", s, system)?;
             for (k, v) in s.iter().enumerate() {
                 if !v.is_finite() {
                     return Err(invalid(format!("initial.state[{k}]"), "must be finite"));
@@ -565,11 +580,13 @@ impl StudySpec {
         Ok(())
     }
 
-    fn validate_integration(&self) -> Result<(), StudyError> {
+    fn validate_integration(&self, system: &dyn StudySystem) -> Result<(), StudyError> {
         positive_finite("integration.rtol", self.integration.rtol)?;
-        if let Some(a) = self.integration.atol {
-            positive_finite("integration.atol[0]", a[0])?;
-            positive_finite("integration.atol[1]", a[1])?;
+        if let Some(a) = &self.integration.atol {
+            components("integration.atol", a, system)?;
+            for (k, &v) in a.iter().enumerate() {
+                positive_finite(&format!("integration.atol[{k}]"), v)?;
+            }
         }
         if self.integration.max_steps == 0 {
             return Err(invalid("integration.max_steps", "must be >= 1"));
@@ -629,10 +646,12 @@ impl StudySpec {
         Ok(())
     }
 
-    fn validate_attractors(&self) -> Result<(), StudyError> {
-        if let Some(s) = self.attractors.scales {
-            positive_finite("attractors.scales[0]", s[0])?;
-            positive_finite("attractors.scales[1]", s[1])?;
+    fn validate_attractors(&self, system: &dyn StudySystem) -> Result<(), StudyError> {
+        if let Some(s) = &self.attractors.scales {
+            components("attractors.scales", s, system)?;
+            for (k, &v) in s.iter().enumerate() {
+                positive_finite(&format!("attractors.scales[{k}]"), v)?;
+            }
         }
         positive_finite("attractors.tol", self.attractors.tol)?;
         positive_finite("attractors.cell", self.attractors.cell)?;
@@ -643,6 +662,23 @@ impl StudySpec {
             ));
         }
         Ok(())
+    }
+
+    /// The values the spec fixes, at the base point (the fixed parameters, the defaults,
+    /// and the axis starts of parameters without a default), naming the field at fault.
+    fn validate_fixed(
+        &self,
+        system: &dyn StudySystem,
+        axes: &[(&str, &Axis)],
+    ) -> Result<(), StudyError> {
+        let mut p = system.point(&self.system.parameters)?;
+        let mut y0 = self.initial.state.clone();
+        for (_, b) in axes {
+            if self.unset_required(system, &b.parameter) {
+                apply_axis(system, &mut p, &mut y0, &b.parameter, b.start);
+            }
+        }
+        system.check_fixed(&p, &|name| axes.iter().any(|(_, a)| a.parameter == name))
     }
 
     /// Every axis value must give a valid model, with the other axis at the base value
@@ -668,7 +704,7 @@ impl StudySpec {
                     ));
                 }
                 let mut p = set.clone();
-                let mut y0 = self.initial.state.map(|s| s.to_vec());
+                let mut y0 = self.initial.state.clone();
                 for (_, b) in axes {
                     if b.parameter == a.parameter {
                         apply_axis(system, &mut p, &mut y0, &b.parameter, v);
@@ -689,6 +725,23 @@ impl StudySpec {
         }
         Ok(())
     }
+}
+
+/// `values` (the field `field`) has one value per state component of `system`.
+fn components(field: &str, values: &[f64], system: &dyn StudySystem) -> Result<(), StudyError> {
+    let n = system.dimension();
+    if values.len() != n {
+        let names = system.state_names().join(", ");
+        return Err(invalid(
+            field,
+            format!(
+                "has {} values; model {:?} has {n} state components ({names})",
+                values.len(),
+                system.name()
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// `record.lyapunov`: enough periods for the spread's blocks, no more than one estimate takes.

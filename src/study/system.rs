@@ -138,7 +138,21 @@ pub(crate) trait StudySystem: std::fmt::Debug + Send + Sync {
     ///
     /// # Errors
     /// The model's constructor's error, naming the parameter.
-    fn check(&self, p: &ParameterPoint) -> Result<(), crate::Error>;
+    fn check(&self, p: &ParameterPoint) -> Result<(), String>;
+
+    /// Checks the values the spec fixes (not those of the grid axes: `on_axes(name)` says
+    /// whether parameter `name` is an axis), naming the field of the spec at fault. Default:
+    /// nothing to check beyond [`check`](Self::check) at every axis value.
+    ///
+    /// # Errors
+    /// [`StudyError::InvalidSpec`] naming the field.
+    fn check_fixed(
+        &self,
+        _p: &ParameterPoint,
+        _on_axes: &dyn Fn(&str) -> bool,
+    ) -> Result<(), StudyError> {
+        Ok(())
+    }
 
     /// The default initial state at `p` (the components the spec does not give).
     ///
