@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use nonsmooth::study::{
-    Merged, PlanSettings, Shard, Study, StudyError, compute_point, read_shards, run_shard,
-    run_to_dir, sbatch_script, write_shard,
+    Merged, PlanSettings, Shard, Study, StudyError, compute_point, read_shards, regime_class,
+    run_shard, run_to_dir, sbatch_script, write_shard,
 };
 
 /// A fresh scratch directory for one test, removed when dropped.
@@ -1095,4 +1095,191 @@ fn a_two_dof_study_records_whole_states_and_merges_identically_in_shards() {
         &TWO_DOF.replace("parameter = \"x2_0\"", "parameter = \"x0\""),
         "grid.y.parameter",
     );
+}
+
+/// The example `examples/studies/impact_damper_2dof.toml`: a system described in the study
+/// file (two masses, four elements, a load, two impact surfaces).
+const DAMPER: &str = include_str!("../examples/studies/impact_damper_2dof.toml");
+
+#[test]
+fn a_described_two_dof_impact_damper_runs_whole_and_in_shards_and_draws_its_map() {
+    let study = Study::from_toml(DAMPER).unwrap();
+    assert_eq!(study.points(), 15);
+    assert!(
+        sbatch_script(
+            &study,
+            Path::new("impact_damper_2dof.toml"),
+            &PlanSettings::new(3, "out", "nonsmooth")
+        )
+        .is_ok()
+    );
+    let mut results = Vec::new();
+    for n in [1, 3] {
+        let d = scratch(&format!("damper-{n}"));
+        run_in_shards(&study, &d, n);
+        results.push(merged_bytes(&d));
+        if n == 3 {
+            let m = Merged::from_dir(&d).unwrap();
+            let files = m.write(&d.join("map.csv")).unwrap();
+            assert!(files.iter().any(|f| f.ends_with("map.png")));
+            assert!(d.join("map.png").metadata().unwrap().len() > 1000);
+            let table = fs::read_to_string(d.join("map.csv")).unwrap();
+            assert!(
+                table.starts_with(
+                    "index,ix,iy,omega,amplitude_factor,period,impacts_per_period,\
+                     impacts_per_period_0,impacts_per_period_1,tle,"
+                ),
+                "{table}"
+            );
+            for (r, l) in m.records.iter().zip(&m.labels) {
+                assert!(r.is_ok(), "point {}: {}", r.index, r.status);
+                assert_eq!(l, &Some(0));
+                assert_eq!(r.impacts_per_surface.len(), 2);
+                // The total is the sum of the walls' (exact: counts over one window).
+                let sum: f64 = r.impacts_per_surface.iter().sum();
+                assert!((sum - r.impacts_per_period).abs() < 1e-12, "{r:?}");
+                assert!(r.sections.iter().all(|s| s.len() == 4));
+                assert!(r.tle.is_finite());
+            }
+            // The free mass hits both walls everywhere; periodic and chaotic regimes.
+            assert!(
+                m.records
+                    .iter()
+                    .all(|r| r.impacts_per_surface.iter().all(|&i| i > 0.0))
+            );
+            let classes: Vec<String> = m.records.iter().map(regime_class).collect();
+            assert!(classes.iter().any(|c| c == "P1, 2 imp."), "{classes:?}");
+            assert!(classes.iter().any(|c| c == "chaotic"), "{classes:?}");
+        }
+    }
+    assert_eq!(results[0], results[1], "1 vs 3 shards");
+}
+
+#[test]
+fn a_described_rigid_stop_runs_with_restitution() {
+    // A forced mass on a spring against a rigid stop: Newton restitution, chattering and
+    // sticking through the drive.
+    let text = r#"
+name = "rigid"
+[system]
+model = "mechanical"
+masses = [1.0]
+[[system.elements]]
+law = "linear_spring"
+dof = 0
+k = 1.0
+[[system.elements]]
+law = "viscous_damper"
+dof = 0
+c = 0.05
+[[system.loads]]
+dof = 0
+amplitude = 0.5
+[[system.surfaces]]
+dof = 0
+position = 0.2
+restitution = "e"
+[grid]
+x = { parameter = "omega", start = 0.8, end = 1.6, points = 3 }
+y = { parameter = "e", start = 0.5, end = 0.8, points = 2 }
+[periods]
+transient = 30
+record = 10
+"#;
+    let study = Study::from_toml(text).unwrap();
+    let recs = run_shard(&study, Shard::WHOLE, || {});
+    for r in &recs {
+        assert!(r.is_ok(), "point {}: {}", r.index, r.status);
+        assert!(r.impacts_per_period > 0.0, "point {}", r.index);
+        // The stop holds: no section beyond it.
+        assert!(r.sections.iter().all(|s| s[0] <= 0.2 + 1e-9), "{r:?}");
+    }
+    expect_spec_error(
+        &text.replace("start = 0.5, end = 0.8", "start = 0.5, end = 1.8"),
+        "grid.y",
+    );
+}
+
+#[test]
+fn bad_descriptions_name_the_field() {
+    let d = DAMPER;
+    let cases: Vec<(String, &str)> = vec![
+        (
+            d.replacen("law = \"hertz\"", "law = \"herz\"", 1),
+            "system.elements[2].law",
+        ),
+        (
+            d.replacen("k = 1e4", "kk = 1e4", 1),
+            "system.elements[2].kk",
+        ),
+        (d.replacen("k = 1e4\n", "", 1), "system.elements[2].k"),
+        (d.replacen("k = 1.0", "k = -1.0", 1), "system.elements[0].k"),
+        (
+            d.replacen("dof = 0", "dof = 2", 1),
+            "system.elements[0].dof",
+        ),
+        (
+            d.replacen(
+                "law = \"hertz\"\nbetween = [1, 0]",
+                "law = \"hertz\"\nbetween = [1, 1]",
+                1,
+            ),
+            "system.elements[2].between",
+        ),
+        (
+            d.replacen("side = \"lower\"", "side = \"below\"", 1),
+            "system.elements[3].side",
+        ),
+        (
+            d.replace("masses = [1.0, 0.05]", "masses = []"),
+            "system.masses",
+        ),
+        (
+            d.replace("masses = [1.0, 0.05]", "masses = [1.0, -0.05]"),
+            "system.masses[1]",
+        ),
+        (
+            d.replace("masses = [1.0, 0.05]", "masses = [1.0, 1.0, 1.0, 1.0, 1.0]"),
+            "system.masses",
+        ),
+        (
+            d.replace("parameters = { gap = 0.1 }", ""),
+            "system.parameters.gap",
+        ),
+        (
+            d.replace("gap = 0.1 }", "gap = 0.1, gapp = 0.2 }"),
+            "system.parameters.gapp",
+        ),
+        (
+            d.replacen("amplitude = 0.05", "amplitude = \"x2_0\"", 1),
+            "system.loads[0].amplitude",
+        ),
+        (
+            d.replacen(
+                "position = \"-gap\"\nside",
+                "position = \"-gap\"\nrestitution = 0.5\nside",
+                1,
+            ),
+            "system.surfaces[1].restitution",
+        ),
+        (
+            d.replace("model = \"mechanical\"", "model = \"paper\""),
+            "system.masses",
+        ),
+        (
+            d.replacen("[[system.loads]]\ndof = 0", "[[system.loads]]\ndof = 5", 1),
+            "system.loads[0].dof",
+        ),
+    ];
+    for (text, field) in &cases {
+        expect_spec_error(text, field);
+    }
+    // A parameter without a value; then on an axis whose values a law rejects.
+    let ok = d.replace("k = 1e4\nb = 2.0", "k = \"kc\"\nb = 2.0");
+    expect_spec_error(&ok, "system.parameters.kc");
+    let axis = ok.replace(
+        "y = { parameter = \"amplitude_factor\", start = 0.5, end = 1.5, points = 3 }",
+        "y = { parameter = \"kc\", start = -1.0, end = 1e4, points = 3 }",
+    );
+    expect_spec_error(&axis, "grid.y");
 }

@@ -10,6 +10,7 @@ use std::sync::Arc;
 use nalgebra::Vector2;
 
 use super::StudyError;
+use super::mechanical::{Described, Description};
 use super::scalar;
 use super::system::{ParameterDef, ParameterPoint, PointRun, RunSettings, StudySystem};
 use crate::ensemble::IndependentSweep;
@@ -33,16 +34,35 @@ const CATALOGUE: &[(&str, Make)] = &[
     ("bouncing_ball", || Arc::new(Ball::new())),
 ];
 
+/// The model of a system described in the study file.
+const MECHANICAL: &str = "mechanical";
+
 /// The names of the systems a spec may name in `system.model`.
 pub(crate) fn model_names() -> Vec<&'static str> {
-    CATALOGUE.iter().map(|(n, _)| *n).collect()
+    let mut names: Vec<&str> = CATALOGUE.iter().map(|(n, _)| *n).collect();
+    names.push(MECHANICAL);
+    names
 }
 
-/// The system called `name`.
+/// The system called `name`: a model of the catalogue, or `"mechanical"`, the system of
+/// `description`.
 ///
 /// # Errors
-/// [`StudyError::InvalidSpec`] naming `system.model` for an unknown name.
-pub(crate) fn system(name: &str) -> Result<Arc<dyn StudySystem>, StudyError> {
+/// [`StudyError::InvalidSpec`] naming `system.model` for an unknown name, a field of the
+/// description if it is invalid, or given for a model of the catalogue.
+pub(crate) fn system(
+    name: &str,
+    description: &Description<'_>,
+) -> Result<Arc<dyn StudySystem>, StudyError> {
+    if name == MECHANICAL {
+        return Ok(Arc::new(Described::new(description)?));
+    }
+    if let Some(field) = description.first_field() {
+        return Err(StudyError::InvalidSpec {
+            field: field.into(),
+            message: format!("describes a system of model = \"{MECHANICAL}\", not of {name:?}"),
+        });
+    }
     CATALOGUE
         .iter()
         .find(|(n, _)| *n == name)

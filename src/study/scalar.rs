@@ -97,7 +97,7 @@ impl<const M: usize> Observer<f64, M> for ImpactLog {
 /// [`sweep::run_point`](crate::sweep::run_point) counts them).
 fn per_period(counts: &[u64], period: usize) -> f64 {
     let n = counts.len();
-    let whole = if period > 0 { (n / period) * period } else { 0 };
+    let whole = n.checked_div(period).map_or(0, |k| k * period);
     let window = if whole > 0 { whole } else { n.max(1) };
     let sum: u64 = counts[n - window.min(n)..].iter().sum();
     sum as f64 / window as f64

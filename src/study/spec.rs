@@ -10,7 +10,8 @@ use std::sync::Arc;
 
 use super::StudyError;
 use super::catalogue;
-use super::system::{ParameterPoint, StudySystem};
+use super::mechanical::{Description, ElementSpec, LoadSpec, SpecValue, SurfaceSpec};
+use super::system::{ParameterPoint, StudySystem, is_initial_name};
 
 /// The most grid points of one study (10⁸: a 10⁴ × 10⁴ plane).
 pub const MAX_POINTS: usize = 100_000_000;
@@ -73,7 +74,8 @@ pub struct StudySpec {
     pub attractors: AttractorSpec,
 }
 
-/// The system: a model of the catalogue and its parameters.
+/// The system: a model of the catalogue and its parameters, or a mechanical system
+/// described here.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SystemSpec {
@@ -89,11 +91,38 @@ pub struct SystemSpec {
     /// - `"bouncing_ball"`: [`BouncingBallTable`](crate::systems::BouncingBallTable),
     ///   `gamma = Aω²/g` (default 1.5), `e` (0.9), `omega` (2π), `g` (9.81),
     ///   `amplitude_factor` on the table's amplitude; rigid impacts with chattering and
-    ///   sticking, starting 2 m/s above the table's velocity.
+    ///   sticking, starting 2 m/s above the table's velocity;
+    ///
+    /// or `"mechanical"`, the system of `masses`, `elements`, `loads` and `surfaces` (see
+    /// the [module docs](super#a-system-described-in-the-study-file)).
     pub model: String,
     /// Parameters that differ from the model's defaults.
     #[serde(default)]
     pub parameters: BTreeMap<String, f64>,
+    /// `mechanical`: the masses, one per degree of freedom.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub masses: Vec<SpecValue>,
+    /// `mechanical`: the elements (force laws on coordinates).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub elements: Vec<ElementSpec>,
+    /// `mechanical`: the harmonic loads.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub loads: Vec<LoadSpec>,
+    /// `mechanical`: the impact surfaces.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub surfaces: Vec<SurfaceSpec>,
+}
+
+impl SystemSpec {
+    /// The description of a mechanical system (empty for a model of the catalogue).
+    pub(crate) fn description(&self) -> Description<'_> {
+        Description {
+            masses: &self.masses,
+            elements: &self.elements,
+            loads: &self.loads,
+            surfaces: &self.surfaces,
+        }
+    }
 }
 
 /// The grid: axis `x`, optionally axis `y`; point `i = ix + nx·iy`.
@@ -147,21 +176,6 @@ impl Axis {
     pub fn is_initial_condition(&self) -> bool {
         is_initial_name(&self.parameter)
     }
-}
-
-/// Whether `name` has the form of an initial-condition component: `x0`, `v0`, `xK_0`,
-/// `vK_0` (`K` a positive integer without leading zeros).
-pub(crate) fn is_initial_name(name: &str) -> bool {
-    if name == "x0" || name == "v0" {
-        return true;
-    }
-    let Some(rest) = name.strip_prefix('x').or_else(|| name.strip_prefix('v')) else {
-        return false;
-    };
-    let Some(k) = rest.strip_suffix("_0") else {
-        return false;
-    };
-    !k.is_empty() && !k.starts_with('0') && k.bytes().all(|b| b.is_ascii_digit())
 }
 
 /// The initial state.
@@ -370,7 +384,7 @@ impl StudySpec {
     /// Checks every field and returns the system.
     fn checked(&self) -> Result<Arc<dyn StudySystem>, StudyError> {
         self.validate_name()?;
-        let system = catalogue::system(&self.system.model)?;
+        let system = catalogue::system(&self.system.model, &self.system.description())?;
         let sys = &*system;
         self.validate_system(sys)?;
         let axes = self.axes();
@@ -681,6 +695,47 @@ impl StudySpec {
         system.check_fixed(&p, &|name| axes.iter().any(|(_, a)| a.parameter == name))
     }
 
+    /// The axes of parameters without a default take their start while the other axis is
+    /// checked: where that base point is invalid and another value of such an axis makes it
+    /// valid, its start is at fault, and the error names that axis.
+    fn blame_axis_start(
+        &self,
+        system: &dyn StudySystem,
+        axes: &[(&str, &Axis)],
+        set: &ParameterPoint,
+    ) -> Result<(), StudyError> {
+        let required: Vec<&(&str, &Axis)> = axes
+            .iter()
+            .filter(|(_, b)| self.unset_required(system, &b.parameter))
+            .collect();
+        let mut base = set.clone();
+        let mut y0 = self.initial.state.clone();
+        for (_, b) in &required {
+            apply_axis(system, &mut base, &mut y0, &b.parameter, b.start);
+        }
+        let Err(e) = system.check(&base) else {
+            return Ok(());
+        };
+        for (field, b) in required {
+            let frees = (1..b.points).any(|k| {
+                let mut p = base.clone();
+                apply_axis(system, &mut p, &mut y0, &b.parameter, b.value(k));
+                system.check(&p).is_ok()
+            });
+            if frees {
+                return Err(invalid(
+                    field.to_string(),
+                    format!(
+                        "value {v} ({} = {v}) gives an invalid model: {e}",
+                        b.parameter,
+                        v = b.start
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
     /// Every axis value must give a valid model, with the other axis at the base value
     /// (the fixed parameters or the model's default), so that an error names the axis
     /// at fault; a parameter without a default (the paper's `omega`) takes its axis start.
@@ -690,6 +745,7 @@ impl StudySpec {
         axes: &[(&str, &Axis)],
     ) -> Result<(), StudyError> {
         let set = system.point(&self.system.parameters)?;
+        self.blame_axis_start(system, axes, &set)?;
         for (field, a) in axes {
             for k in 0..a.points {
                 let v = a.value(k);

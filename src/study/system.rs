@@ -249,3 +249,18 @@ pub(crate) fn fill(given: Option<&[f64]>, rest: &[f64]) -> Vec<f64> {
         })
         .collect()
 }
+
+/// Whether `name` has the form of an initial-condition component: `x0`, `v0`, `xK_0`,
+/// `vK_0` (`K` a positive integer without leading zeros).
+pub(crate) fn is_initial_name(name: &str) -> bool {
+    if name == "x0" || name == "v0" {
+        return true;
+    }
+    let Some(rest) = name.strip_prefix('x').or_else(|| name.strip_prefix('v')) else {
+        return false;
+    };
+    let Some(k) = rest.strip_suffix("_0") else {
+        return false;
+    };
+    !k.is_empty() && !k.starts_with('0') && k.bytes().all(|b| b.is_ascii_digit())
+}
