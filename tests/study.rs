@@ -1283,3 +1283,54 @@ fn bad_descriptions_name_the_field() {
     );
     expect_spec_error(&axis, "grid.y");
 }
+
+/// Every spec in `examples/studies` reads and plans, the catalogue's models and a described
+/// system among them; the small ones (at most 30 points) run whole and in two shards, every
+/// point without failure, with the same merged files.
+#[test]
+fn every_example_spec_reads_plans_and_the_small_ones_run() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/studies");
+    let mut specs: Vec<PathBuf> = fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    specs.sort();
+    let mut models = std::collections::BTreeSet::new();
+    let mut ran = 0;
+    for path in &specs {
+        let study = Study::from_file(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        models.insert(study.spec().system.model.clone());
+        let shards = study.points().min(4);
+        let script = sbatch_script(&study, path, &PlanSettings::new(shards, "out", "nonsmooth"))
+            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        assert!(script.contains(&format!("#SBATCH --array=1-{shards}\n")));
+        if study.points() > 30 {
+            continue;
+        }
+        let name = study.spec().name.clone();
+        let whole = scratch(&format!("example-{name}-1"));
+        let two = scratch(&format!("example-{name}-2"));
+        run_in_shards(&study, &whole, 1);
+        run_in_shards(&study, &two, 2);
+        let (_, recs) = read_shards(&whole).unwrap();
+        for r in &recs {
+            assert!(r.is_ok(), "{name} point {}: {}", r.index, r.status);
+        }
+        assert_eq!(merged_bytes(&whole), merged_bytes(&two), "{name}");
+        ran += 1;
+    }
+    for model in [
+        "paper",
+        "duffing_ueda",
+        "two_dof_impact",
+        "bouncing_ball",
+        "mechanical",
+    ] {
+        assert!(
+            models.contains(model),
+            "no example spec of {model}: {models:?}"
+        );
+    }
+    assert!(ran >= 5, "{ran} small examples ran");
+}
