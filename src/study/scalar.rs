@@ -173,13 +173,17 @@ impl<const M: usize> Recording<M> {
             Regime::Periodic(p) => p,
             Regime::NotPeriodic => 0,
         };
-        let n = s.record as usize;
+        // At least one recorded period (the spec's check; one bucket all the same).
+        let n = (s.record as usize).max(1);
         let surfaces = self.impacts.last.len();
         let mut counts = vec![vec![0u64; n]; surfaces];
         let mut total = vec![0u64; n];
         for &(t, k) in &self.impacts.impacts {
+            // `as` saturates (NaN to 0): every impact lands in a bucket of the window.
             let i = (((t - self.t_rec) / period).floor().max(0.0) as usize).min(n - 1);
-            counts[k][i] += 1;
+            if let Some(c) = counts.get_mut(k) {
+                c[i] += 1;
+            }
             total[i] += 1;
         }
         PointRun {
