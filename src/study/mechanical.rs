@@ -33,14 +33,14 @@
 //! `amplitude_factor` (a factor on every load's amplitude, default 1) are always
 //! parameters; any other name becomes one, without a default (it must be given in
 //! `system.parameters` or as a grid axis). The laws
-//! and their parameters (defaults in brackets):
+//! and their parameters (with their defaults):
 //!
 //! | law | parameters |
 //! |---|---|
-//! | `linear_spring` | `k`, `x0` [0] |
+//! | `linear_spring` | `k`, `x0 = 0` |
 //! | `viscous_damper` | `c` |
 //! | `cubic_spring` | `k1`, `k3` |
-//! | `hertz` | `position`, `k`, `n1` [1.5], `b` [0], `n2` [1.5], `n3` [1]; `side` [`"upper"`] |
+//! | `hertz` | `position`, `k`, `n1 = 1.5`, `b = 0`, `n2 = 1.5`, `n3 = 1`; `side = "upper"` |
 //! | `dry_friction` | `t`, `eps` (the friction's `v/√(v²+ε²)` sign) |
 //!
 //! A surface is a stop `position` on its coordinate: `side = "upper"` (the default) for a

@@ -111,14 +111,15 @@
 //! position = "gap"                         # side = "upper" (default) or "lower"
 //! ```
 //!
-//! The laws ([`ElementSpec`]; defaults in brackets): `linear_spring` (`k`, `x0` [0]),
-//! `viscous_damper` (`c`), `cubic_spring` (`k1`, `k3`), `hertz` (`position`, `k`, `n1` [1.5],
-//! `b` [0], `n2` [1.5], `n3` [1]; `side` [`"upper"`]: contact where the coordinate exceeds
-//! `position`, `"lower"` where it falls below) and `dry_friction` (`t`, `eps`: the
-//! regularized sign `v/√(v²+ε²)`). Every number may instead name a parameter ([`SpecValue`]):
-//! `omega` (required: the forcing frequency and the section period) and `amplitude_factor`
-//! (a factor on every load's amplitude, default 1) always exist; any other name becomes a
-//! parameter without a default, to be given in `system.parameters` or as a grid axis.
+//! The laws ([`ElementSpec`]; defaults after `=`): `linear_spring` (`k`, `x0 = 0`),
+//! `viscous_damper` (`c`), `cubic_spring` (`k1`, `k3`), `hertz` (`position`, `k`,
+//! `n1 = 1.5`, `b = 0`, `n2 = 1.5`, `n3 = 1`; `side = "upper"`: contact where the
+//! coordinate exceeds `position`, `"lower"` where it falls below) and `dry_friction` (`t`,
+//! `eps`: the regularized sign `v/√(v²+ε²)`). Every number may instead name a parameter
+//! ([`SpecValue`]): `omega` (required: the forcing frequency and the section period) and
+//! `amplitude_factor` (a factor on every load's amplitude, default 1) always exist; any
+//! other name becomes a parameter without a default, to be given in `system.parameters` or
+//! as a grid axis.
 //! A surface ([`SurfaceSpec`]) without `restitution` counts the impacts of a compliant
 //! contact; with `restitution = e` it is a rigid stop with Newton's impact law, run through
 //! chattering and sticking — the drive runs one rigid contact, so it must be the only

@@ -197,11 +197,23 @@ impl<const M: usize> Recording<M> {
     }
 }
 
+/// An estimator of the top Lyapunov exponent and its spread from the tolerances, the norm,
+/// `d0` and the number of periods.
+trait Estimate<const M: usize>:
+    FnOnce(Tolerances<f64, M>, Norm<f64, M>, f64, usize) -> crate::Result<(f64, f64)>
+{
+}
+
+impl<const M: usize, F> Estimate<M> for F where
+    F: FnOnce(Tolerances<f64, M>, Norm<f64, M>, f64, usize) -> crate::Result<(f64, f64)>
+{
+}
+
 /// The top Lyapunov exponent from the end state of a run (phase 0): `estimate(tol, norm,
 /// d0, periods)` runs the estimator.
 fn lyapunov<const M: usize>(
     s: &RunSettings,
-    estimate: impl FnOnce(Tolerances<f64, M>, Norm<f64, M>, f64, usize) -> crate::Result<(f64, f64)>,
+    estimate: impl Estimate<M>,
 ) -> Option<Result<(f64, f64), String>> {
     let (periods, d0) = s.lyapunov?;
     let run = || -> crate::Result<(f64, f64)> {
