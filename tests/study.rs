@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use nonsmooth::study::{
-    Merged, PlanSettings, Shard, Study, StudyError, compute_point, read_shards, run_shard,
-    run_to_dir, sbatch_script, write_shard,
+    Merged, PlanSettings, Shard, Study, StudyError, compute_point, read_shards, regime_class,
+    run_shard, run_to_dir, sbatch_script, write_shard,
 };
 
 /// A fresh scratch directory for one test, removed when dropped.
@@ -1002,4 +1002,335 @@ fn plan_rejects_or_quotes_every_hostile_value() {
     assert!(!ok && out.is_empty(), "{out}");
     assert!(err.contains("--partition"), "{err}");
     assert!(!pwned.exists());
+}
+
+/// A system of two degrees of freedom (the catalogue's 2-DOF impact oscillator: a state of
+/// four components, one impact surface) over the forcing frequency and the initial position
+/// of the secondary mass.
+const TWO_DOF: &str = r#"
+name = "two_dof"
+[system]
+model = "two_dof_impact"
+[grid]
+x = { parameter = "omega", start = 0.5, end = 0.9, points = 4 }
+y = { parameter = "x2_0", start = -0.3, end = 0.3, points = 3 }
+[periods]
+transient = 40
+record = 16
+[record]
+poincare = 4
+lyapunov = { periods = 10 }
+"#;
+
+#[test]
+fn a_two_dof_study_records_whole_states_and_merges_identically_in_shards() {
+    let study = Study::from_toml(TWO_DOF).unwrap();
+    let mut results = Vec::new();
+    for n in [1, 3] {
+        let d = scratch(&format!("two-dof-{n}"));
+        run_in_shards(&study, &d, n);
+        let (_, recs) = read_shards(&d).unwrap();
+        // What the shard files hold is what the points computed.
+        for r in &recs {
+            assert_eq!(
+                format!("{r:?}"),
+                format!("{:?}", compute_point(&study, r.index))
+            );
+        }
+        results.push(merged_bytes(&d));
+        if n == 1 {
+            let m = Merged::from_dir(&d).unwrap();
+            m.write(&d.join("merged.csv")).unwrap();
+            let sections = fs::read_to_string(d.join("merged.sections.csv")).unwrap();
+            assert!(sections.starts_with("index,k,x1,x2,v1,v2\n"), "{sections}");
+            let attractors = fs::read_to_string(d.join("merged.attractors.csv")).unwrap();
+            assert!(
+                attractors
+                    .lines()
+                    .next()
+                    .unwrap()
+                    .ends_with(",centroid_x1,centroid_x2,centroid_v1,centroid_v2"),
+                "{attractors}"
+            );
+            assert!(d.join("merged.png").exists());
+        }
+        for r in &recs {
+            assert!(r.is_ok(), "point {}: {}", r.index, r.status);
+            assert!(!r.sections.is_empty());
+            assert!(r.sections.iter().all(|s| s.len() == 4));
+            // An initial-condition axis: fingerprints of four integers per cell.
+            assert!(!r.cells.is_empty() && r.cells.iter().all(|c| c.len() == 4));
+            // One surface: no per-surface columns.
+            assert!(r.impacts_per_surface.is_empty());
+        }
+        // The secondary mass hits its stop at every frequency of the map.
+        assert!(recs.iter().all(|r| r.impacts_per_period > 0.0));
+        // The axis of the secondary mass's start moves it: its first sections differ.
+        let (a, b) = (&recs[0].sections, &recs[8].sections);
+        assert_eq!(study.values(8).1, 0.3);
+        assert!(a != b || recs[0].period == 1);
+    }
+    assert_eq!(results[0], results[1], "1 vs 3 shards");
+    // Settings of the wrong size are rejected, naming the field.
+    expect_spec_error(
+        &TWO_DOF.replace("[periods]", "[initial]\nstate = [0.0, 0.0]\n[periods]"),
+        "initial.state",
+    );
+    expect_spec_error(
+        &TWO_DOF.replace(
+            "[periods]",
+            "[attractors]\nscales = [1.0, 1.0, 1.0]\n[periods]",
+        ),
+        "attractors.scales",
+    );
+    expect_spec_error(
+        &TWO_DOF.replace(
+            "[periods]",
+            "[integration]\natol = [1e-9, 1e-9, 1e-9, -1.0]\n[periods]",
+        ),
+        "integration.atol[3]",
+    );
+    // `x0` is the initial-condition axis of one degree of freedom, not of two.
+    expect_spec_error(
+        &TWO_DOF.replace("parameter = \"x2_0\"", "parameter = \"x0\""),
+        "grid.y.parameter",
+    );
+}
+
+/// The example `examples/studies/impact_damper_2dof.toml`: a system described in the study
+/// file (two masses, four elements, a load, two impact surfaces).
+const DAMPER: &str = include_str!("../examples/studies/impact_damper_2dof.toml");
+
+#[test]
+fn a_described_two_dof_impact_damper_runs_whole_and_in_shards_and_draws_its_map() {
+    let study = Study::from_toml(DAMPER).unwrap();
+    assert_eq!(study.points(), 15);
+    assert!(
+        sbatch_script(
+            &study,
+            Path::new("impact_damper_2dof.toml"),
+            &PlanSettings::new(3, "out", "nonsmooth")
+        )
+        .is_ok()
+    );
+    let mut results = Vec::new();
+    for n in [1, 3] {
+        let d = scratch(&format!("damper-{n}"));
+        run_in_shards(&study, &d, n);
+        results.push(merged_bytes(&d));
+        if n == 3 {
+            let m = Merged::from_dir(&d).unwrap();
+            let files = m.write(&d.join("map.csv")).unwrap();
+            assert!(files.iter().any(|f| f.ends_with("map.png")));
+            assert!(d.join("map.png").metadata().unwrap().len() > 1000);
+            let table = fs::read_to_string(d.join("map.csv")).unwrap();
+            assert!(
+                table.starts_with(
+                    "index,ix,iy,omega,amplitude_factor,period,impacts_per_period,\
+                     impacts_per_period_0,impacts_per_period_1,tle,"
+                ),
+                "{table}"
+            );
+            for (r, l) in m.records.iter().zip(&m.labels) {
+                assert!(r.is_ok(), "point {}: {}", r.index, r.status);
+                assert_eq!(l, &Some(0));
+                assert_eq!(r.impacts_per_surface.len(), 2);
+                // The total is the sum of the walls' (exact: counts over one window).
+                let sum: f64 = r.impacts_per_surface.iter().sum();
+                assert!((sum - r.impacts_per_period).abs() < 1e-12, "{r:?}");
+                assert!(r.sections.iter().all(|s| s.len() == 4));
+                assert!(r.tle.is_finite());
+            }
+            // The free mass hits both walls everywhere; periodic and chaotic regimes.
+            assert!(
+                m.records
+                    .iter()
+                    .all(|r| r.impacts_per_surface.iter().all(|&i| i > 0.0))
+            );
+            let classes: Vec<String> = m.records.iter().map(regime_class).collect();
+            assert!(classes.iter().any(|c| c == "P1, 2 imp."), "{classes:?}");
+            assert!(classes.iter().any(|c| c == "chaotic"), "{classes:?}");
+        }
+    }
+    assert_eq!(results[0], results[1], "1 vs 3 shards");
+}
+
+#[test]
+fn a_described_rigid_stop_runs_with_restitution() {
+    // A forced mass on a spring against a rigid stop: Newton restitution, chattering and
+    // sticking through the drive.
+    let text = r#"
+name = "rigid"
+[system]
+model = "mechanical"
+masses = [1.0]
+[[system.elements]]
+law = "linear_spring"
+dof = 0
+k = 1.0
+[[system.elements]]
+law = "viscous_damper"
+dof = 0
+c = 0.05
+[[system.loads]]
+dof = 0
+amplitude = 0.5
+[[system.surfaces]]
+dof = 0
+position = 0.2
+restitution = "e"
+[grid]
+x = { parameter = "omega", start = 0.8, end = 1.6, points = 3 }
+y = { parameter = "e", start = 0.5, end = 0.8, points = 2 }
+[periods]
+transient = 30
+record = 10
+"#;
+    let study = Study::from_toml(text).unwrap();
+    let recs = run_shard(&study, Shard::WHOLE, || {});
+    for r in &recs {
+        assert!(r.is_ok(), "point {}: {}", r.index, r.status);
+        assert!(r.impacts_per_period > 0.0, "point {}", r.index);
+        // The stop holds: no section beyond it.
+        assert!(r.sections.iter().all(|s| s[0] <= 0.2 + 1e-9), "{r:?}");
+    }
+    expect_spec_error(
+        &text.replace("start = 0.5, end = 0.8", "start = 0.5, end = 1.8"),
+        "grid.y",
+    );
+}
+
+#[test]
+fn bad_descriptions_name_the_field() {
+    let d = DAMPER;
+    let cases: Vec<(String, &str)> = vec![
+        (
+            d.replacen("law = \"hertz\"", "law = \"herz\"", 1),
+            "system.elements[2].law",
+        ),
+        (
+            d.replacen("k = 1e4", "kk = 1e4", 1),
+            "system.elements[2].kk",
+        ),
+        (d.replacen("k = 1e4\n", "", 1), "system.elements[2].k"),
+        (d.replacen("k = 1.0", "k = -1.0", 1), "system.elements[0].k"),
+        (
+            d.replacen("dof = 0", "dof = 2", 1),
+            "system.elements[0].dof",
+        ),
+        (
+            d.replacen(
+                "law = \"hertz\"\nbetween = [1, 0]",
+                "law = \"hertz\"\nbetween = [1, 1]",
+                1,
+            ),
+            "system.elements[2].between",
+        ),
+        (
+            d.replacen("side = \"lower\"", "side = \"below\"", 1),
+            "system.elements[3].side",
+        ),
+        (
+            d.replace("masses = [1.0, 0.05]", "masses = []"),
+            "system.masses",
+        ),
+        (
+            d.replace("masses = [1.0, 0.05]", "masses = [1.0, -0.05]"),
+            "system.masses[1]",
+        ),
+        (
+            d.replace("masses = [1.0, 0.05]", "masses = [1.0, 1.0, 1.0, 1.0, 1.0]"),
+            "system.masses",
+        ),
+        (
+            d.replace("parameters = { gap = 0.1 }", ""),
+            "system.parameters.gap",
+        ),
+        (
+            d.replace("gap = 0.1 }", "gap = 0.1, gapp = 0.2 }"),
+            "system.parameters.gapp",
+        ),
+        (
+            d.replacen("amplitude = 0.05", "amplitude = \"x2_0\"", 1),
+            "system.loads[0].amplitude",
+        ),
+        (
+            d.replacen(
+                "position = \"-gap\"\nside",
+                "position = \"-gap\"\nrestitution = 0.5\nside",
+                1,
+            ),
+            "system.surfaces[1].restitution",
+        ),
+        (
+            d.replace("model = \"mechanical\"", "model = \"paper\""),
+            "system.masses",
+        ),
+        (
+            d.replacen("[[system.loads]]\ndof = 0", "[[system.loads]]\ndof = 5", 1),
+            "system.loads[0].dof",
+        ),
+    ];
+    for (text, field) in &cases {
+        expect_spec_error(text, field);
+    }
+    // A parameter without a value; then on an axis whose values a law rejects.
+    let ok = d.replace("k = 1e4\nb = 2.0", "k = \"kc\"\nb = 2.0");
+    expect_spec_error(&ok, "system.parameters.kc");
+    let axis = ok.replace(
+        "y = { parameter = \"amplitude_factor\", start = 0.5, end = 1.5, points = 3 }",
+        "y = { parameter = \"kc\", start = -1.0, end = 1e4, points = 3 }",
+    );
+    expect_spec_error(&axis, "grid.y");
+}
+
+/// Every spec in `examples/studies` reads and plans, the catalogue's models and a described
+/// system among them; the small ones (at most 30 points) run whole and in two shards, every
+/// point without failure, with the same merged files.
+#[test]
+fn every_example_spec_reads_plans_and_the_small_ones_run() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/studies");
+    let mut specs: Vec<PathBuf> = fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    specs.sort();
+    let mut models = std::collections::BTreeSet::new();
+    let mut ran = 0;
+    for path in &specs {
+        let study = Study::from_file(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        models.insert(study.spec().system.model.clone());
+        let shards = study.points().min(4);
+        let script = sbatch_script(&study, path, &PlanSettings::new(shards, "out", "nonsmooth"))
+            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        assert!(script.contains(&format!("#SBATCH --array=1-{shards}\n")));
+        if study.points() > 30 {
+            continue;
+        }
+        let name = study.spec().name.clone();
+        let whole = scratch(&format!("example-{name}-1"));
+        let two = scratch(&format!("example-{name}-2"));
+        run_in_shards(&study, &whole, 1);
+        run_in_shards(&study, &two, 2);
+        let (_, recs) = read_shards(&whole).unwrap();
+        for r in &recs {
+            assert!(r.is_ok(), "{name} point {}: {}", r.index, r.status);
+        }
+        assert_eq!(merged_bytes(&whole), merged_bytes(&two), "{name}");
+        ran += 1;
+    }
+    for model in [
+        "paper",
+        "duffing_ueda",
+        "two_dof_impact",
+        "bouncing_ball",
+        "mechanical",
+    ] {
+        assert!(
+            models.contains(model),
+            "no example spec of {model}: {models:?}"
+        );
+    }
+    assert!(ran >= 5, "{ran} small examples ran");
 }

@@ -27,8 +27,8 @@ pub struct AttractorSummary {
     pub impacts_per_period: f64,
     /// Mean top Lyapunov exponent over its points (NaN if not recorded).
     pub tle_mean: f64,
-    /// The representative's mean section point `(x, v)`.
-    pub centroid: [f64; 2],
+    /// The representative's mean section point (the whole state).
+    pub centroid: Vec<f64>,
 }
 
 /// The group key of a point: the coordinates of its parameter axes.
@@ -43,13 +43,16 @@ fn group(study: &Study, index: usize) -> (Option<usize>, Option<usize>) {
 }
 
 /// Symmetric Hausdorff distance of two point sets in the scaled max norm.
-fn hausdorff(a: &[[f64; 2]], b: &[[f64; 2]], s: [f64; 2]) -> f64 {
-    let d = |p: &[f64; 2], q: &[f64; 2]| {
-        ((p[0] - q[0]) / s[0])
-            .abs()
-            .max(((p[1] - q[1]) / s[1]).abs())
+fn hausdorff(a: &[Vec<f64>], b: &[Vec<f64>], s: &[f64]) -> f64 {
+    let d = |p: &Vec<f64>, q: &Vec<f64>| {
+        p.iter()
+            .zip(q)
+            .zip(s)
+            .map(|((p, q), s)| ((p - q) / s).abs())
+            .reduce(f64::max)
+            .unwrap_or(0.0)
     };
-    let one = |a: &[[f64; 2]], b: &[[f64; 2]]| {
+    let one = |a: &[Vec<f64>], b: &[Vec<f64>]| {
         a.iter()
             .map(|p| b.iter().map(|q| d(p, q)).fold(f64::INFINITY, f64::min))
             .fold(0.0, f64::max)
@@ -58,7 +61,7 @@ fn hausdorff(a: &[[f64; 2]], b: &[[f64; 2]], s: [f64; 2]) -> f64 {
 }
 
 /// Jaccard overlap `|A ∩ B| / |A ∪ B|` of two sorted cell lists.
-fn jaccard(a: &[(i64, i64)], b: &[(i64, i64)]) -> f64 {
+fn jaccard(a: &[Vec<i64>], b: &[Vec<i64>]) -> f64 {
     let (mut i, mut j, mut common) = (0, 0, 0usize);
     while i < a.len() && j < b.len() {
         match a[i].cmp(&b[j]) {
@@ -80,7 +83,7 @@ fn jaccard(a: &[(i64, i64)], b: &[(i64, i64)]) -> f64 {
 }
 
 /// The orbit's own section points: the last `period` kept points.
-fn orbit(r: &PointRecord) -> &[[f64; 2]] {
+fn orbit(r: &PointRecord) -> &[Vec<f64>] {
     let n = r.sections.len();
     &r.sections[n - r.period.min(n)..]
 }
@@ -88,7 +91,7 @@ fn orbit(r: &PointRecord) -> &[[f64; 2]] {
 /// Whether `r` reached the attractor of `rep`.
 fn same(r: &PointRecord, rep: &PointRecord, study: &Study) -> bool {
     let a = &study.spec().attractors;
-    let scales = a.scales.unwrap_or(study.kind().scales());
+    let scales = &study.scales();
     if r.period > 0 && r.period == rep.period {
         (r.impacts_per_period - rep.impacts_per_period).abs() < 1e-9
             && hausdorff(orbit(r), orbit(rep), scales) <= a.tol
@@ -139,10 +142,12 @@ pub fn identify(
             let rep = &records[k];
             let (count, tsum, tn) = stats.get(&(*g, label)).copied().unwrap_or((0, 0.0, 0));
             let n = rep.sections.len().max(1) as f64;
-            let centroid = rep
-                .sections
-                .iter()
-                .fold([0.0, 0.0], |c, p| [c[0] + p[0] / n, c[1] + p[1] / n]);
+            let mut centroid = vec![0.0; study.system().dimension()];
+            for p in &rep.sections {
+                for (c, x) in centroid.iter_mut().zip(p) {
+                    *c += x / n;
+                }
+            }
             summary.push(AttractorSummary {
                 group: *g,
                 label,
@@ -182,13 +187,17 @@ mod tests {
 
     #[test]
     fn jaccard_and_hausdorff() {
-        let a = [(0, 0), (1, 2), (3, 4)];
-        let b = [(1, 2), (3, 4), (5, 5)];
+        let a = [vec![0, 0], vec![1, 2], vec![3, 4]];
+        let b = [vec![1, 2], vec![3, 4], vec![5, 5]];
         assert!((jaccard(&a, &b) - 0.5).abs() < 1e-15);
         assert_eq!(jaccard(&a, &[]), 0.0);
-        let p = [[0.0, 0.0], [1.0, 1.0]];
-        let q = [[1.0, 1.0], [0.0, 0.1]];
-        assert!((hausdorff(&p, &q, [1.0, 1.0]) - 0.1).abs() < 1e-15);
-        assert!((hausdorff(&p, &q, [1.0, 0.5]) - 0.2).abs() < 1e-15);
+        let p = [vec![0.0, 0.0], vec![1.0, 1.0]];
+        let q = [vec![1.0, 1.0], vec![0.0, 0.1]];
+        assert!((hausdorff(&p, &q, &[1.0, 1.0]) - 0.1).abs() < 1e-15);
+        assert!((hausdorff(&p, &q, &[1.0, 0.5]) - 0.2).abs() < 1e-15);
+        // Four components: the largest scaled difference.
+        let p = [vec![0.0, 0.0, 0.0, 0.0]];
+        let q = [vec![0.0, 0.1, 0.0, 0.3]];
+        assert!((hausdorff(&p, &q, &[1.0, 1.0, 1.0, 0.5]) - 0.6).abs() < 1e-15);
     }
 }

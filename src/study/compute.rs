@@ -2,19 +2,16 @@
 
 use std::collections::BTreeMap;
 
-use nalgebra::{SVector, Vector2};
+use nalgebra::Vector2;
 
-use super::model::{ModelKind, ParameterSet};
+use super::catalogue::Paper;
 use super::record::PointRecord;
 use super::shard::{Shard, shard_indices};
 use super::spec::{Study, apply_axis};
-use crate::Dynamics;
-use crate::ensemble::{Ensemble, F64x8, F64x16, IndependentSweep, Member, Simd, sweep_starts};
+use super::system::{ParameterPoint, PointRun, RunSettings, fill};
+use crate::ensemble::{Ensemble, F64x8, F64x16, Member, Simd, sweep_starts};
 use crate::entropy::{Histogram, QRange, entropy_index};
-use crate::integrate::{Dopri5, Tolerances};
-use crate::lyapunov::{Norm, TwoTrajectory};
-use crate::sample::Regime;
-use crate::sweep::{Stop, SweepError, SweepPoint, SweepSystem, run_point};
+use crate::sweep::SweepError;
 use crate::systems::paper::PaperParameters;
 
 /// Computes grid point `index` of `study` (a failure is recorded in the point's `status`,
@@ -22,40 +19,21 @@ use crate::systems::paper::PaperParameters;
 pub fn compute_point(study: &Study, index: usize) -> PointRecord {
     match try_point(study, index) {
         Ok(r) => r,
-        Err(m) => PointRecord::failed(index, m),
+        Err(m) => failed(study, index, m),
     }
 }
 
 fn try_point(study: &Study, index: usize) -> Result<PointRecord, String> {
-    let (set, y0) = point_setup(study, index)?;
-    match study.kind() {
-        ModelKind::Paper => {
-            let (p, omega, y0) = paper_start(&set, y0)?;
-            run_model(
-                study,
-                index,
-                || Ok(p.oscillator::<f64>(omega)?),
-                std::f64::consts::TAU / omega,
-                Some(impact_stop(&p)),
-                y0,
-            )
-        }
-        ModelKind::DuffingUeda => {
-            let d = set.duffing().ok_or("internal: not Duffing–Ueda")?;
-            run_model(
-                study,
-                index,
-                || d.model::<f64>(),
-                d.period(),
-                None,
-                fill(y0, [0.0, 0.0]),
-            )
-        }
-    }
+    let (point, given) = point_setup(study, index)?;
+    let system = study.system();
+    let rest = system.rest_state(&point)?;
+    let y0 = fill(given.as_deref(), &rest);
+    let run = system.run(&point, &y0, &run_settings(study))?;
+    Ok(record(study, index, run))
 }
 
-/// The parameters and the given initial components of point `index`.
-fn point_setup(study: &Study, index: usize) -> Result<(ParameterSet, Option<[f64; 2]>), String> {
+/// The parameters and the given initial components (NaN: not given) of point `index`.
+fn point_setup(study: &Study, index: usize) -> Result<(ParameterPoint, Option<Vec<f64>>), String> {
     let spec = study.spec();
     if index >= study.points() {
         return Err(format!(
@@ -63,121 +41,72 @@ fn point_setup(study: &Study, index: usize) -> Result<(ParameterSet, Option<[f64
             study.points()
         ));
     }
-    let mut set = ParameterSet::new(study.kind(), &spec.system.parameters);
-    let mut y0 = spec.initial.state;
+    let system = study.system();
+    let mut point = system
+        .point(&spec.system.parameters)
+        .map_err(|e| e.to_string())?;
+    let mut y0 = spec.initial.state.clone();
     let (xv, yv) = study.values(index);
-    apply_axis(&mut set, &mut y0, &spec.grid.x.parameter, xv);
+    apply_axis(system, &mut point, &mut y0, &spec.grid.x.parameter, xv);
     if let Some(y) = &spec.grid.y {
-        apply_axis(&mut set, &mut y0, &y.parameter, yv);
+        apply_axis(system, &mut point, &mut y0, &y.parameter, yv);
     }
-    Ok((set, y0))
+    Ok((point, y0))
+}
+
+/// The run settings of every point of `study`.
+pub(crate) fn run_settings(study: &Study) -> RunSettings {
+    let spec = study.spec();
+    let system = study.system();
+    let rtol = spec.integration.rtol;
+    let atol = match &spec.integration.atol {
+        Some(a) => a.to_vec(),
+        None => system.atol_per_rtol().iter().map(|a| a * rtol).collect(),
+    };
+    RunSettings {
+        rtol,
+        atol,
+        max_steps: spec.integration.max_steps,
+        transient: spec.periods.transient,
+        record: spec.periods.record,
+        period_tol: spec.record.period_tol,
+        max_period: spec.record.max_period,
+        lyapunov: spec
+            .record
+            .lyapunov
+            .as_ref()
+            .map(|l| (l.periods, l.d0.unwrap_or(system.d0()))),
+        scales: study.scales(),
+    }
 }
 
 /// The paper model's parameters, ω and initial state (the rest state where not given).
 fn paper_start(
-    set: &ParameterSet,
-    y0: Option<[f64; 2]>,
+    point: &ParameterPoint,
+    given: Option<Vec<f64>>,
 ) -> Result<(PaperParameters, f64, Vector2<f64>), String> {
-    let (p, omega) = set.paper().ok_or("internal: not the paper's model")?;
+    let (p, omega) = Paper::at(point);
     let rest = [p.static_equilibrium().map_err(|e| e.to_string())?, 0.0];
-    Ok((p, omega, fill(y0, rest)))
+    let y = fill(given.as_deref(), &rest);
+    Ok((p, omega, Vector2::new(y[0], y[1])))
 }
 
-/// Impacts: rising crossings of `x = x_I`.
-fn impact_stop(p: &PaperParameters) -> Stop {
-    Stop {
-        position: 0,
-        velocity: 1,
-        level: p.x_i,
-    }
-}
-
-/// The initial state: given components, the rest state for the others.
-fn fill(y0: Option<[f64; 2]>, rest: [f64; 2]) -> Vector2<f64> {
-    let s = y0.unwrap_or(rest);
-    let pick = |k: usize| if s[k].is_nan() { rest[k] } else { s[k] };
-    Vector2::new(pick(0), pick(1))
-}
-
-/// The integration tolerances and the sweep settings of every point.
-fn integration(study: &Study) -> Result<(Tolerances<f64, 2>, IndependentSweep), String> {
+/// The point's record from its run: period, sections, fingerprint, `q` and the top
+/// Lyapunov exponent.
+fn record(study: &Study, index: usize, run: PointRun) -> PointRecord {
     let spec = study.spec();
-    let s = |e: &dyn std::fmt::Display| e.to_string();
-    let rtol = spec.integration.rtol;
-    let atol = spec.integration.atol.unwrap_or({
-        let a = study.kind().atol_per_rtol();
-        [a[0] * rtol, a[1] * rtol]
-    });
-    let tol = Tolerances::per_component(rtol, atol).map_err(|e| s(&e))?;
-    let settings = IndependentSweep::new(spec.periods.transient, spec.periods.record)
-        .and_then(|c| c.period_detection(spec.record.period_tol, spec.record.max_period))
-        .map_err(|e| s(&e))?
-        .max_steps(spec.integration.max_steps);
-    Ok((tol, settings))
-}
-
-fn run_model<S, F>(
-    study: &Study,
-    index: usize,
-    make: F,
-    period: f64,
-    stop: Option<Stop>,
-    y0: Vector2<f64>,
-) -> Result<PointRecord, String>
-where
-    S: Dynamics<f64, 2>,
-    F: Fn() -> crate::Result<S>,
-{
-    let s = |e: &dyn std::fmt::Display| e.to_string();
-    let (tol, settings) = integration(study)?;
-    let cfg = settings.config(vec![0.0]).map_err(|e| s(&e))?;
-    let system = make().map_err(|e| s(&e))?;
-    let pt = run_point(
-        &cfg,
-        0.0,
-        SweepSystem {
-            system,
-            period,
-            stop,
-        },
-        Dopri5::new(tol),
-        y0,
-        settings.transient,
-    )
-    .map_err(|e| s(&e))?;
-    Ok(record(study, index, make, period, &tol, &pt))
-}
-
-/// The point's record from its run: period, sections, fingerprint, `q` and (a second,
-/// scalar run from the end state) the top Lyapunov exponent.
-fn record<S, F>(
-    study: &Study,
-    index: usize,
-    make: F,
-    period: f64,
-    tol: &Tolerances<f64, 2>,
-    pt: &SweepPoint<2>,
-) -> PointRecord
-where
-    S: Dynamics<f64, 2>,
-    F: Fn() -> crate::Result<S>,
-{
-    let spec = study.spec();
-    let kind = study.kind();
-    let period_n = match pt.regime {
-        Regime::Periodic(p) => p,
-        Regime::NotPeriodic => 0,
-    };
-    let keep = spec.record.poincare.max(period_n).min(pt.poincare.len());
-    let sections: Vec<[f64; 2]> = pt.poincare[pt.poincare.len() - keep..]
-        .iter()
-        .map(|p| [p[0], p[1]])
-        .collect();
-    let scales = spec.attractors.scales.unwrap_or(kind.scales());
+    let period_n = run.period;
+    let keep = spec.record.poincare.max(period_n).min(run.poincare.len());
+    let sections: Vec<Vec<f64>> = run.poincare[run.poincare.len() - keep..].to_vec();
     // Fingerprints are compared only between points of the same system parameters, which
     // exist only on a grid with an initial-condition axis.
     let cells = if study.has_initial_condition_axis() {
-        fingerprint(&pt.poincare, scales, spec.attractors.cell)
+        fingerprint(&run.poincare, &study.scales(), spec.attractors.cell)
+    } else {
+        Vec::new()
+    };
+    let impacts_per_surface = if study.system().surfaces() >= 2 {
+        run.impacts_per_surface
     } else {
         Vec::new()
     };
@@ -185,7 +114,8 @@ where
         index,
         status: "ok".into(),
         period: period_n,
-        impacts_per_period: pt.impacts_per_period,
+        impacts_per_period: run.impacts_per_period,
+        impacts_per_surface,
         tle: f64::NAN,
         tle_spread: f64::NAN,
         q: f64::NAN,
@@ -195,33 +125,17 @@ where
     if let Some(q) = &spec.record.q {
         rec.q = Histogram::new(q.lo, q.hi, q.step)
             .ok()
-            .and_then(|h| h.estimate(&pt.intervals).ok())
+            .and_then(|h| h.estimate(&run.intervals).ok())
             .and_then(|est| entropy_index(&est.probabilities, &QRange::default()).ok())
             .map_or(f64::NAN, |i| i.q);
     }
-    if let Some(l) = &spec.record.lyapunov {
-        let tle = (|| -> crate::Result<(f64, f64)> {
-            let norm = Norm::weighted(scales)?;
-            let d0 = l.d0.unwrap_or(kind.d0());
-            let mut est = TwoTrajectory::<f64, 2, 4, _, _>::with_tolerances(
-                make()?,
-                Dopri5::new,
-                tol,
-                d0,
-                norm,
-            )?;
-            // The run ended after a whole number of periods: t = 0 has the same phase.
-            est.start(0.0, pt.end_state)?;
-            let e = est.estimate(period, l.periods)?;
-            Ok((e.exponent, e.spread))
-        })();
-        match tle {
-            Ok((l, sp)) => {
-                rec.tle = l;
-                rec.tle_spread = sp;
-            }
-            Err(e) => rec.status = format!("lyapunov: {e}"),
+    match run.lyapunov {
+        Some(Ok((l, sp))) => {
+            rec.tle = l;
+            rec.tle_spread = sp;
         }
+        Some(Err(e)) => rec.status = format!("lyapunov: {e}"),
+        None => {}
     }
     rec
 }
@@ -231,19 +145,19 @@ pub const MAX_CELLS: usize = 256;
 
 /// The cells of side `cell·scale` visited by the section points, at most [`MAX_CELLS`] of
 /// them (the most visited; ties by cell), sorted.
-fn fingerprint(points: &[SVector<f64, 2>], scales: [f64; 2], cell: f64) -> Vec<(i64, i64)> {
-    let mut all: Vec<(i64, i64)> = points
+fn fingerprint(points: &[Vec<f64>], scales: &[f64], cell: f64) -> Vec<Vec<i64>> {
+    let mut all: Vec<Vec<i64>> = points
         .iter()
         .map(|p| {
             // `as` saturates: a far-out point lands in an edge cell instead of wrapping.
-            (
-                (p[0] / (scales[0] * cell)).floor() as i64,
-                (p[1] / (scales[1] * cell)).floor() as i64,
-            )
+            p.iter()
+                .zip(scales)
+                .map(|(x, s)| (x / (s * cell)).floor() as i64)
+                .collect()
         })
         .collect();
     all.sort_unstable();
-    let mut counted: Vec<((i64, i64), usize)> = Vec::new();
+    let mut counted: Vec<(Vec<i64>, usize)> = Vec::new();
     for c in all {
         match counted.last_mut() {
             Some((last, n)) if *last == c => *n += 1,
@@ -254,13 +168,31 @@ fn fingerprint(points: &[SVector<f64, 2>], scales: [f64; 2], cell: f64) -> Vec<(
         counted.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
         counted.truncate(MAX_CELLS);
     }
-    let mut cells: Vec<(i64, i64)> = counted.into_iter().map(|(c, _)| c).collect();
+    let mut cells: Vec<Vec<i64>> = counted.into_iter().map(|(c, _)| c).collect();
     cells.sort_unstable();
     cells
 }
 
+/// A point whose run failed: with NaN impacts on each surface of a system with two or more.
+fn failed(study: &Study, index: usize, message: String) -> PointRecord {
+    let mut r = PointRecord::failed(index, message);
+    let n = study.system().surfaces();
+    if n >= 2 {
+        r.impacts_per_surface = vec![f64::NAN; n];
+    }
+    r
+}
+
 /// Points per batch of the paper model's lanes (a batch runs on one thread).
 const BATCH: usize = 64;
+
+/// THE DISPATCH TO LANES: the system of `study` if its points run in SIMD lanes — today the
+/// paper's model only ([`sweep_starts`] over [`Member`], the paper's oscillator family);
+/// every other system runs point by point on the scalar path ([`compute_point`]). Lanes
+/// for other systems are added here.
+fn lanes(study: &Study) -> Option<&Paper> {
+    study.system().as_any().downcast_ref::<Paper>()
+}
 
 /// Computes the points of `shard` in parallel (rayon, in the current pool), calling
 /// `progress` after each point; returned in index order. The result does not depend on the
@@ -270,12 +202,12 @@ const BATCH: usize = 64;
 /// [`LaneMath::Exact`](crate::ensemble::LaneMath::Exact), batches of 64 points per
 /// task), which gives each point's run to the bit as [`compute_point`] does (tested); the
 /// Lyapunov exponent, where recorded, is the scalar two-trajectory estimate from the run's
-/// end state. Duffing–Ueda points run on the scalar path.
+/// end state. The points of every other system run on the scalar path.
 pub fn run_shard<F: Fn() + Sync>(study: &Study, shard: Shard, progress: F) -> Vec<PointRecord> {
     use rayon::prelude::*;
     let idx: Vec<usize> = shard_indices(study.points(), shard).collect();
-    match study.kind() {
-        ModelKind::Paper => idx
+    match lanes(study) {
+        Some(_) => idx
             .par_chunks(BATCH)
             .flat_map_iter(|batch| {
                 let recs = paper_batch(study, batch);
@@ -283,7 +215,7 @@ pub fn run_shard<F: Fn() + Sync>(study: &Study, shard: Shard, progress: F) -> Ve
                 recs
             })
             .collect(),
-        ModelKind::DuffingUeda => idx
+        None => idx
             .par_iter()
             .map(|&i| {
                 let r = compute_point(study, i);
@@ -297,7 +229,8 @@ pub fn run_shard<F: Fn() + Sync>(study: &Study, shard: Shard, progress: F) -> Ve
 /// The paper model's points `indices` in lanes: the records of [`compute_point`], to the
 /// bit, with the same messages for what fails.
 fn paper_batch(study: &Study, indices: &[usize]) -> Vec<PointRecord> {
-    let (tol, settings) = match integration(study) {
+    let run_settings = run_settings(study);
+    let (tol, settings) = match Paper::integration(&run_settings) {
         Ok(v) => v,
         Err(m) => {
             return indices
@@ -311,7 +244,7 @@ fn paper_batch(study: &Study, indices: &[usize]) -> Vec<PointRecord> {
     // move it).
     let mut groups: BTreeMap<u64, Vec<(usize, Member, Vector2<f64>)>> = BTreeMap::new();
     for (k, &i) in indices.iter().enumerate() {
-        let start = point_setup(study, i).and_then(|(set, y0)| paper_start(&set, y0));
+        let start = point_setup(study, i).and_then(|(point, y0)| paper_start(&point, y0));
         match start {
             Err(m) => recs[k] = Some(PointRecord::failed(i, m)),
             Ok((p, omega, y0)) => match Member::new(p, omega) {
@@ -328,7 +261,7 @@ fn paper_batch(study: &Study, indices: &[usize]) -> Vec<PointRecord> {
         sweep_starts::<F64x8>
     };
     for group in groups.values() {
-        let stop = impact_stop(group[0].1.params());
+        let stop = Paper::impact_stop(group[0].1.params());
         let starts: Vec<(Member, Vector2<f64>)> = group.iter().map(|(_, m, y)| (*m, *y)).collect();
         let run = Ensemble::new(tol)
             .map_err(|e| SweepError::failed(0.0, e))
@@ -344,7 +277,17 @@ fn paper_batch(study: &Study, indices: &[usize]) -> Vec<PointRecord> {
                     let i = indices[*k];
                     recs[*k] = Some(match r {
                         Err(e) => PointRecord::failed(i, SweepError::failed(0.0, e).to_string()),
-                        Ok(pt) => record(study, i, || Ok(*m.scalar()), m.period(), &tol, &pt),
+                        Ok(pt) => record(
+                            study,
+                            i,
+                            Paper::point_run(
+                                &run_settings,
+                                || Ok(*m.scalar()),
+                                m.period(),
+                                &tol,
+                                &pt,
+                            ),
+                        ),
                     });
                 }
             }

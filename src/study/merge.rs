@@ -7,7 +7,7 @@ use plotters::prelude::*;
 use super::StudyError;
 use super::attractor::{AttractorSummary, identify, regime_class};
 use super::record::PointRecord;
-use super::shard::{fmt_f64, read_shards, sections_csv};
+use super::shard::{fmt_f64, read_shards, sections_csv, surface_columns, surface_values};
 use super::spec::Study;
 
 /// A merged study.
@@ -71,7 +71,8 @@ impl Merged {
             .map_or("y".to_string(), |y| y.parameter.clone());
         let mut w = csv::Writer::from_writer(Vec::new());
         let e = |e: csv::Error| StudyError::Io(e.to_string());
-        w.write_record([
+        let n = surface_columns(&self.study);
+        let mut header: Vec<String> = [
             "index",
             "ix",
             "iy",
@@ -79,18 +80,16 @@ impl Merged {
             yname.as_str(),
             "period",
             "impacts_per_period",
-            "tle",
-            "tle_spread",
-            "q",
-            "label",
-            "class",
-            "status",
-        ])
-        .map_err(e)?;
+        ]
+        .map(String::from)
+        .to_vec();
+        header.extend((0..n).map(|k| format!("impacts_per_period_{k}")));
+        header.extend(["tle", "tle_spread", "q", "label", "class", "status"].map(String::from));
+        w.write_record(&header).map_err(e)?;
         for (r, l) in self.records.iter().zip(&self.labels) {
             let (ix, iy) = self.study.coordinates(r.index);
             let (x, y) = self.study.values(r.index);
-            w.write_record([
+            let mut row = vec![
                 r.index.to_string(),
                 ix.to_string(),
                 iy.to_string(),
@@ -98,14 +97,17 @@ impl Merged {
                 fmt_f64(y),
                 r.period.to_string(),
                 fmt_f64(r.impacts_per_period),
+            ];
+            row.extend(surface_values(r, n));
+            row.extend([
                 fmt_f64(r.tle),
                 fmt_f64(r.tle_spread),
                 fmt_f64(r.q),
                 l.map_or(String::new(), |l| l.to_string()),
                 regime_class(r),
                 r.status.clone(),
-            ])
-            .map_err(e)?;
+            ]);
+            w.write_record(row).map_err(e)?;
         }
         w.into_inner().map_err(|e| StudyError::Io(e.to_string()))
     }
@@ -128,12 +130,12 @@ impl Merged {
         written.push(out.to_path_buf());
 
         let p = side(".sections.csv");
-        std::fs::write(&p, sections_csv(&self.records)?).map_err(|e| io(&p, &e))?;
+        std::fs::write(&p, sections_csv(&self.study, &self.records)?).map_err(|e| io(&p, &e))?;
         written.push(p);
 
         let ce = |e: csv::Error| StudyError::Io(e.to_string());
         let mut w = csv::Writer::from_writer(Vec::new());
-        w.write_record([
+        let mut header: Vec<String> = [
             "group_ix",
             "group_iy",
             "label",
@@ -143,13 +145,20 @@ impl Merged {
             "period",
             "impacts_per_period",
             "tle_mean",
-            "centroid_x",
-            "centroid_v",
-        ])
-        .map_err(ce)?;
+        ]
+        .map(String::from)
+        .to_vec();
+        header.extend(
+            self.study
+                .system()
+                .state_names()
+                .iter()
+                .map(|n| format!("centroid_{n}")),
+        );
+        w.write_record(&header).map_err(ce)?;
         let opt = |o: Option<usize>| o.map_or(String::new(), |v| v.to_string());
         for a in &self.attractors {
-            w.write_record([
+            let mut row = vec![
                 opt(a.group.0),
                 opt(a.group.1),
                 a.label.to_string(),
@@ -159,10 +168,9 @@ impl Merged {
                 a.period.to_string(),
                 fmt_f64(a.impacts_per_period),
                 fmt_f64(a.tle_mean),
-                fmt_f64(a.centroid[0]),
-                fmt_f64(a.centroid[1]),
-            ])
-            .map_err(ce)?;
+            ];
+            row.extend(a.centroid.iter().map(|&c| fmt_f64(c)));
+            w.write_record(row).map_err(ce)?;
         }
         let p = side(".attractors.csv");
         std::fs::write(

@@ -3,18 +3,30 @@
 //! merged with a verified, deterministic merge (feature `cli`).
 //!
 //! A study is a TOML file ([`StudySpec`], validated with errors that name the field): a model
-//! of the catalogue and its parameters, a grid over one or two named parameters (`omega`,
-//! `amplitude_factor`, any model parameter) or initial-condition components (`x0`, `v0`),
+//! of the catalogue (`paper`, `duffing_ueda`, `two_dof_impact`, `bouncing_ball`; see
+//! [`SystemSpec::model`]) and its parameters, or a mechanical system described in the file
+//! ([below](#a-system-described-in-the-study-file)); a grid over one or two named
+//! parameters (`omega`, `amplitude_factor`, any model parameter) or initial-condition
+//! components (`x0`, `v0` for one degree of freedom; `x1_0`, …, `v2_0` for several),
 //! integration settings, transient and recorded forcing periods, and what to record.
 //! At each grid point ([`compute_point`]) the system runs `transient` periods from the
 //! initial state and records `record` periods with the sweep machinery
 //! ([`run_point`](crate::sweep::run_point)): the stroboscopic points, the regime (period
 //! detection), impacts per forcing period, optionally the top Lyapunov exponent (two
 //! trajectories from the end of the window) and the entropy index `q*` of the inter-impact
-//! intervals; and the attractor's fingerprint. A shard runs the paper model's points in
+//! intervals; and the attractor's fingerprint. Records hold whole states (`(x, v)` for one
+//! degree of freedom, `(x1 … xN, v1 … vN)` for `N`) and, for a system with two or more
+//! impact surfaces, the impacts per period on each. A shard runs the paper model's points in
 //! SIMD lanes ([`ensemble::sweep_starts`](crate::ensemble::sweep_starts), exact math),
 //! 64 points per task, which reproduces [`compute_point`]'s scalar run to the bit (tested
-//! field by field, failures included); the Lyapunov exponent stays a scalar run.
+//! field by field, failures included); the Lyapunov exponent stays a scalar run. Every
+//! other system runs point by point on the scalar path: one
+//! [`Simulation`](crate::drive::Simulation) with its impact surfaces as events, or, for a
+//! rigid stop with Newton restitution (the ball on the table),
+//! [`run_with_sticking`](crate::drive::run_with_sticking) through chattering and sticking;
+//! its exponent by two trajectories ([`TwoTrajectory`](crate::lyapunov::TwoTrajectory), or
+//! [`HybridTwoTrajectory`](crate::lyapunov::HybridTwoTrajectory) across the resets of a
+//! rigid stop).
 //!
 //! # Sharding and determinism
 //! Point `i = ix + nx·iy` belongs to shard `I` of `N` when `i ≡ I − 1 (mod N)`
@@ -31,8 +43,9 @@
 //! Points are compared only with points of the same system parameters (a *group*: the
 //! whole plane of a basin picture; a single point of a parameter map, whose label is then
 //! 0). Within a group, in index order, a point gets the label of the first representative
-//! it matches, or opens a new label. With section points `P = {p_k}` scaled component-wise
-//! by `s = (s_x, s_v)` (`attractors.scales`, default the model's Lyapunov scales):
+//! it matches, or opens a new label. With section points `P = {p_k}` (whole states) scaled
+//! component-wise by `s = (s_x, s_v)` (one scale per state component: `attractors.scales`,
+//! default the model's Lyapunov scales):
 //!
 //! * **periodic orbits** (period `p ≥ 1` detected) match when they have the same period
 //!   and impacts per period and their orbits' section points `P, Q` (the last `p` points)
@@ -67,10 +80,62 @@
 //! ([`AttractorSummary`]) gives each attractor's basin fraction, period, impacts per period,
 //! mean exponent and centroid.
 //!
+//! # A system described in the study file
+//! `model = "mechanical"` describes a [`Mechanical`](crate::model::Mechanical) system of one
+//! to [`MAX_DESCRIBED_DOFS`] degrees of freedom (numbered from 0) in the `system` table:
+//!
+//! ```toml
+//! [system]
+//! model = "mechanical"
+//! masses = [1.0, 0.05]                     # one per degree of freedom
+//! parameters = { gap = 0.1 }               # omega: the forcing frequency, here an axis
+//!
+//! [[system.elements]]                      # a force law on a coordinate
+//! law = "linear_spring"
+//! dof = 0                                  # q0; or between = [1, 0]: q1 − q0
+//! k = 1.0
+//!
+//! [[system.elements]]                      # a Hertz stop: just an element
+//! law = "hertz"
+//! between = [1, 0]
+//! position = "gap"                         # a number or a parameter ("-gap": its negative)
+//! k = 1e4
+//! b = 2.0
+//!
+//! [[system.loads]]                         # amplitude·cos(ω t + phase) on a degree of freedom
+//! dof = 0
+//! amplitude = 0.05
+//!
+//! [[system.surfaces]]                      # impacts are counted on each surface
+//! between = [1, 0]
+//! position = "gap"                         # side = "upper" (default) or "lower"
+//! ```
+//!
+//! The laws ([`ElementSpec`]; defaults after `=`): `linear_spring` (`k`, `x0 = 0`),
+//! `viscous_damper` (`c`), `cubic_spring` (`k1`, `k3`), `hertz` (`position`, `k`,
+//! `n1 = 1.5`, `b = 0`, `n2 = 1.5`, `n3 = 1`; `side = "upper"`: contact where the
+//! coordinate exceeds `position`, `"lower"` where it falls below) and `dry_friction` (`t`,
+//! `eps`: the regularized sign `v/√(v²+ε²)`). Every number may instead name a parameter
+//! ([`SpecValue`]): `omega` (required: the forcing frequency and the section period) and
+//! `amplitude_factor` (a factor on every load's amplitude, default 1) always exist; any
+//! other name becomes a parameter without a default, to be given in `system.parameters` or
+//! as a grid axis.
+//! A surface ([`SurfaceSpec`]) without `restitution` counts the impacts of a compliant
+//! contact; with `restitution = e` it is a rigid stop with Newton's impact law, run through
+//! chattering and sticking — the drive runs one rigid contact, so it must be the only
+//! surface. The state is `(x1, …, xN, v1, …, vN)` (`(x, v)` for one mass), the rest state
+//! the origin, the scales and absolute tolerances per `rtol` 1. A bad description is
+//! rejected naming the field, e.g. `system.elements[2].law`. Example:
+//! `examples/studies/impact_damper_2dof.toml`, a primary mass with a free mass rattling in
+//! a cavity (two walls, impacts counted on each).
+//!
 //! # The shard files
 //! Shard `I` of `N` writes three files into the output directory:
-//! `shard-IIIII-of-NNNNN.csv` (one row per point), `shard-IIIII-of-NNNNN.sections.csv`
-//! (the kept stroboscopic points, one row each) and `shard-IIIII-of-NNNNN.json`, the
+//! `shard-IIIII-of-NNNNN.csv` (one row per point; columns `impacts_per_period_K` per
+//! surface for a system with two or more, cells as `a:b:…`, one integer per state
+//! component), `shard-IIIII-of-NNNNN.sections.csv` (the kept stroboscopic points, one row
+//! each: `index, k` and the state components by name, `x, v` for one degree of freedom) and
+//! `shard-IIIII-of-NNNNN.json`, the
 //! manifest: format version, crate version, the spec itself (so a directory of shards is
 //! self-describing), its hash, `I`, `N`, the number of points and the FNV-1a hash of each
 //! CSV file. CSV and JSON rather than Parquet: `csv` is already a dependency of the crate,
@@ -89,16 +154,20 @@
 //! section points, the attractor summary and the PNG figure ([`Merged::figure`]).
 
 mod attractor;
+mod catalogue;
 mod compute;
+mod mechanical;
 mod merge;
-mod model;
 mod plan;
 mod record;
+mod scalar;
 mod shard;
 mod spec;
+mod system;
 
 pub use attractor::{AttractorSummary, identify, regime_class};
 pub use compute::{MAX_CELLS, compute_point, run_shard};
+pub use mechanical::{ElementSpec, LoadSpec, MAX_DESCRIBED_DOFS, SpecValue, SurfaceSpec};
 pub use merge::Merged;
 pub use plan::{PlanSettings, sbatch_script};
 pub use record::PointRecord;

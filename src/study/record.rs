@@ -11,8 +11,11 @@ pub struct PointRecord {
     pub status: String,
     /// The period in forcing periods (0: no period up to the maximum tested).
     pub period: usize,
-    /// Impacts per forcing period (NaN if the run failed).
+    /// Impacts per forcing period, on all impact surfaces together (NaN if the run failed).
     pub impacts_per_period: f64,
+    /// Impacts per forcing period on each impact surface, for a system with two or more
+    /// (NaN if the run failed); empty for a system with one surface or none.
+    pub impacts_per_surface: Vec<f64>,
     /// Top Lyapunov exponent (1/time unit; NaN if not recorded).
     pub tle: f64,
     /// Its standard error (NaN if not recorded).
@@ -20,23 +23,27 @@ pub struct PointRecord {
     /// Entropy index `q*` of the inter-impact intervals (NaN if not recorded or not
     /// defined, e.g. one interval value on a periodic orbit).
     pub q: f64,
-    /// The last stroboscopic points `(x, v)` (at most the spec's `record.poincare`, at
+    /// The last stroboscopic points, each the whole state (`(x, v)` for one degree of
+    /// freedom, `(x1 … xN, v1 … vN)` for `N`; at most the spec's `record.poincare`, at
     /// least the period).
-    pub sections: Vec<[f64; 2]>,
+    pub sections: Vec<Vec<f64>>,
     /// The attractor fingerprint: the cells of the section tessellation visited by the
-    /// recorded points, sorted (see the [module docs](super)); empty on a grid
-    /// without an initial-condition axis, where no two points share their parameters.
-    pub cells: Vec<(i64, i64)>,
+    /// recorded points (one integer per state component), sorted (see the
+    /// [module docs](super)); empty on a grid without an initial-condition axis, where no
+    /// two points share their parameters.
+    pub cells: Vec<Vec<i64>>,
 }
 
 impl PointRecord {
-    /// A point whose run failed.
+    /// A point whose run failed (with no impacts per surface: a study of a system with two
+    /// or more surfaces records NaN for each).
     pub fn failed(index: usize, message: String) -> Self {
         Self {
             index,
             status: message,
             period: 0,
             impacts_per_period: f64::NAN,
+            impacts_per_surface: Vec::new(),
             tle: f64::NAN,
             tle_spread: f64::NAN,
             q: f64::NAN,

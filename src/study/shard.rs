@@ -184,55 +184,87 @@ fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), StudyError> {
     fs::rename(&tmp, path).map_err(|e| io(path, e))
 }
 
-pub(crate) const POINT_HEADER: [&str; 10] = [
-    "index",
-    "status",
-    "period",
-    "impacts_per_period",
-    "tle",
-    "tle_spread",
-    "q",
-    "kept_sections",
-    "cells",
-    "spec_hash",
-];
+/// The columns of the points file: the per-surface impacts only for a system with two or
+/// more impact surfaces (`impacts_per_period_0`, …, after `impacts_per_period`).
+fn point_header(study: &Study) -> Vec<String> {
+    let mut h: Vec<String> = ["index", "status", "period", "impacts_per_period"]
+        .map(String::from)
+        .to_vec();
+    h.extend((0..surface_columns(study)).map(|k| format!("impacts_per_period_{k}")));
+    h.extend(
+        [
+            "tle",
+            "tle_spread",
+            "q",
+            "kept_sections",
+            "cells",
+            "spec_hash",
+        ]
+        .map(String::from),
+    );
+    h
+}
 
-fn points_csv(records: &[PointRecord], hash: &str) -> Result<Vec<u8>, StudyError> {
+/// The number of per-surface impact columns: the surfaces of a system with two or more.
+pub(crate) fn surface_columns(study: &Study) -> usize {
+    let n = study.system().surfaces();
+    if n >= 2 { n } else { 0 }
+}
+
+/// The per-surface impacts of `r` for its `n` columns (NaN where the record has none).
+pub(crate) fn surface_values(r: &PointRecord, n: usize) -> impl Iterator<Item = String> + '_ {
+    (0..n).map(|k| fmt_f64(r.impacts_per_surface.get(k).copied().unwrap_or(f64::NAN)))
+}
+
+fn points_csv(study: &Study, records: &[PointRecord], hash: &str) -> Result<Vec<u8>, StudyError> {
     let mut w = csv::Writer::from_writer(Vec::new());
     let e = |e: csv::Error| StudyError::Io(e.to_string());
-    w.write_record(POINT_HEADER).map_err(e)?;
+    w.write_record(point_header(study)).map_err(e)?;
+    let n = surface_columns(study);
     for r in records {
-        let cells: Vec<String> = r.cells.iter().map(|(a, b)| format!("{a}:{b}")).collect();
-        w.write_record([
+        let cells: Vec<String> = r
+            .cells
+            .iter()
+            .map(|c| {
+                c.iter()
+                    .map(|k| k.to_string())
+                    .collect::<Vec<_>>()
+                    .join(":")
+            })
+            .collect();
+        let mut row = vec![
             r.index.to_string(),
             r.status.clone(),
             r.period.to_string(),
             fmt_f64(r.impacts_per_period),
+        ];
+        row.extend(surface_values(r, n));
+        row.extend([
             fmt_f64(r.tle),
             fmt_f64(r.tle_spread),
             fmt_f64(r.q),
             r.sections.len().to_string(),
             cells.join(" "),
             hash.to_string(),
-        ])
-        .map_err(e)?;
+        ]);
+        w.write_record(row).map_err(e)?;
     }
     w.into_inner().map_err(|e| StudyError::Io(e.to_string()))
 }
 
-pub(super) fn sections_csv(records: &[PointRecord]) -> Result<Vec<u8>, StudyError> {
+/// The kept section points, one row each: `index, k` and the state components by name
+/// (`x, v` for one degree of freedom).
+pub(super) fn sections_csv(study: &Study, records: &[PointRecord]) -> Result<Vec<u8>, StudyError> {
     let mut w = csv::Writer::from_writer(Vec::new());
     let e = |e: csv::Error| StudyError::Io(e.to_string());
-    w.write_record(["index", "k", "x", "v"]).map_err(e)?;
+    let mut header = vec!["index".to_string(), "k".to_string()];
+    header.extend(study.system().state_names());
+    w.write_record(&header).map_err(e)?;
     for r in records {
         for (k, s) in r.sections.iter().enumerate() {
-            w.write_record([
-                r.index.to_string(),
-                k.to_string(),
-                fmt_f64(s[0]),
-                fmt_f64(s[1]),
-            ])
-            .map_err(e)?;
+            let mut row = vec![r.index.to_string(), k.to_string()];
+            row.extend(s.iter().map(|&x| fmt_f64(x)));
+            w.write_record(row).map_err(e)?;
         }
     }
     w.into_inner().map_err(|e| StudyError::Io(e.to_string()))
@@ -306,8 +338,8 @@ pub fn write_shard(
     }
     fs::create_dir_all(dir).map_err(|e| io(dir, e))?;
     let stem = shard.stem();
-    let points = points_csv(records, study.hash())?;
-    let sections = sections_csv(records)?;
+    let points = points_csv(study, records, study.hash())?;
+    let sections = sections_csv(study, records)?;
     let points_file = format!("{stem}.csv");
     let sections_file = format!("{stem}.sections.csv");
     let manifest = ShardManifest {
@@ -350,6 +382,7 @@ fn parse_usize(path: &Path, row: usize, col: &str, s: &str) -> Result<usize, Stu
 
 /// Reads one shard's points after checking its hashes.
 fn read_shard(
+    study: &Study,
     dir: &Path,
     m: &ShardManifest,
     manifest_path: &Path,
@@ -374,8 +407,8 @@ fn read_shard(
             ));
         }
     }
-    let records = parse_points(&pp, &points, &m.spec_hash)?;
-    attach_sections(&sp, &sections, records)
+    let records = parse_points(study, &pp, &points, &m.spec_hash)?;
+    attach_sections(study, &sp, &sections, records)
 }
 
 /// The bytes of a file listed in the manifest `m` (at `manifest_path`).
@@ -398,36 +431,46 @@ fn read_listed(
 /// The points file `pp` (its bytes `points`): each point with its number of kept sections
 /// (its `sections` still empty), every row of the study with hash `spec_hash`.
 fn parse_points(
+    study: &Study,
     pp: &Path,
     points: &[u8],
     spec_hash: &str,
 ) -> Result<Vec<(PointRecord, usize)>, StudyError> {
     let mut rd = csv::Reader::from_reader(points);
     let header = rd.headers().map_err(|e| corrupt(pp, e))?.clone();
-    if header.iter().ne(POINT_HEADER.iter().copied()) {
+    if header
+        .iter()
+        .ne(point_header(study).iter().map(String::as_str))
+    {
         return Err(corrupt(pp, "unexpected header"));
     }
+    let n = surface_columns(study);
+    let dim = study.system().dimension();
     let mut records = Vec::new();
     for (row, rec) in rd.records().enumerate() {
         let rec = rec.map_err(|e| corrupt(pp, e))?;
         let f = |k: usize| rec.get(k).unwrap_or("");
-        if f(9) != spec_hash {
+        if f(9 + n) != spec_hash {
             return Err(corrupt(
                 pp,
-                format!("row {row}: spec hash {} differs", f(9)),
+                format!("row {row}: spec hash {} differs", f(9 + n)),
             ));
         }
-        let cells = parse_cells(pp, row, f(8))?;
-        let kept = parse_usize(pp, row, "kept_sections", f(7))?;
+        let cells = parse_cells(pp, row, f(8 + n), dim)?;
+        let kept = parse_usize(pp, row, "kept_sections", f(7 + n))?;
+        let impacts_per_surface = (0..n)
+            .map(|k| parse_f64(pp, row, &format!("impacts_per_period_{k}"), f(4 + k)))
+            .collect::<Result<Vec<f64>, StudyError>>()?;
         records.push((
             PointRecord {
                 index: parse_usize(pp, row, "index", f(0))?,
                 status: f(1).to_string(),
                 period: parse_usize(pp, row, "period", f(2))?,
                 impacts_per_period: parse_f64(pp, row, "impacts_per_period", f(3))?,
-                tle: parse_f64(pp, row, "tle", f(4))?,
-                tle_spread: parse_f64(pp, row, "tle_spread", f(5))?,
-                q: parse_f64(pp, row, "q", f(6))?,
+                impacts_per_surface,
+                tle: parse_f64(pp, row, "tle", f(4 + n))?,
+                tle_spread: parse_f64(pp, row, "tle_spread", f(5 + n))?,
+                q: parse_f64(pp, row, "q", f(6 + n))?,
                 sections: Vec::with_capacity(kept),
                 cells,
             },
@@ -437,15 +480,20 @@ fn parse_points(
     Ok(records)
 }
 
-/// The cells `a:b` (separated by white space) of row `row` of the points file `pp`.
-fn parse_cells(pp: &Path, row: usize, text: &str) -> Result<Vec<(i64, i64)>, StudyError> {
+/// The cells `a:b:…` (one integer per state component, `dim` of them; cells separated by
+/// white space) of row `row` of the points file `pp`.
+fn parse_cells(pp: &Path, row: usize, text: &str, dim: usize) -> Result<Vec<Vec<i64>>, StudyError> {
     let mut cells = Vec::new();
     for c in text.split_whitespace() {
         let bad = || corrupt(pp, format!("row {row}: cell {c:?}"));
-        let (a, b) = c.split_once(':').ok_or_else(bad)?;
-        let a: i64 = a.parse().map_err(|_| bad())?;
-        let b: i64 = b.parse().map_err(|_| bad())?;
-        cells.push((a, b));
+        let cell = c
+            .split(':')
+            .map(|k| k.parse::<i64>().map_err(|_| bad()))
+            .collect::<Result<Vec<i64>, StudyError>>()?;
+        if cell.len() != dim {
+            return Err(bad());
+        }
+        cells.push(cell);
     }
     Ok(cells)
 }
@@ -453,6 +501,7 @@ fn parse_cells(pp: &Path, row: usize, text: &str) -> Result<Vec<(i64, i64)>, Stu
 /// Appends the sections file `sp` (its bytes `sections`) to the points of `records`; each
 /// point must get exactly its number of kept sections.
 fn attach_sections(
+    study: &Study,
     sp: &Path,
     sections: &[u8],
     mut records: Vec<(PointRecord, usize)>,
@@ -461,7 +510,15 @@ fn attach_sections(
     for (k, (r, _)) in records.iter().enumerate() {
         pos.insert(r.index, k);
     }
+    let names = study.system().state_names();
     let mut rd = csv::Reader::from_reader(sections);
+    let header = rd.headers().map_err(|e| corrupt(sp, e))?.clone();
+    let expected = ["index", "k"]
+        .into_iter()
+        .chain(names.iter().map(String::as_str));
+    if header.iter().ne(expected) {
+        return Err(corrupt(sp, "unexpected header"));
+    }
     for (row, rec) in rd.records().enumerate() {
         let rec = rec.map_err(|e| corrupt(sp, e))?;
         let f = |k: usize| rec.get(k).unwrap_or("");
@@ -469,9 +526,12 @@ fn attach_sections(
         let k = *pos
             .get(&index)
             .ok_or_else(|| corrupt(sp, format!("row {row}: point {index} is not in the shard")))?;
-        let x = parse_f64(sp, row, "x", f(2))?;
-        let v = parse_f64(sp, row, "v", f(3))?;
-        records[k].0.sections.push([x, v]);
+        let point = names
+            .iter()
+            .enumerate()
+            .map(|(c, name)| parse_f64(sp, row, name, f(2 + c)))
+            .collect::<Result<Vec<f64>, StudyError>>()?;
+        records[k].0.sections.push(point);
     }
     let mut out = Vec::with_capacity(records.len());
     for (r, kept) in records {
@@ -510,7 +570,7 @@ pub fn read_shards(dir: &Path) -> Result<(Study, Vec<PointRecord>), StudyError> 
     let mut slots: Vec<Option<PointRecord>> = vec![None; total];
     for (i, (p, m)) in &by_index {
         let shard = Shard::new(*i, n)?;
-        place_shard(dir, p, m, shard, total, &mut slots)?;
+        place_shard(&study, dir, p, m, shard, total, &mut slots)?;
     }
     let mut out = Vec::with_capacity(total);
     for (i, s) in slots.into_iter().enumerate() {
@@ -641,6 +701,7 @@ fn index_shards(
 /// the manifest's counts against the spec's `total` and the points file against both:
 /// each message says which count is claimed and which was found.
 fn place_shard(
+    study: &Study,
     dir: &Path,
     p: &Path,
     m: &ShardManifest,
@@ -650,7 +711,7 @@ fn place_shard(
 ) -> Result<(), StudyError> {
     let expected: Vec<usize> = shard_indices(total, shard).collect();
     check_manifest_counts(p, m, shard, total, expected.len())?;
-    let recs = read_shard(dir, m, p)?;
+    let recs = read_shard(study, dir, m, p)?;
     check_points_file(p, m, &recs)?;
     for (r, &e) in recs.into_iter().zip(&expected) {
         if r.index != e {

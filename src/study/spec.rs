@@ -6,8 +6,12 @@ use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
 
+use std::sync::Arc;
+
 use super::StudyError;
-use super::model::{ModelKind, ParameterSet};
+use super::catalogue;
+use super::mechanical::{Description, ElementSpec, LoadSpec, SpecValue, SurfaceSpec};
+use super::system::{ParameterPoint, StudySystem, is_initial_name};
 
 /// The most grid points of one study (10⁸: a 10⁴ × 10⁴ plane).
 pub const MAX_POINTS: usize = 100_000_000;
@@ -39,8 +43,9 @@ pub const MAX_PERIODS: u64 = crate::sample::MAX_SECTIONS_PER_RUN - 1;
 /// record = 50                     # forcing periods recorded
 /// ```
 ///
-/// Optional tables: `[initial] state = [x, v]` (default: the model's rest state),
-/// `[integration] rtol, atol = [a_x, a_v], max_steps`, `[record] poincare, period_tol,
+/// Optional tables: `[initial] state = [x, v]` (the whole state: `[x1, …, xN, v1, …, vN]`
+/// for `N` degrees of freedom; default the model's rest state), `[integration] rtol, atol =
+/// [a_x, a_v] (one per state component), max_steps`, `[record] poincare, period_tol,
 /// max_period, lyapunov = { periods, d0 }, q = { lo, hi, step }`, `[attractors] scales,
 /// tol, cell, overlap` (see [`AttractorSpec`]). Unknown keys are errors, so a misspelt
 /// field is never silently ignored.
@@ -69,18 +74,55 @@ pub struct StudySpec {
     pub attractors: AttractorSpec,
 }
 
-/// The system: a model of the catalogue and its parameters.
+/// The system: a model of the catalogue and its parameters, or a mechanical system
+/// described here.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SystemSpec {
-    /// `"paper"` (the paper's cart; parameters as in
-    /// [`PaperParameters`](crate::systems::paper::PaperParameters) plus `omega` and
-    /// `amplitude_factor`, a factor on the unbalance `m0e`) or `"duffing_ueda"` (`k`, `b`,
-    /// `omega`, `amplitude_factor` on `b`).
+    /// A model of the catalogue:
+    /// - `"paper"`: the paper's cart; parameters as in
+    ///   [`PaperParameters`](crate::systems::paper::PaperParameters) plus `omega` (no
+    ///   default) and `amplitude_factor`, a factor on the unbalance `m0e`;
+    /// - `"duffing_ueda"`: [`DuffingUeda`](crate::systems::DuffingUeda), `k`, `b`, `omega`,
+    ///   `amplitude_factor` on `b`;
+    /// - `"two_dof_impact"`: [`TwoDofImpact`](crate::systems::TwoDofImpact), `m1`, `m2`,
+    ///   `k1`, `k2`, `c1`, `c2`, `force`, `gap`, `k_contact`, `b_contact`, `omega` (default
+    ///   0.7), `amplitude_factor` on `force`; state `(x1, x2, v1, v2)`, one surface;
+    /// - `"bouncing_ball"`: [`BouncingBallTable`](crate::systems::BouncingBallTable),
+    ///   `gamma = Aω²/g` (default 1.5), `e` (0.9), `omega` (2π), `g` (9.81),
+    ///   `amplitude_factor` on the table's amplitude; rigid impacts with chattering and
+    ///   sticking, starting 2 m/s above the table's velocity;
+    ///
+    /// or `"mechanical"`, the system of `masses`, `elements`, `loads` and `surfaces` (see
+    /// the [module docs](super#a-system-described-in-the-study-file)).
     pub model: String,
     /// Parameters that differ from the model's defaults.
     #[serde(default)]
     pub parameters: BTreeMap<String, f64>,
+    /// `mechanical`: the masses, one per degree of freedom.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub masses: Vec<SpecValue>,
+    /// `mechanical`: the elements (force laws on coordinates).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub elements: Vec<ElementSpec>,
+    /// `mechanical`: the harmonic loads.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub loads: Vec<LoadSpec>,
+    /// `mechanical`: the impact surfaces.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub surfaces: Vec<SurfaceSpec>,
+}
+
+impl SystemSpec {
+    /// The description of a mechanical system (empty for a model of the catalogue).
+    pub(crate) fn description(&self) -> Description<'_> {
+        Description {
+            masses: &self.masses,
+            elements: &self.elements,
+            loads: &self.loads,
+            surfaces: &self.surfaces,
+        }
+    }
 }
 
 /// The grid: axis `x`, optionally axis `y`; point `i = ix + nx·iy`.
@@ -129,9 +171,10 @@ impl Axis {
         }
     }
 
-    /// Whether the axis is an initial-condition component.
+    /// Whether the axis is an initial-condition component: `x0`, `v0` (one degree of
+    /// freedom) or `xK_0`, `vK_0` (degree of freedom `K ≥ 1` of several).
     pub fn is_initial_condition(&self) -> bool {
-        self.parameter == "x0" || self.parameter == "v0"
+        is_initial_name(&self.parameter)
     }
 }
 
@@ -139,10 +182,11 @@ impl Axis {
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct InitialSpec {
-    /// `[x, v]`; default the model's rest state (the paper: the static equilibrium against
-    /// the stop; Duffing–Ueda: the origin).
+    /// The state `[x, v]` (`[x1, …, xN, v1, …, vN]` for `N` degrees of freedom); default
+    /// the model's rest state (the paper: the static equilibrium against the stop;
+    /// Duffing–Ueda: the origin).
     #[serde(default)]
-    pub state: Option<[f64; 2]>,
+    pub state: Option<Vec<f64>>,
 }
 
 /// Integration settings (DOPRI5 with event location).
@@ -152,9 +196,10 @@ pub struct IntegrationSpec {
     /// Relative tolerance.
     #[serde(default = "default_rtol")]
     pub rtol: f64,
-    /// Absolute tolerances `[position, velocity]`; default the model's scale × `rtol`.
+    /// Absolute tolerances, one per state component (`[position, velocity]` for one degree
+    /// of freedom); default the model's scale × `rtol`.
     #[serde(default)]
-    pub atol: Option<[f64; 2]>,
+    pub atol: Option<Vec<f64>>,
     /// Step cap per run.
     #[serde(default = "default_max_steps")]
     pub max_steps: usize,
@@ -262,9 +307,10 @@ pub struct QSpec {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct AttractorSpec {
-    /// Scales `[x, v]` of the section coordinates; default the model's.
+    /// Scales of the section coordinates, one per state component (`[x, v]` for one
+    /// degree of freedom); default the model's.
     #[serde(default)]
-    pub scales: Option<[f64; 2]>,
+    pub scales: Option<Vec<f64>>,
     /// Periodic orbits coincide when their section points are within `tol` (scaled, max
     /// norm) of each other.
     #[serde(default = "default_attractor_tol")]
@@ -332,17 +378,25 @@ impl StudySpec {
     /// # Errors
     /// [`StudyError::InvalidSpec`].
     pub fn validate(&self) -> Result<(), StudyError> {
+        self.checked().map(|_| ())
+    }
+
+    /// Checks every field and returns the system.
+    fn checked(&self) -> Result<Arc<dyn StudySystem>, StudyError> {
         self.validate_name()?;
-        let kind = ModelKind::parse(&self.system.model)?;
-        self.validate_system(kind)?;
+        let system = catalogue::system(&self.system.model, &self.system.description())?;
+        let sys = &*system;
+        self.validate_system(sys)?;
         let axes = self.axes();
-        self.validate_grid(kind, &axes)?;
-        self.validate_initial()?;
-        self.validate_integration()?;
+        self.validate_grid(sys, &axes)?;
+        self.validate_fixed(sys, &axes)?;
+        self.validate_initial(sys)?;
+        self.validate_integration(sys)?;
         self.validate_periods()?;
         self.validate_record()?;
-        self.validate_attractors()?;
-        self.validate_axis_models(kind, &axes)
+        self.validate_attractors(sys)?;
+        self.validate_axis_models(sys, &axes)?;
+        Ok(system)
     }
 
     /// The number of grid points.
@@ -398,15 +452,15 @@ impl StudySpec {
     }
 
     /// The fixed parameters: known to the model and finite.
-    fn validate_system(&self, kind: ModelKind) -> Result<(), StudyError> {
+    fn validate_system(&self, system: &dyn StudySystem) -> Result<(), StudyError> {
         for (name, &v) in &self.system.parameters {
-            if !kind.parameter_names().contains(&name.as_str()) {
+            if !system.has_parameter(name) {
                 return Err(invalid(
                     format!("system.parameters.{name}"),
                     format!(
                         "unknown parameter of model {:?}; known: {}",
                         self.system.model,
-                        kind.parameter_names().join(", ")
+                        system.parameter_list()
                     ),
                 ));
             }
@@ -429,11 +483,15 @@ impl StudySpec {
         axes
     }
 
-    /// Each axis on its own, two distinct axes, the number of points, and the forcing
-    /// frequency given somewhere if the model needs one.
-    fn validate_grid(&self, kind: ModelKind, axes: &[(&str, &Axis)]) -> Result<(), StudyError> {
+    /// Each axis on its own, two distinct axes, the number of points, and every parameter
+    /// without a default (the paper's forcing frequency) given somewhere.
+    fn validate_grid(
+        &self,
+        system: &dyn StudySystem,
+        axes: &[(&str, &Axis)],
+    ) -> Result<(), StudyError> {
         for (field, a) in axes {
-            self.validate_axis(kind, field, a)?;
+            self.validate_axis(system, field, a)?;
         }
         if let Some(y) = &self.grid.y {
             if y.parameter == self.grid.x.parameter {
@@ -451,30 +509,52 @@ impl StudySpec {
                 format!("{total} points; at most {MAX_POINTS}"),
             ));
         }
-        if !axes.iter().any(|(_, a)| a.parameter == "omega")
-            && kind.requires_omega()
-            && !self.system.parameters.contains_key("omega")
-        {
-            return Err(invalid(
-                "system.parameters.omega",
-                "the forcing frequency must be given (here or as a grid axis)",
-            ));
+        for d in system.parameters() {
+            if d.default.is_none() && !self.is_given(&d.name, axes) {
+                return Err(invalid(
+                    format!("system.parameters.{}", d.name),
+                    format!(
+                        "{} has no default: it must be given (here or as a grid axis)",
+                        d.name
+                    ),
+                ));
+            }
         }
         Ok(())
     }
 
+    /// Whether parameter `name` is given in `system.parameters` or as an axis.
+    fn is_given(&self, name: &str, axes: &[(&str, &Axis)]) -> bool {
+        self.system.parameters.contains_key(name) || axes.iter().any(|(_, a)| a.parameter == name)
+    }
+
+    /// Whether parameter `name` has no default and is not a fixed parameter of the spec.
+    fn unset_required(&self, system: &dyn StudySystem, name: &str) -> bool {
+        !self.system.parameters.contains_key(name)
+            && system
+                .parameters()
+                .iter()
+                .any(|d| d.name == name && d.default.is_none())
+    }
+
     /// One axis: a known parameter, at least one point, finite and increasing ends.
-    fn validate_axis(&self, kind: ModelKind, field: &str, a: &Axis) -> Result<(), StudyError> {
-        let known =
-            a.is_initial_condition() || kind.parameter_names().contains(&a.parameter.as_str());
+    fn validate_axis(
+        &self,
+        system: &dyn StudySystem,
+        field: &str,
+        a: &Axis,
+    ) -> Result<(), StudyError> {
+        let initial = system.initial_names();
+        let known = initial.contains(&a.parameter) || system.has_parameter(&a.parameter);
         if !known {
             return Err(invalid(
                 format!("{field}.parameter"),
                 format!(
-                    "unknown parameter {:?} of model {:?}; known: {}, x0, v0",
+                    "unknown parameter {:?} of model {:?}; known: {}, {}",
                     a.parameter,
                     self.system.model,
-                    kind.parameter_names().join(", ")
+                    system.parameter_list(),
+                    initial.join(", ")
                 ),
             ));
         }
@@ -502,8 +582,9 @@ impl StudySpec {
         Ok(())
     }
 
-    fn validate_initial(&self) -> Result<(), StudyError> {
-        if let Some(s) = self.initial.state {
+    fn validate_initial(&self, system: &dyn StudySystem) -> Result<(), StudyError> {
+        if let Some(s) = &self.initial.state {
+            components("initial.state", s, system)?;
             for (k, v) in s.iter().enumerate() {
                 if !v.is_finite() {
                     return Err(invalid(format!("initial.state[{k}]"), "must be finite"));
@@ -513,11 +594,13 @@ impl StudySpec {
         Ok(())
     }
 
-    fn validate_integration(&self) -> Result<(), StudyError> {
+    fn validate_integration(&self, system: &dyn StudySystem) -> Result<(), StudyError> {
         positive_finite("integration.rtol", self.integration.rtol)?;
-        if let Some(a) = self.integration.atol {
-            positive_finite("integration.atol[0]", a[0])?;
-            positive_finite("integration.atol[1]", a[1])?;
+        if let Some(a) = &self.integration.atol {
+            components("integration.atol", a, system)?;
+            for (k, &v) in a.iter().enumerate() {
+                positive_finite(&format!("integration.atol[{k}]"), v)?;
+            }
         }
         if self.integration.max_steps == 0 {
             return Err(invalid("integration.max_steps", "must be >= 1"));
@@ -577,10 +660,12 @@ impl StudySpec {
         Ok(())
     }
 
-    fn validate_attractors(&self) -> Result<(), StudyError> {
-        if let Some(s) = self.attractors.scales {
-            positive_finite("attractors.scales[0]", s[0])?;
-            positive_finite("attractors.scales[1]", s[1])?;
+    fn validate_attractors(&self, system: &dyn StudySystem) -> Result<(), StudyError> {
+        if let Some(s) = &self.attractors.scales {
+            components("attractors.scales", s, system)?;
+            for (k, &v) in s.iter().enumerate() {
+                positive_finite(&format!("attractors.scales[{k}]"), v)?;
+            }
         }
         positive_finite("attractors.tol", self.attractors.tol)?;
         positive_finite("attractors.cell", self.attractors.cell)?;
@@ -593,15 +678,74 @@ impl StudySpec {
         Ok(())
     }
 
+    /// The values the spec fixes, at the base point (the fixed parameters, the defaults,
+    /// and the axis starts of parameters without a default), naming the field at fault.
+    fn validate_fixed(
+        &self,
+        system: &dyn StudySystem,
+        axes: &[(&str, &Axis)],
+    ) -> Result<(), StudyError> {
+        let mut p = system.point(&self.system.parameters)?;
+        let mut y0 = self.initial.state.clone();
+        for (_, b) in axes {
+            if self.unset_required(system, &b.parameter) {
+                apply_axis(system, &mut p, &mut y0, &b.parameter, b.start);
+            }
+        }
+        system.check_fixed(&p, &|name| axes.iter().any(|(_, a)| a.parameter == name))
+    }
+
+    /// The axes of parameters without a default take their start while the other axis is
+    /// checked: where that base point is invalid and another value of such an axis makes it
+    /// valid, its start is at fault, and the error names that axis.
+    fn blame_axis_start(
+        &self,
+        system: &dyn StudySystem,
+        axes: &[(&str, &Axis)],
+        set: &ParameterPoint,
+    ) -> Result<(), StudyError> {
+        let required: Vec<&(&str, &Axis)> = axes
+            .iter()
+            .filter(|(_, b)| self.unset_required(system, &b.parameter))
+            .collect();
+        let mut base = set.clone();
+        let mut y0 = self.initial.state.clone();
+        for (_, b) in &required {
+            apply_axis(system, &mut base, &mut y0, &b.parameter, b.start);
+        }
+        let Err(e) = system.check(&base) else {
+            return Ok(());
+        };
+        for (field, b) in required {
+            let frees = (1..b.points).any(|k| {
+                let mut p = base.clone();
+                apply_axis(system, &mut p, &mut y0, &b.parameter, b.value(k));
+                system.check(&p).is_ok()
+            });
+            if frees {
+                return Err(invalid(
+                    field.to_string(),
+                    format!(
+                        "value {v} ({} = {v}) gives an invalid model: {e}",
+                        b.parameter,
+                        v = b.start
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
     /// Every axis value must give a valid model, with the other axis at the base value
     /// (the fixed parameters or the model's default), so that an error names the axis
     /// at fault; a parameter without a default (the paper's `omega`) takes its axis start.
     fn validate_axis_models(
         &self,
-        kind: ModelKind,
+        system: &dyn StudySystem,
         axes: &[(&str, &Axis)],
     ) -> Result<(), StudyError> {
-        let set = ParameterSet::new(kind, &self.system.parameters);
+        let set = system.point(&self.system.parameters)?;
+        self.blame_axis_start(system, axes, &set)?;
         for (field, a) in axes {
             for k in 0..a.points {
                 let v = a.value(k);
@@ -616,18 +760,15 @@ impl StudySpec {
                     ));
                 }
                 let mut p = set.clone();
-                let mut y0 = self.initial.state;
+                let mut y0 = self.initial.state.clone();
                 for (_, b) in axes {
                     if b.parameter == a.parameter {
-                        apply_axis(&mut p, &mut y0, &b.parameter, v);
-                    } else if b.parameter == "omega"
-                        && kind.requires_omega()
-                        && !self.system.parameters.contains_key("omega")
-                    {
-                        apply_axis(&mut p, &mut y0, &b.parameter, b.start);
+                        apply_axis(system, &mut p, &mut y0, &b.parameter, v);
+                    } else if self.unset_required(system, &b.parameter) {
+                        apply_axis(system, &mut p, &mut y0, &b.parameter, b.start);
                     }
                 }
-                p.check().map_err(|e| {
+                system.check(&p).map_err(|e| {
                     invalid(
                         field.to_string(),
                         format!(
@@ -640,6 +781,23 @@ impl StudySpec {
         }
         Ok(())
     }
+}
+
+/// `values` (the field `field`) has one value per state component of `system`.
+fn components(field: &str, values: &[f64], system: &dyn StudySystem) -> Result<(), StudyError> {
+    let n = system.dimension();
+    if values.len() != n {
+        let names = system.state_names().join(", ");
+        return Err(invalid(
+            field,
+            format!(
+                "has {} values; model {:?} has {n} state components ({names})",
+                values.len(),
+                system.name()
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// `record.lyapunov`: enough periods for the spread's blocks, no more than one estimate takes.
@@ -696,24 +854,40 @@ pub(crate) fn fnv1a(bytes: &[u8]) -> u64 {
     h
 }
 
-/// Sets an axis value: a model parameter or an initial-condition component.
-pub(crate) fn apply_axis(p: &mut ParameterSet, y0: &mut Option<[f64; 2]>, name: &str, value: f64) {
-    match name {
-        "x0" | "v0" => {
-            let mut s = y0.unwrap_or([f64::NAN, f64::NAN]);
-            s[usize::from(name == "v0")] = value;
-            *y0 = Some(s);
+/// Sets an axis value: a model parameter or an initial-condition component (`y0` holds the
+/// given components, NaN for the others). Names are checked by the spec.
+pub(crate) fn apply_axis(
+    system: &dyn StudySystem,
+    p: &mut ParameterPoint,
+    y0: &mut Option<Vec<f64>>,
+    name: &str,
+    value: f64,
+) {
+    match system.initial_names().iter().position(|n| n == name) {
+        Some(k) => {
+            let s = y0.get_or_insert_with(|| vec![f64::NAN; system.dimension()]);
+            if let Some(c) = s.get_mut(k) {
+                *c = value;
+            }
         }
-        _ => p.set(name, value),
+        None => {
+            let _ = p.set(name, value);
+        }
     }
 }
 
-/// A validated study: the spec, its hash and its grid.
-#[derive(Debug, Clone, PartialEq)]
+/// A validated study: the spec, its hash, its system and its grid.
+#[derive(Debug, Clone)]
 pub struct Study {
     spec: StudySpec,
     hash: String,
-    kind: ModelKind,
+    system: Arc<dyn StudySystem>,
+}
+
+impl PartialEq for Study {
+    fn eq(&self, other: &Self) -> bool {
+        self.spec == other.spec && self.hash == other.hash
+    }
 }
 
 impl Study {
@@ -722,10 +896,9 @@ impl Study {
     /// # Errors
     /// As [`StudySpec::validate`].
     pub fn new(spec: StudySpec) -> Result<Self, StudyError> {
-        spec.validate()?;
+        let system = spec.checked()?;
         let hash = spec.hash()?;
-        let kind = ModelKind::parse(&spec.system.model)?;
-        Ok(Self { spec, hash, kind })
+        Ok(Self { spec, hash, system })
     }
 
     /// Reads a study from TOML text.
@@ -756,9 +929,17 @@ impl Study {
         &self.hash
     }
 
-    /// The model.
-    pub(crate) fn kind(&self) -> ModelKind {
-        self.kind
+    /// The system.
+    pub(crate) fn system(&self) -> &dyn StudySystem {
+        &*self.system
+    }
+
+    /// The scales of the state components: `attractors.scales`, or the system's.
+    pub(crate) fn scales(&self) -> Vec<f64> {
+        match &self.spec.attractors.scales {
+            Some(s) => s.to_vec(),
+            None => self.system.scales(),
+        }
     }
 
     /// The number of grid points.

@@ -1,0 +1,860 @@
+//! A mechanical system described in the study file (`[system] model = "mechanical"`):
+//! masses, elements (a force law on a degree of freedom or a relative coordinate), harmonic
+//! loads and impact surfaces, built at each grid point as a [`model::Mechanical`] system.
+//!
+//! ```toml
+//! [system]
+//! model = "mechanical"
+//! masses = [1.0, 0.05]                    # one per degree of freedom (1 to 4)
+//! parameters = { omega = 1.0, gap = 0.05 } # omega: the forcing frequency (required)
+//!
+//! [[system.elements]]                     # a law on q0: spring and damper
+//! law = "linear_spring"
+//! dof = 0
+//! k = 1.0
+//!
+//! [[system.elements]]                     # a Hertz stop on q1 − q0 at +gap
+//! law = "hertz"
+//! between = [1, 0]
+//! position = "gap"                        # a number, or the name of a parameter
+//! k = 1e4
+//!
+//! [[system.loads]]                        # amplitude·cos(ω t + phase) on q0
+//! dof = 0
+//! amplitude = 0.1
+//!
+//! [[system.surfaces]]                     # impacts are counted on each surface
+//! between = [1, 0]
+//! position = "gap"
+//! side = "upper"
+//! ```
+//!
+//! Every number may instead name a parameter (`"-name"` for its negative): `omega` and
+//! `amplitude_factor` (a factor on every load's amplitude, default 1) are always
+//! parameters; any other name becomes one, without a default (it must be given in
+//! `system.parameters` or as a grid axis). The laws
+//! and their parameters (with their defaults):
+//!
+//! | law | parameters |
+//! |---|---|
+//! | `linear_spring` | `k`, `x0 = 0` |
+//! | `viscous_damper` | `c` |
+//! | `cubic_spring` | `k1`, `k3` |
+//! | `hertz` | `position`, `k`, `n1 = 1.5`, `b = 0`, `n2 = 1.5`, `n3 = 1`; `side = "upper"` |
+//! | `dry_friction` | `t`, `eps` (the friction's `v/√(v²+ε²)` sign) |
+//!
+//! A surface is a stop `position` on its coordinate: `side = "upper"` (the default) for a
+//! contact where the coordinate reaches it from below, `"lower"` from above. Without
+//! `restitution` it only counts impacts (the contact force is an element, e.g. `hertz`);
+//! with `restitution = e` it is a rigid stop with Newton's impact law, run with chattering
+//! and sticking ([`run_with_sticking`](crate::drive::run_with_sticking)), which drives one
+//! rigid contact: such a surface must be the only one.
+//!
+//! [`model::Mechanical`]: crate::model::Mechanical
+
+use std::collections::BTreeMap;
+
+use serde::{Deserialize, Serialize};
+
+use super::StudyError;
+use super::scalar::{self, MAX_SURFACES};
+use super::system::{
+    ParameterDef, ParameterPoint, PointRun, RunSettings, StudySystem, is_initial_name,
+};
+use crate::event::{Gap, NewtonImpact};
+use crate::excite::Harmonic;
+use crate::force::{
+    ContactOnset, CubicSpring, DryFriction, HertzContact, LinearSpring, Side, ViscousDamper,
+};
+use crate::model::{Coordinate, Element, Elements, Load, Loads, Mechanical};
+use crate::{Dynamics, ForceLaw, ParameterError};
+
+/// The most degrees of freedom of a described system.
+pub const MAX_DESCRIBED_DOFS: usize = 4;
+
+/// A number of a described system, or the name of a parameter (`system.parameters` or a
+/// grid axis; `"-name"` for its negative).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum SpecValue {
+    /// A number.
+    Number(f64),
+    /// A parameter's name.
+    Parameter(String),
+}
+
+/// An element of a described system: a force law on a coordinate.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ElementSpec {
+    /// The law: `linear_spring`, `viscous_damper`, `cubic_spring`, `hertz`, `dry_friction`
+    /// (see the [table](super#a-system-described-in-the-study-file)).
+    pub law: String,
+    /// The degree of freedom `i` (from 0) the law acts on, or
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dof: Option<usize>,
+    /// the pair `[i, j]` of the relative coordinate `q_i − q_j`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub between: Option<[usize; 2]>,
+    /// `"upper"` or `"lower"`: the side of a `hertz` stop (default `"upper"`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub side: Option<String>,
+    /// The law's parameters by name.
+    #[serde(flatten)]
+    pub parameters: BTreeMap<String, SpecValue>,
+}
+
+/// A harmonic load `amplitude·amplitude_factor·cos(ω t + phase)` on a degree of freedom.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LoadSpec {
+    /// The degree of freedom (from 0).
+    pub dof: usize,
+    /// The amplitude.
+    pub amplitude: SpecValue,
+    /// The phase (rad; default 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub phase: Option<SpecValue>,
+}
+
+/// An impact surface: a stop at `position` on a coordinate.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SurfaceSpec {
+    /// The degree of freedom (from 0), or
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dof: Option<usize>,
+    /// the pair `[i, j]` of the relative coordinate `q_i − q_j`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub between: Option<[usize; 2]>,
+    /// The stop's position on the coordinate.
+    pub position: SpecValue,
+    /// `"upper"` (the coordinate reaches the stop from below; the default) or `"lower"`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub side: Option<String>,
+    /// Newton's restitution coefficient `e ∈ [0, 1]` of a rigid stop; none: the surface
+    /// counts the impacts of a compliant contact (an element).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub restitution: Option<SpecValue>,
+}
+
+/// The description of a mechanical system in a spec (the `system` table's fields).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Description<'a> {
+    pub masses: &'a [SpecValue],
+    pub elements: &'a [ElementSpec],
+    pub loads: &'a [LoadSpec],
+    pub surfaces: &'a [SurfaceSpec],
+}
+
+impl Description<'_> {
+    /// The first field given, for an error on a model of the catalogue.
+    pub fn first_field(&self) -> Option<&'static str> {
+        [
+            ("system.masses", self.masses.is_empty()),
+            ("system.elements", self.elements.is_empty()),
+            ("system.loads", self.loads.is_empty()),
+            ("system.surfaces", self.surfaces.is_empty()),
+        ]
+        .into_iter()
+        .find(|(_, empty)| !empty)
+        .map(|(f, _)| f)
+    }
+}
+
+/// A law's parameters: each name with its default (`None`: required).
+type LawParameters = &'static [(&'static str, Option<f64>)];
+
+/// The laws and their parameters.
+const LAWS: &[(&str, LawParameters)] = &[
+    ("linear_spring", &[("k", None), ("x0", Some(0.0))]),
+    ("viscous_damper", &[("c", None)]),
+    ("cubic_spring", &[("k1", None), ("k3", None)]),
+    (
+        "hertz",
+        &[
+            ("position", None),
+            ("k", None),
+            ("n1", Some(1.5)),
+            ("b", Some(0.0)),
+            ("n2", Some(1.5)),
+            ("n3", Some(1.0)),
+        ],
+    ),
+    ("dry_friction", &[("t", None), ("eps", None)]),
+];
+
+/// The law's parameter named `name` by its constructor, as the spec names it.
+fn spec_name(law: &str, name: &'static str) -> &'static str {
+    match (law, name) {
+        ("hertz", "x_i") => "position",
+        ("hertz", "k_i") => "k",
+        ("dry_friction", "T") => "t",
+        _ => name,
+    }
+}
+
+fn invalid(field: impl Into<String>, message: impl Into<String>) -> StudyError {
+    StudyError::InvalidSpec {
+        field: field.into(),
+        message: message.into(),
+    }
+}
+
+/// Whether `name` can name a parameter: a letter or `_`, then letters, digits, `_`.
+fn is_identifier(name: &str) -> bool {
+    let mut c = name.chars();
+    c.next()
+        .is_some_and(|f| f.is_ascii_alphabetic() || f == '_')
+        && c.all(|x| x.is_ascii_alphanumeric() || x == '_')
+}
+
+/// A built-in force law of a described system.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Law {
+    Linear(LinearSpring<f64>),
+    Damper(ViscousDamper<f64>),
+    Cubic(CubicSpring<f64>),
+    Hertz(HertzContact<f64>),
+    Friction(DryFriction<f64>),
+}
+
+macro_rules! each_law {
+    ($self:expr, $l:ident => $e:expr) => {
+        match $self {
+            Law::Linear($l) => $e,
+            Law::Damper($l) => $e,
+            Law::Cubic($l) => $e,
+            Law::Hertz($l) => $e,
+            Law::Friction($l) => $e,
+        }
+    };
+}
+
+impl ForceLaw<f64> for Law {
+    #[inline]
+    fn force(&self, x: f64, v: f64) -> f64 {
+        each_law!(self, l => l.force(x, v))
+    }
+    fn partials(&self, x: f64, v: f64) -> (f64, f64) {
+        each_law!(self, l => l.partials(x, v))
+    }
+    fn velocity_exponent(&self) -> Option<f64> {
+        each_law!(self, l => l.velocity_exponent())
+    }
+    fn contact_onset(&self) -> Option<ContactOnset<f64>> {
+        each_law!(self, l => l.contact_onset())
+    }
+}
+
+/// The elements of a described system.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct DescribedElements<const N: usize>(Vec<Element<f64, N, Law>>);
+
+impl<const N: usize> Elements<f64, N> for DescribedElements<N> {
+    #[inline]
+    fn add_forces(&self, q: &[f64], qd: &[f64], out: &mut nalgebra::SVector<f64, N>) {
+        for e in &self.0 {
+            e.add_forces(q, qd, out);
+        }
+    }
+    fn add_tangent(
+        &self,
+        q: &[f64],
+        qd: &[f64],
+        k: &mut nalgebra::SMatrix<f64, N, N>,
+        c: &mut nalgebra::SMatrix<f64, N, N>,
+    ) {
+        for e in &self.0 {
+            e.add_tangent(q, qd, k, c);
+        }
+    }
+}
+
+/// The loads of a described system.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct DescribedLoads<const N: usize>(Vec<Load<f64, N, Harmonic<f64>>>);
+
+impl<const N: usize> Loads<f64, N> for DescribedLoads<N> {
+    #[inline]
+    fn add_forces(&self, t: f64, out: &mut nalgebra::SVector<f64, N>) {
+        for l in &self.0 {
+            l.add_forces(t, out);
+        }
+    }
+    fn add_rates(&self, t: f64, out: &mut nalgebra::SVector<f64, N>) {
+        for l in &self.0 {
+            l.add_rates(t, out);
+        }
+    }
+    fn phase(&self, t: f64) -> Option<f64> {
+        self.0.iter().find_map(|l| l.phase(t))
+    }
+    fn time_scale(&self, t: f64) -> Option<f64> {
+        self.0
+            .iter()
+            .fold(None, |m, l| crate::model::shorter(m, l.time_scale(t)))
+    }
+}
+
+/// A model of `N` degrees of freedom built from a description.
+type Model<const N: usize> = Mechanical<f64, N, DescribedElements<N>, DescribedLoads<N>>;
+
+/// Why a described system could not be built at a point: the field, what is wrong, and the
+/// parameter the value came from (if it came from one).
+#[derive(Debug, Clone, PartialEq)]
+struct BuildError {
+    field: String,
+    message: String,
+    parameter: Option<String>,
+}
+
+impl std::fmt::Display for BuildError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "`{}` {}", self.field, self.message)
+    }
+}
+
+/// A system described in the study file (validated).
+#[derive(Debug, Clone)]
+pub(crate) struct Described {
+    masses: Vec<SpecValue>,
+    elements: Vec<ElementSpec>,
+    loads: Vec<LoadSpec>,
+    surfaces: Vec<SurfaceSpec>,
+    params: Vec<ParameterDef>,
+}
+
+impl Described {
+    /// Checks the description's structure (laws, coordinates, names), naming the field.
+    ///
+    /// # Errors
+    /// [`StudyError::InvalidSpec`] naming the first invalid field.
+    pub fn new(d: &Description<'_>) -> Result<Self, StudyError> {
+        let n = d.masses.len();
+        if n == 0 || n > MAX_DESCRIBED_DOFS {
+            return Err(invalid(
+                "system.masses",
+                format!(
+                    "a mechanical system needs 1 to {MAX_DESCRIBED_DOFS} masses (one per \
+                     degree of freedom); got {n}"
+                ),
+            ));
+        }
+        let mut names: Vec<String> = Vec::new();
+        let mut note = |field: String, v: &SpecValue| -> Result<(), StudyError> {
+            match v {
+                SpecValue::Number(x) if !x.is_finite() => {
+                    Err(invalid(field, format!("must be finite (got {x})")))
+                }
+                SpecValue::Number(_) => Ok(()),
+                SpecValue::Parameter(p) => {
+                    let p = p.strip_prefix('-').unwrap_or(p);
+                    if !is_identifier(p) || is_initial_name(p) {
+                        return Err(invalid(
+                            field,
+                            format!(
+                                "{p:?} is neither a number nor a parameter name (letters, \
+                                 digits, '_'; not an initial-condition name such as x0)"
+                            ),
+                        ));
+                    }
+                    if p != "omega" && p != "amplitude_factor" && !names.iter().any(|n| n == p) {
+                        names.push(p.to_string());
+                    }
+                    Ok(())
+                }
+            }
+        };
+        for (k, m) in d.masses.iter().enumerate() {
+            note(format!("system.masses[{k}]"), m)?;
+        }
+        for (i, e) in d.elements.iter().enumerate() {
+            let f = format!("system.elements[{i}]");
+            let Some((_, params)) = LAWS.iter().find(|(l, _)| *l == e.law) else {
+                let known: Vec<&str> = LAWS.iter().map(|(l, _)| *l).collect();
+                return Err(invalid(
+                    format!("{f}.law"),
+                    format!("unknown law {:?}; known: {}", e.law, known.join(", ")),
+                ));
+            };
+            check_coordinate(&f, e.dof, e.between, n)?;
+            check_side(&format!("{f}.side"), e.side.as_deref())?;
+            if e.side.is_some() && e.law != "hertz" {
+                return Err(invalid(
+                    format!("{f}.side"),
+                    format!("only a hertz stop has a side, not {:?}", e.law),
+                ));
+            }
+            for name in e.parameters.keys() {
+                if !params.iter().any(|(p, _)| p == name) {
+                    let known: Vec<&str> = params.iter().map(|(p, _)| *p).collect();
+                    return Err(invalid(
+                        format!("{f}.{name}"),
+                        format!(
+                            "unknown parameter of law {:?}; known: {}",
+                            e.law,
+                            known.join(", ")
+                        ),
+                    ));
+                }
+            }
+            for (p, default) in params.iter() {
+                match e.parameters.get(*p) {
+                    Some(v) => note(format!("{f}.{p}"), v)?,
+                    None if default.is_none() => {
+                        return Err(invalid(
+                            format!("{f}.{p}"),
+                            format!("is missing (law {:?})", e.law),
+                        ));
+                    }
+                    None => {}
+                }
+            }
+        }
+        for (i, l) in d.loads.iter().enumerate() {
+            let f = format!("system.loads[{i}]");
+            check_coordinate(&f, Some(l.dof), None, n)?;
+            note(format!("{f}.amplitude"), &l.amplitude)?;
+            if let Some(p) = &l.phase {
+                note(format!("{f}.phase"), p)?;
+            }
+        }
+        if d.surfaces.len() > MAX_SURFACES {
+            return Err(invalid(
+                "system.surfaces",
+                format!("{} surfaces; at most {MAX_SURFACES}", d.surfaces.len()),
+            ));
+        }
+        for (i, s) in d.surfaces.iter().enumerate() {
+            let f = format!("system.surfaces[{i}]");
+            check_coordinate(&f, s.dof, s.between, n)?;
+            check_side(&format!("{f}.side"), s.side.as_deref())?;
+            note(format!("{f}.position"), &s.position)?;
+            if let Some(e) = &s.restitution {
+                note(format!("{f}.restitution"), e)?;
+                if d.surfaces.len() > 1 {
+                    return Err(invalid(
+                        format!("{f}.restitution"),
+                        "a rigid stop must be the only surface (the drive runs one rigid \
+                         contact, with chattering and sticking)",
+                    ));
+                }
+            }
+        }
+        let mut params = vec![
+            ParameterDef::required("omega"),
+            ParameterDef::new("amplitude_factor", 1.0),
+        ];
+        params.extend(names.iter().map(|p| ParameterDef::required(p)));
+        Ok(Self {
+            masses: d.masses.to_vec(),
+            elements: d.elements.to_vec(),
+            loads: d.loads.to_vec(),
+            surfaces: d.surfaces.to_vec(),
+            params,
+        })
+    }
+
+    /// The model at `p` (`N` must be the number of masses).
+    fn model<const N: usize>(&self, p: &ParameterPoint) -> Result<Model<N>, BuildError> {
+        let mut masses = [0.0; N];
+        for (k, (m, v)) in masses.iter_mut().zip(&self.masses).enumerate() {
+            let field = format!("system.masses[{k}]");
+            *m = value(p, v);
+            if !(m.is_finite() && *m > 0.0) {
+                return Err(build_error(
+                    field,
+                    v,
+                    format!("must be finite and > 0 (got {m})"),
+                ));
+            }
+        }
+        let mut elements = Vec::with_capacity(self.elements.len());
+        for (i, e) in self.elements.iter().enumerate() {
+            let f = format!("system.elements[{i}]");
+            let c = coordinate::<N>(&f, e.dof, e.between)?;
+            elements.push(Element::new(c, self.law(p, &f, e)?));
+        }
+        let omega = p.get("omega");
+        let factor = p.get("amplitude_factor");
+        let mut loads = Vec::with_capacity(self.loads.len());
+        for (i, l) in self.loads.iter().enumerate() {
+            let f = format!("system.loads[{i}]");
+            let amplitude = value(p, &l.amplitude) * factor;
+            let phase = l.phase.as_ref().map_or(0.0, |v| value(p, v));
+            let h = Harmonic::new(amplitude, omega, std::f64::consts::FRAC_PI_2 + phase).map_err(
+                |e| {
+                    let (name, v) = match e.name {
+                        "omega" => ("omega", None),
+                        "phase" => ("phase", l.phase.as_ref()),
+                        _ => ("amplitude", Some(&l.amplitude)),
+                    };
+                    let message = format!("must be {} (got {})", e.requirement, e.value);
+                    match v {
+                        Some(v) => build_error(format!("{f}.{name}"), v, message),
+                        None => BuildError {
+                            field: "system.parameters.omega".into(),
+                            message,
+                            parameter: Some("omega".into()),
+                        },
+                    }
+                },
+            )?;
+            let load = Load::on_dof(l.dof, h).map_err(|e| BuildError {
+                field: format!("{f}.dof"),
+                message: e.to_string(),
+                parameter: None,
+            })?;
+            loads.push(load);
+        }
+        let model = Mechanical::with_masses(masses).map_err(|e| BuildError {
+            field: "system.masses".into(),
+            message: e.to_string(),
+            parameter: None,
+        })?;
+        Ok(model
+            .with_elements(DescribedElements(elements))
+            .with_loads(DescribedLoads(loads)))
+    }
+
+    /// The law of element `e` (field `f`) at `p`.
+    fn law(&self, p: &ParameterPoint, f: &str, e: &ElementSpec) -> Result<Law, BuildError> {
+        let get = |name: &str| -> f64 {
+            match e.parameters.get(name) {
+                Some(v) => value(p, v),
+                None => LAWS
+                    .iter()
+                    .find(|(l, _)| *l == e.law)
+                    .and_then(|(_, ps)| ps.iter().find(|(n, _)| *n == name))
+                    .and_then(|(_, d)| *d)
+                    .unwrap_or(f64::NAN),
+            }
+        };
+        let fail = |err: ParameterError| {
+            let name = spec_name(&e.law, err.name);
+            let message = format!("must be {} (got {})", err.requirement, err.value);
+            match e.parameters.get(name) {
+                Some(v) => build_error(format!("{f}.{name}"), v, message),
+                None => BuildError {
+                    field: format!("{f}.{name}"),
+                    message,
+                    parameter: None,
+                },
+            }
+        };
+        let law = match e.law.as_str() {
+            "linear_spring" => Law::Linear(
+                LinearSpring::new(get("k"))
+                    .and_then(|l| l.with_rest_position(get("x0")))
+                    .map_err(fail)?,
+            ),
+            "viscous_damper" => Law::Damper(ViscousDamper::new(get("c")).map_err(fail)?),
+            "cubic_spring" => Law::Cubic(CubicSpring::new(get("k1"), get("k3")).map_err(fail)?),
+            "hertz" => {
+                let side = match e.side.as_deref() {
+                    Some("lower") => Side::Lower,
+                    _ => Side::Upper,
+                };
+                Law::Hertz(
+                    HertzContact::new(get("position"), get("k"))
+                        .map(|h| h.with_side(side))
+                        .and_then(|h| h.with_stiffness_exponent(get("n1")))
+                        .and_then(|h| h.with_damping(get("b"), get("n2"), get("n3")))
+                        .map_err(fail)?,
+                )
+            }
+            "dry_friction" => Law::Friction(DryFriction::sqrt(get("t"), get("eps")).map_err(fail)?),
+            other => {
+                return Err(BuildError {
+                    field: format!("{f}.law"),
+                    message: format!("unknown law {other:?}"),
+                    parameter: None,
+                });
+            }
+        };
+        Ok(law)
+    }
+
+    /// The surfaces at `p`.
+    fn gaps<const N: usize>(&self, p: &ParameterPoint) -> Result<Vec<Gap<f64, N>>, BuildError> {
+        let mut gaps = Vec::with_capacity(self.surfaces.len());
+        for (i, s) in self.surfaces.iter().enumerate() {
+            let f = format!("system.surfaces[{i}]");
+            let c = coordinate::<N>(&f, s.dof, s.between)?;
+            let position = value(p, &s.position);
+            let c = c.with_offset(-position).map_err(|_| {
+                build_error(
+                    format!("{f}.position"),
+                    &s.position,
+                    format!("must be finite (got {position})"),
+                )
+            })?;
+            gaps.push(match s.side.as_deref() {
+                Some("lower") => Gap::above(c, ()),
+                _ => Gap::below(c, ()),
+            });
+        }
+        Ok(gaps)
+    }
+
+    /// The rigid stop at `p`, if the description has one.
+    fn rigid<const N: usize>(
+        &self,
+        p: &ParameterPoint,
+        model: &Model<N>,
+    ) -> Result<Option<NewtonImpact<f64, N>>, BuildError> {
+        let Some((i, e)) = self
+            .surfaces
+            .iter()
+            .enumerate()
+            .find_map(|(i, s)| s.restitution.as_ref().map(|e| (i, e)))
+        else {
+            return Ok(None);
+        };
+        let gap = self
+            .gaps::<N>(p)?
+            .into_iter()
+            .next()
+            .ok_or_else(|| BuildError {
+                field: "system.surfaces".into(),
+                message: "internal: no surface".into(),
+                parameter: None,
+            })?;
+        let r = value(p, e);
+        NewtonImpact::new(gap, r, model.mass_matrix())
+            .map(Some)
+            .map_err(|err| {
+                build_error(
+                    format!("system.surfaces[{i}].restitution"),
+                    e,
+                    format!("must be {} (got {})", err.requirement, err.value),
+                )
+            })
+    }
+
+    /// Builds everything at `p` (with `N` degrees of freedom).
+    fn check_n<const N: usize>(&self, p: &ParameterPoint) -> Result<(), BuildError> {
+        let model = self.model::<N>(p)?;
+        self.gaps::<N>(p)?;
+        self.rigid::<N>(p, &model)?;
+        let omega = p.get("omega");
+        if !(omega.is_finite() && omega > 0.0) {
+            return Err(BuildError {
+                field: "system.parameters.omega".into(),
+                message: format!("the forcing frequency must be finite and > 0 (got {omega})"),
+                parameter: Some("omega".into()),
+            });
+        }
+        Ok(())
+    }
+
+    fn build_check(&self, p: &ParameterPoint) -> Result<(), BuildError> {
+        match self.masses.len() {
+            1 => self.check_n::<1>(p),
+            2 => self.check_n::<2>(p),
+            3 => self.check_n::<3>(p),
+            4 => self.check_n::<4>(p),
+            n => Err(BuildError {
+                field: "system.masses".into(),
+                message: format!("{n} masses; at most {MAX_DESCRIBED_DOFS}"),
+                parameter: None,
+            }),
+        }
+    }
+
+    /// Runs `p` with `N` degrees of freedom (state `M = 2N`, `M2 = 2M`).
+    fn run_n<const N: usize, const M: usize, const M2: usize>(
+        &self,
+        p: &ParameterPoint,
+        y0: &[f64],
+        s: &RunSettings,
+    ) -> Result<PointRun, String>
+    where
+        Model<N>: Dynamics<f64, M>,
+    {
+        let e = |e: BuildError| e.to_string();
+        let model = self.model::<N>(p).map_err(e)?;
+        let period = std::f64::consts::TAU / p.get("omega");
+        match self.rigid::<N>(p, &model).map_err(e)? {
+            Some(impact) => scalar::run_rigid::<N, M, _, _, _>(s, model, impact, period, y0),
+            None => {
+                let gaps = self.gaps::<N>(p).map_err(e)?;
+                scalar::run_smooth::<M, M2, _, _>(s, model, gaps, period, y0)
+            }
+        }
+    }
+}
+
+/// The value of `v` at `p` (`"-name"`: the parameter's negative).
+fn value(p: &ParameterPoint, v: &SpecValue) -> f64 {
+    match v {
+        SpecValue::Number(x) => *x,
+        SpecValue::Parameter(name) => match name.strip_prefix('-') {
+            Some(name) => -p.get(name),
+            None => p.get(name),
+        },
+    }
+}
+
+/// A build error of the value `v` at `field`.
+fn build_error(field: String, v: &SpecValue, message: String) -> BuildError {
+    match v {
+        SpecValue::Number(_) => BuildError {
+            field,
+            message,
+            parameter: None,
+        },
+        SpecValue::Parameter(name) => BuildError {
+            field,
+            message: format!("{message}: parameter {name:?}"),
+            parameter: Some(name.strip_prefix('-').unwrap_or(name).to_string()),
+        },
+    }
+}
+
+/// Exactly one of `dof` and `between`, within the `n` degrees of freedom.
+fn check_coordinate(
+    f: &str,
+    dof: Option<usize>,
+    between: Option<[usize; 2]>,
+    n: usize,
+) -> Result<(), StudyError> {
+    match (dof, between) {
+        (Some(i), None) if i < n => Ok(()),
+        (Some(i), None) => Err(invalid(
+            format!("{f}.dof"),
+            format!("{i} is not a degree of freedom of {n} (0 to {})", n - 1),
+        )),
+        (None, Some([i, j])) if i < n && j < n && i != j => Ok(()),
+        (None, Some([i, j])) => Err(invalid(
+            format!("{f}.between"),
+            format!(
+                "[{i}, {j}] must be two different degrees of freedom of {n} (0 to {})",
+                n - 1
+            ),
+        )),
+        (Some(_), Some(_)) => Err(invalid(
+            format!("{f}.between"),
+            "give either dof or between, not both",
+        )),
+        (None, None) => Err(invalid(
+            format!("{f}.dof"),
+            "is missing: give dof = i or between = [i, j]",
+        )),
+    }
+}
+
+/// `None`, `"upper"` or `"lower"`.
+fn check_side(field: &str, side: Option<&str>) -> Result<(), StudyError> {
+    match side {
+        None | Some("upper") | Some("lower") => Ok(()),
+        Some(other) => Err(invalid(
+            field,
+            format!("{other:?}: expected \"upper\" or \"lower\""),
+        )),
+    }
+}
+
+/// The coordinate `dof` or `between` (checked by [`check_coordinate`]).
+fn coordinate<const N: usize>(
+    f: &str,
+    dof: Option<usize>,
+    between: Option<[usize; 2]>,
+) -> Result<Coordinate<f64, N>, BuildError> {
+    let c = match (dof, between) {
+        (Some(i), _) => Coordinate::dof(i),
+        (None, Some([i, j])) => Coordinate::relative(i, j),
+        (None, None) => Coordinate::dof(usize::MAX),
+    };
+    c.map_err(|e| BuildError {
+        field: format!("{f}.{}", if dof.is_some() { "dof" } else { "between" }),
+        message: e.to_string(),
+        parameter: None,
+    })
+}
+
+impl StudySystem for Described {
+    fn name(&self) -> &str {
+        "mechanical"
+    }
+    fn parameters(&self) -> &[ParameterDef] {
+        &self.params
+    }
+    fn dimension(&self) -> usize {
+        2 * self.masses.len()
+    }
+    fn surfaces(&self) -> usize {
+        self.surfaces.len()
+    }
+    fn scales(&self) -> Vec<f64> {
+        vec![1.0; self.dimension()]
+    }
+    fn atol_per_rtol(&self) -> Vec<f64> {
+        vec![1.0; self.dimension()]
+    }
+    fn d0(&self) -> f64 {
+        1e-6
+    }
+    fn check(&self, p: &ParameterPoint) -> Result<(), String> {
+        self.build_check(p).map_err(|e| e.to_string())
+    }
+    fn check_fixed(
+        &self,
+        p: &ParameterPoint,
+        on_axes: &dyn Fn(&str) -> bool,
+    ) -> Result<(), StudyError> {
+        match self.build_check(p) {
+            Ok(()) => Ok(()),
+            // A value from an axis parameter: the axis check names the axis.
+            Err(e) if e.parameter.as_deref().is_some_and(on_axes) => Ok(()),
+            Err(e) => Err(invalid(e.field, e.message)),
+        }
+    }
+    fn rest_state(&self, _p: &ParameterPoint) -> Result<Vec<f64>, String> {
+        Ok(vec![0.0; self.dimension()])
+    }
+    fn run(&self, p: &ParameterPoint, y0: &[f64], s: &RunSettings) -> Result<PointRun, String> {
+        match self.masses.len() {
+            1 => self.run_n::<1, 2, 4>(p, y0, s),
+            2 => self.run_n::<2, 4, 8>(p, y0, s),
+            3 => self.run_n::<3, 6, 12>(p, y0, s),
+            4 => self.run_n::<4, 8, 16>(p, y0, s),
+            n => Err(format!("{n} masses; at most {MAX_DESCRIBED_DOFS}")),
+        }
+    }
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_and_sides() {
+        assert!(is_identifier("gap") && is_identifier("_k2") && is_identifier("K"));
+        assert!(!is_identifier("") && !is_identifier("2k") && !is_identifier("a-b"));
+        assert_eq!(spec_name("hertz", "x_i"), "position");
+        assert_eq!(spec_name("linear_spring", "k"), "k");
+        assert!(check_side("f", Some("sideways")).is_err());
+        assert!(check_coordinate("f", Some(2), None, 2).is_err());
+        assert!(check_coordinate("f", None, Some([1, 1]), 2).is_err());
+        assert!(check_coordinate("f", None, None, 2).is_err());
+        assert!(check_coordinate("f", None, Some([1, 0]), 2).is_ok());
+    }
+
+    #[test]
+    fn the_law_enum_is_the_law() {
+        let h = HertzContact::new(0.1, 1e3)
+            .unwrap()
+            .with_damping(0.2, 1.5, 1.0)
+            .unwrap();
+        let l = Law::Hertz(h);
+        for (x, v) in [(0.05, 1.0), (0.15, -0.3), (0.2, 0.7)] {
+            assert_eq!(l.force(x, v).to_bits(), h.force(x, v).to_bits());
+            assert_eq!(l.partials(x, v), h.partials(x, v));
+        }
+        assert_eq!(l.contact_onset(), h.contact_onset());
+    }
+}
