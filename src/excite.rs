@@ -545,7 +545,7 @@ impl<T: Real> Excitation<T> for RampedRotor<T> {
 /// one per lane, each with its own parameters (see [`LaneLaw`](crate::force::LaneLaw) for
 /// packing; the same contract: each lane is the scalar [`force`](Excitation::force) of
 /// the excitation packed into it, to the bit with
-/// [`LaneMath::Exact`](crate::lanes::LaneMath::Exact)).
+/// [`LaneMath::Exact`]).
 ///
 /// Implemented by `()`, [`Constant`], [`Harmonic`], [`UnbalancedRotor`] (their `sin` is
 /// the lane form of the scalar `fastmath` kernel, [`lanes::math::sin`](crate::lanes::math::sin))

@@ -147,7 +147,7 @@ pub trait Observer<T: Real, const N: usize> {
     /// Default: `Ok`.
     ///
     /// # Errors
-    /// Whatever the observer finds wrong (typically [`EventError::IndexOutOfRange`]).
+    /// Whatever the observer finds wrong (typically [`EventError::IndexOutOfRange`](crate::event::EventError::IndexOutOfRange)).
     fn check(&self) -> Result<()> {
         Ok(())
     }
@@ -417,7 +417,7 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
     ///
     /// # Errors
     /// [`IntegrateError`] for invalid inputs (non-finite state, `t_end ≤ t0`) or failed
-    /// steps, [`EventError::Zeno`] for an accumulation of events.
+    /// steps, [`EventError::Zeno`](crate::event::EventError::Zeno) for an accumulation of events.
     pub fn run<O: Observer<T, N>>(
         &mut self,
         t0: T,
