@@ -21,16 +21,14 @@ use nalgebra::SVector;
 use nalgebra::Vector2;
 use nonsmooth::LaneDynamics;
 use nonsmooth::drive::Simulation;
-use nonsmooth::ensemble::{
-    Ensemble, F64x4, F64x8, F64x16, LaneMath, Lanes, Member, MemberRun, Simd,
-};
+use nonsmooth::ensemble::{Ensemble, F64x4, F64x8, F64x16, LaneMath, Lanes, MemberRun, Simd};
 use nonsmooth::event::{Direction, Event, EventSet, Stop};
 use nonsmooth::integrate::{Dopri5, Tolerances};
-use nonsmooth::systems::paper::PAPER;
+use nonsmooth::systems::paper::{Member, PAPER};
 use nonsmooth::systems::{DuffingUeda, TwoDofImpact};
 
 struct Setup {
-    jobs: Vec<MemberRun>,
+    jobs: Vec<MemberRun<Member>>,
     tol: Tolerances<f64, 2>,
     impact: Event<Stop<f64>>,
 }

@@ -51,7 +51,7 @@ impl<const M: usize> Observer<f64, M> for Events<M> {
 /// A trajectory's result, comparable bit for bit (errors by their message).
 type Run<const M: usize> = Result<(u64, [u64; M], String), String>;
 
-fn key<const M: usize>(r: &nonsmooth::Result<Outcome<f64, M>>) -> Run<M> {
+fn key<const M: usize, E: std::fmt::Display>(r: &Result<Outcome<f64, M>, E>) -> Run<M> {
     match r {
         Ok(o) => Ok((
             o.t.to_bits(),
@@ -181,12 +181,12 @@ fn run() -> nonsmooth::Result<bool> {
                 b: 5.0 + 7.0 * i as f64 / (n - 1) as f64,
                 ..DuffingUeda::default()
             };
-            MemberRun::<_, 2>::periods_of(
+            Ok(MemberRun::<_, 2>::periods_of(
                 p.model::<f64>()?,
                 SVector::from([1.0, 0.0]),
                 p.period(),
                 periods,
-            )
+            )?)
         })
         .collect::<nonsmooth::Result<Vec<_>>>()?;
     ok &= compare("duffing_ueda", &jobs, tol, ())?;
@@ -197,12 +197,12 @@ fn run() -> nonsmooth::Result<bool> {
     let jobs = (0..n)
         .map(|i| {
             let w = 0.3 + i as f64 / (n - 1) as f64;
-            MemberRun::<_, 4>::periods_of(
+            Ok(MemberRun::<_, 4>::periods_of(
                 p.model::<f64>(w)?,
                 SVector::zeros(),
                 TwoDofImpact::period(w),
                 periods,
-            )
+            )?)
         })
         .collect::<nonsmooth::Result<Vec<_>>>()?;
     let stop = Event::new(p.stop::<f64>()?, Direction::Rising);
@@ -222,12 +222,12 @@ fn run() -> nonsmooth::Result<bool> {
                 ..base
             };
             let v0 = ball.table_motion(0.0).1 + 2.0;
-            MemberRun::<_, 2>::periods_of(
+            Ok(MemberRun::<_, 2>::periods_of(
                 ball.model::<f64>()?,
                 SVector::from([0.0, v0]),
                 ball.period(),
                 periods,
-            )
+            )?)
         })
         .collect::<nonsmooth::Result<Vec<_>>>()?;
     let impact =
@@ -244,12 +244,12 @@ fn run() -> nonsmooth::Result<bool> {
                 (Softening { k: 1.0 }, ViscousDamper::new(0.1)?),
                 Harmonic::new(0.5, w, 0.0)?,
             )?;
-            MemberRun::periods_of(
+            Ok(MemberRun::periods_of(
                 LaneByLane(osc),
                 SVector::from([0.1, 0.0]),
                 std::f64::consts::TAU / w,
                 periods,
-            )
+            )?)
         })
         .collect::<nonsmooth::Result<Vec<_>>>()?;
     ok &= compare("user_law_fallback", &jobs, tol, ())?;

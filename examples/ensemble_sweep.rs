@@ -1,6 +1,6 @@
 //! W3 on the ensemble: the paper's sweep grid (ω ∈ [17.5, 25], step 0.005, 1501 values;
 //! 100 transient and 50 recorded periods; rtol 1e-8) with independent starts from rest, in
-//! lanes (`ensemble::sweep_independent_parallel`) against the scalar `sweep` with the same
+//! lanes (`sweep::sweep_independent_parallel`) against the scalar `sweep` with the same
 //! independent starts, and the paper's continuation sweep (both directions, transients
 //! 100/50) on the scalar path for reference. All on the default rayon pool.
 //!
@@ -12,11 +12,14 @@
 use std::time::Instant;
 
 use nalgebra::Vector2;
-use nonsmooth::ensemble::{Ensemble, F64x8, F64x16, IndependentSweep, Member, Simd};
+use nonsmooth::ensemble::{Ensemble, F64x8, F64x16, Simd};
 use nonsmooth::event::Stop;
 use nonsmooth::integrate::{Dopri5, Tolerances};
-use nonsmooth::sweep::{SweepConfig, SweepDirection, SweepSystem, sweep};
-use nonsmooth::systems::paper::{PAPER, PaperOscillator};
+use nonsmooth::sweep::{
+    IndependentSweep, LaneStart, SweepConfig, SweepDirection, SweepSystem, sweep,
+    sweep_independent_parallel,
+};
+use nonsmooth::systems::paper::{Member, PAPER, PaperOscillator};
 
 fn make(w: f64) -> nonsmooth::Result<SweepSystem<PaperOscillator<f64>>> {
     Ok(SweepSystem {
@@ -51,20 +54,20 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     );
 
     let start = Instant::now();
-    let members: Vec<Member> = values
+    let starts: Vec<LaneStart<Member, 2>> = values
         .iter()
-        .map(|&w| Member::paper(w))
+        .map(|&w| Member::paper(w).map(|m| m.start(y0)))
         .collect::<Result<_, _>>()?;
     let e = Ensemble::new(tol)?;
     // Sixteen lanes pay on AVX-512, eight on AVX2 (see the `ensemble` module docs).
     let wide = Simd::Auto.resolve() == Simd::Avx512;
     let sweep_lanes = if wide {
-        nonsmooth::ensemble::sweep_independent_parallel::<F64x16>
+        sweep_independent_parallel::<F64x16, Member, Stop, 2>
     } else {
-        nonsmooth::ensemble::sweep_independent_parallel::<F64x8>
+        sweep_independent_parallel::<F64x8, Member, Stop, 2>
     };
     let chunk = if wide { 32 } else { 16 };
-    let lanes = sweep_lanes(&e, &settings, &members, y0, stop(), chunk)?;
+    let lanes = sweep_lanes(&e, &settings, &starts, Some(stop()), chunk)?;
     let t_lanes = start.elapsed().as_secs_f64();
     println!(
         "independent starts, ensemble ({} lanes, exact): {t_lanes:7.2} s",

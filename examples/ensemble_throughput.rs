@@ -27,11 +27,11 @@ use std::time::Instant;
 use nalgebra::Vector2;
 use nonsmooth::drive::{Control, EventRecord, Observer, Simulation, StepView};
 use nonsmooth::ensemble::{
-    Ensemble, F64x2, F64x4, F64x8, F64x16, LaneMath, Lanes, Member, MemberRun, Simd,
+    Ensemble, F64x2, F64x4, F64x8, F64x16, LaneMath, Lanes, MemberRun, Simd,
 };
 use nonsmooth::event::{Direction, Event, Stop};
 use nonsmooth::integrate::{DenseOutput, Dopri5, Tolerances};
-use nonsmooth::systems::paper::PAPER;
+use nonsmooth::systems::paper::{Member, PAPER};
 
 /// Section points (steps land on them: a step ending on a grid time is a section) and
 /// the number of impacts.
@@ -87,12 +87,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         },
         Direction::Rising,
     );
-    let jobs: Vec<MemberRun> = (0..n)
+    let jobs: Vec<MemberRun<Member>> = (0..n)
         .map(|i| {
             let w = 17.5 + 7.5 * i as f64 / (n - 1) as f64;
             MemberRun::periods(Member::paper(w)?, y0, periods)
         })
-        .collect::<nonsmooth::Result<_>>()?;
+        .collect::<Result<_, nonsmooth::drive::RunError>>()?;
     let observers = || -> Vec<Collect> {
         jobs.iter()
             .map(|j| Collect {
@@ -129,7 +129,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     fn lanes<V: Lanes>(
         e: &Ensemble<Event<Stop<f64>>>,
-        jobs: &[MemberRun],
+        jobs: &[MemberRun<Member>],
         obs: &mut [Collect],
     ) -> nonsmooth::Result<()> {
         for r in e.run::<V, _, _>(jobs, obs)? {

@@ -1,7 +1,7 @@
 //! W4 on the ensemble: the top Lyapunov exponent over the paper's Fig. 5 grid (ω ∈ [17.5,
 //! 25], step 0.01, 751 values; 100 transient and 1000 recorded forcing periods, d0 =
 //! `PAPER_D0`, the paper's norm, rtol 1e-8), both trajectories of every pair in lanes
-//! (`ensemble::tle_independent_parallel`, independent starts from rest), on the default
+//! (`lyapunov::tle_independent_parallel`, independent starts from rest), on the default
 //! rayon pool. The scalar estimator from rest (`TwoTrajectory`) is timed on every
 //! `--every`-th value (default 25) for the ratio and compared value by value.
 //!
@@ -13,11 +13,13 @@
 use std::time::Instant;
 
 use nalgebra::Vector2;
-use nonsmooth::ensemble::{Ensemble, F64x8, F64x16, LaneMath, Member, Simd};
+use nonsmooth::ensemble::{Ensemble, F64x8, F64x16, LaneMath, Simd};
 use nonsmooth::integrate::{Dopri5, Tolerances};
-use nonsmooth::lyapunov::{DiagramSettings, IntervalRule, TwoTrajectory, pair_tolerances};
-use nonsmooth::systems::paper::PAPER;
+use nonsmooth::lyapunov::{
+    DiagramSettings, IntervalRule, TwoTrajectory, pair_tolerances, tle_independent_parallel,
+};
 use nonsmooth::systems::paper::lyapunov::{D0 as PAPER_D0, norm as paper_norm};
+use nonsmooth::systems::paper::{Member, PAPER};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
@@ -41,9 +43,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         Simd::Auto.resolve()
     );
 
-    let members: Vec<Member> = omegas
+    let members: Vec<(f64, Member)> = omegas
         .iter()
-        .map(|&w| Member::paper(w))
+        .map(|&w| Member::paper(w).map(|m| (w, m)))
         .collect::<Result<_, _>>()?;
     let start = Instant::now();
     // The lane pair is not the scalar pair to the bit anyway (each copy has its own step),
@@ -51,9 +53,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let e = Ensemble::new(tol)?.with_math(LaneMath::Vector);
     let wide = Simd::Auto.resolve() == Simd::Avx512;
     let tle = if wide {
-        nonsmooth::ensemble::tle_independent_parallel::<F64x16>
+        tle_independent_parallel::<F64x16, Member, 2>
     } else {
-        nonsmooth::ensemble::tle_independent_parallel::<F64x8>
+        tle_independent_parallel::<F64x8, Member, 2>
     };
     let lanes = tle(&e, &members, y0, PAPER_D0, paper_norm(), &settings, 64)?;
     let t_lanes = start.elapsed().as_secs_f64();

@@ -5,14 +5,12 @@
 
 use nalgebra::Vector2;
 use nonsmooth::drive::{Control, EventRecord, Observer, Simulation};
-use nonsmooth::ensemble::{
-    Ensemble, F64x2, F64x4, F64x8, F64x16, LaneMath, Lanes, Member, MemberRun,
-};
+use nonsmooth::ensemble::{Ensemble, F64x2, F64x4, F64x8, F64x16, LaneMath, Lanes, MemberRun};
 use nonsmooth::event::{Direction, Event, Level, Stop};
 use nonsmooth::integrate::{Dopri5, Stats, Tolerances};
 use nonsmooth::lanes::math;
 use nonsmooth::sample::Stroboscopic;
-use nonsmooth::systems::paper::{PAPER, PaperParameters};
+use nonsmooth::systems::paper::{Member, PAPER, PaperParameters};
 
 /// Section points and event times of one run.
 #[derive(Debug, Clone)]
@@ -72,7 +70,11 @@ fn rest() -> Vector2<f64> {
 }
 
 /// The scalar path: `Simulation` + `Dopri5`, steps landing on the sections.
-fn scalar(job: &MemberRun, tol: Tolerances<f64, 2>, event: bool) -> (Record, Stats, Vector2<f64>) {
+fn scalar(
+    job: &MemberRun<Member>,
+    tol: Tolerances<f64, 2>,
+    event: bool,
+) -> (Record, Stats, Vector2<f64>) {
     let mut rec = Record::new(job.member.period());
     let sim = Simulation::new(*job.member.scalar(), Dopri5::new(tol))
         .landing_grid(job.grid)
@@ -90,7 +92,7 @@ fn scalar(job: &MemberRun, tol: Tolerances<f64, 2>, event: bool) -> (Record, Sta
 
 /// The ensemble path in lanes of `V`.
 fn lanes<V: Lanes>(
-    jobs: &[MemberRun],
+    jobs: &[MemberRun<Member>],
     tol: Tolerances<f64, 2>,
     math: LaneMath,
 ) -> Vec<(Record, Stats, Vector2<f64>)> {
@@ -113,7 +115,7 @@ fn lanes<V: Lanes>(
         .collect()
 }
 
-fn paper_jobs(omegas: &[f64], periods: f64) -> Vec<MemberRun> {
+fn paper_jobs(omegas: &[f64], periods: f64) -> Vec<MemberRun<Member>> {
     omegas
         .iter()
         .map(|&w| MemberRun::periods(Member::paper(w).unwrap(), rest(), periods).unwrap())
@@ -147,7 +149,7 @@ fn lanes_reproduce_the_scalar_paper_model_to_the_bit() {
 #[test]
 fn tail_compaction_keeps_every_trajectory() {
     let omegas = [17.0, 18.0, 19.0, 20.465, 22.0, 25.0, 15.7];
-    let jobs: Vec<MemberRun> = omegas
+    let jobs: Vec<MemberRun<Member>> = omegas
         .iter()
         .enumerate()
         .map(|(k, &w)| {
@@ -277,7 +279,7 @@ impl Linear {
 fn smooth_reference_closed_form() {
     let omegas = [6.0, 9.0, 12.7, 15.0, 20.0, 31.0];
     let y0 = Vector2::new(1e-3, -2e-2);
-    let jobs: Vec<MemberRun> = omegas
+    let jobs: Vec<MemberRun<Member>> = omegas
         .iter()
         .map(|&w| MemberRun::periods(Member::new(Linear::params(), w).unwrap(), y0, 30.0).unwrap())
         .collect();
@@ -325,7 +327,7 @@ fn events_in_lanes_are_located_like_the_scalar_ones() {
     let tol = Tolerances::per_component(1e-9, [1e-13, 1e-11]).unwrap();
     let ev = Event::new(Level::new(0, level).unwrap(), Direction::Either);
     for math in [LaneMath::Exact, LaneMath::Vector] {
-        let jobs: Vec<MemberRun> = omegas
+        let jobs: Vec<MemberRun<Member>> = omegas
             .iter()
             .map(|&w| {
                 MemberRun::periods(Member::new(Linear::params(), w).unwrap(), y0, 20.0).unwrap()
@@ -403,7 +405,7 @@ fn results_do_not_depend_on_lanes_order_or_threads() {
         assert_eq!(summary(&lanes::<F64x8>(&jobs, tol, math)), base);
         assert_eq!(summary(&lanes::<F64x16>(&jobs, tol, math)), base);
         // Reversed batch: the same per trajectory.
-        let rev: Vec<MemberRun> = jobs.iter().rev().copied().collect();
+        let rev: Vec<MemberRun<Member>> = jobs.iter().rev().copied().collect();
         let mut r = summary(&lanes::<F64x4>(&rev, tol, math));
         r.reverse();
         assert_eq!(r, base);
@@ -645,7 +647,7 @@ fn within<T: Send + 'static>(secs: u64, f: impl FnOnce() -> T + Send + 'static) 
 
 /// The ensemble's results with `Record` observers: per trajectory its summary or the error
 /// message.
-fn run_records(jobs: Vec<MemberRun>) -> Vec<Result<Summary, String>> {
+fn run_records(jobs: Vec<MemberRun<Member>>) -> Vec<Result<Summary, String>> {
     within(120, move || {
         let mut recs: Vec<Record> = jobs
             .iter()

@@ -3,15 +3,14 @@
 //! same bits on every instruction set).
 
 use nalgebra::Vector2;
-use nonsmooth::ensemble::{
-    Ensemble, F64x2, F64x4, F64x8, IndependentSweep, LaneMath, Member, MemberRun, Simd,
-    sweep_independent,
-};
+use nonsmooth::ensemble::{Ensemble, F64x2, F64x4, F64x8, LaneMath, MemberRun, Simd};
 use nonsmooth::event::{Direction, Event, Stop};
 use nonsmooth::integrate::{Dopri5, Tolerances};
-use nonsmooth::sweep::{SweepPoint, SweepSystem, sweep};
+use nonsmooth::sweep::{
+    IndependentSweep, LaneStart, SweepPoint, SweepSystem, sweep, sweep_independent,
+};
 use nonsmooth::systems::paper::lyapunov::{D0 as PAPER_D0, norm as paper_norm};
-use nonsmooth::systems::paper::{PAPER, PaperOscillator};
+use nonsmooth::systems::paper::{Member, PAPER, PaperOscillator};
 
 fn tol() -> Tolerances<f64, 2> {
     Tolerances::per_component(1e-8, [1e-12, 1e-10]).unwrap()
@@ -51,6 +50,11 @@ fn members() -> Vec<Member> {
     OMEGAS.iter().map(|&w| Member::paper(w).unwrap()).collect()
 }
 
+/// The members as lane-sweep starts from `y0`.
+fn starts(members: &[Member], y0: Vector2<f64>) -> Vec<LaneStart<Member, 2>> {
+    members.iter().map(|m| m.start(y0)).collect()
+}
+
 #[test]
 fn independent_sweep_in_lanes_is_the_scalar_sweep_to_the_bit() {
     let settings = IndependentSweep::new(40, 20).unwrap();
@@ -58,27 +62,29 @@ fn independent_sweep_in_lanes_is_the_scalar_sweep_to_the_bit() {
     assert!(want.iter().any(|p| p.impacts > 0) && want.iter().any(|p| p.impacts == 0));
     let e = Ensemble::new(tol()).unwrap();
     let m = members();
-    let got4 = sweep_independent::<F64x4>(&e, &settings, &m, rest(), stop()).unwrap();
+    let got4 =
+        sweep_independent::<F64x4, _, _, 2>(&e, &settings, &starts(&m, rest()), Some(stop()))
+            .unwrap();
     assert_eq!(got4, want);
-    let got8 = sweep_independent::<F64x8>(&e, &settings, &m, rest(), stop()).unwrap();
+    let got8 =
+        sweep_independent::<F64x8, _, _, 2>(&e, &settings, &starts(&m, rest()), Some(stop()))
+            .unwrap();
     assert_eq!(got8, want);
-    let got2 = sweep_independent::<F64x2>(
+    let got2 = sweep_independent::<F64x2, _, _, 2>(
         &e.clone().with_simd(Simd::Baseline),
         &settings,
-        &m,
-        rest(),
-        stop(),
+        &starts(&m, rest()),
+        Some(stop()),
     )
     .unwrap();
     assert_eq!(got2, want);
     #[cfg(feature = "parallel")]
     {
-        let gotp = nonsmooth::ensemble::sweep_independent_parallel::<F64x4>(
+        let gotp = nonsmooth::sweep::sweep_independent_parallel::<F64x4, _, _, 2>(
             &e,
             &settings,
-            &m,
-            rest(),
-            stop(),
+            &starts(&m, rest()),
+            Some(stop()),
             3,
         )
         .unwrap();
@@ -91,7 +97,13 @@ fn independent_sweep_vector_math_agrees_in_regime_and_impacts() {
     let settings = IndependentSweep::new(40, 20).unwrap();
     let want = scalar(&settings);
     let e = Ensemble::new(tol()).unwrap().with_math(LaneMath::Vector);
-    let got = sweep_independent::<F64x4>(&e, &settings, &members(), rest(), stop()).unwrap();
+    let got = sweep_independent::<F64x4, _, _, 2>(
+        &e,
+        &settings,
+        &starts(&members(), rest()),
+        Some(stop()),
+    )
+    .unwrap();
     // Rounding differences grow on chaotic attractors and after only 40 transient periods
     // a slowly converging orbit may still look longer: most values agree in regime, and
     // where they do, in impacts per period.
@@ -116,7 +128,9 @@ fn independent_sweep_vector_math_agrees_in_regime_and_impacts() {
 fn independent_sweep_errors() {
     let e = Ensemble::new(tol()).unwrap();
     let s = IndependentSweep::new(10, 5).unwrap();
-    assert!(sweep_independent::<F64x4>(&e, &s, &[], rest(), stop()).is_err());
+    assert!(
+        sweep_independent::<F64x4, _, _, 2>(&e, &s, &starts(&[], rest()), Some(stop())).is_err()
+    );
     assert!(IndependentSweep::new(10, 0).is_err());
     assert!(s.period_detection(f64::NAN, 4).is_err());
     assert!(s.period_detection(1e-4, 0).is_err());
@@ -124,15 +138,21 @@ fn independent_sweep_errors() {
         position: 5,
         ..stop()
     };
-    assert!(sweep_independent::<F64x4>(&e, &s, &members()[..2], rest(), bad).is_err());
+    assert!(
+        sweep_independent::<F64x4, _, _, 2>(&e, &s, &starts(&members()[..2], rest()), Some(bad))
+            .is_err()
+    );
     let nan = Vector2::new(f64::NAN, 0.0);
-    assert!(sweep_independent::<F64x4>(&e, &s, &members()[..2], nan, stop()).is_err());
+    assert!(
+        sweep_independent::<F64x4, _, _, 2>(&e, &s, &starts(&members()[..2], nan), Some(stop()))
+            .is_err()
+    );
 }
 
 #[test]
 fn every_instruction_set_gives_the_same_bits() {
     let y0 = rest();
-    let jobs: Vec<MemberRun> = [17.6, 18.0, 19.0, 20.465, 21.3]
+    let jobs: Vec<MemberRun<Member>> = [17.6, 18.0, 19.0, 20.465, 21.3]
         .iter()
         .map(|&w| MemberRun::periods(Member::paper(w).unwrap(), y0, 30.0).unwrap())
         .collect();
@@ -194,17 +214,20 @@ fn scalar_tle(w: f64, transient: usize, intervals: usize) -> (f64, f64) {
 
 #[test]
 fn lane_tle_agrees_with_the_scalar_estimator_within_its_spread() {
-    use nonsmooth::ensemble::tle_independent;
+    use nonsmooth::lyapunov::tle_independent;
     use nonsmooth::lyapunov::{DiagramSettings, IntervalRule};
     let (transient, intervals) = (60, 300);
     let settings =
         DiagramSettings::new(IntervalRule::ForcingPeriod, transient, 0, intervals).unwrap();
     // Periodic (λ < 0) and chaotic (λ > 0) values.
     let omegas = [19.0, 20.2, 20.465];
-    let m: Vec<Member> = omegas.iter().map(|&w| Member::paper(w).unwrap()).collect();
+    let m: Vec<(f64, Member)> = omegas
+        .iter()
+        .map(|&w| (w, Member::paper(w).unwrap()))
+        .collect();
     let e = Ensemble::new(tol()).unwrap();
     let lanes =
-        tle_independent::<F64x4>(&e, &m, rest(), PAPER_D0, paper_norm(), &settings).unwrap();
+        tle_independent::<F64x4, _, 2>(&e, &m, rest(), PAPER_D0, paper_norm(), &settings).unwrap();
     for (p, &w) in lanes.iter().zip(&omegas) {
         let (l, se) = scalar_tle(w, transient, intervals);
         assert_eq!(p.parameter, w);
@@ -228,11 +251,11 @@ fn lane_tle_agrees_with_the_scalar_estimator_within_its_spread() {
     }
     // The same bits on any lane count and thread count.
     let lanes8 =
-        tle_independent::<F64x8>(&e, &m, rest(), PAPER_D0, paper_norm(), &settings).unwrap();
+        tle_independent::<F64x8, _, 2>(&e, &m, rest(), PAPER_D0, paper_norm(), &settings).unwrap();
     assert_eq!(lanes8, lanes);
     #[cfg(feature = "parallel")]
     {
-        let par = nonsmooth::ensemble::tle_independent_parallel::<F64x2>(
+        let par = nonsmooth::lyapunov::tle_independent_parallel::<F64x2, _, 2>(
             &e,
             &m,
             rest(),
@@ -245,6 +268,9 @@ fn lane_tle_agrees_with_the_scalar_estimator_within_its_spread() {
         assert_eq!(par, lanes);
     }
     // Bad input.
-    assert!(tle_independent::<F64x4>(&e, &[], rest(), PAPER_D0, paper_norm(), &settings).is_err());
-    assert!(tle_independent::<F64x4>(&e, &m, rest(), 0.0, paper_norm(), &settings).is_err());
+    assert!(
+        tle_independent::<F64x4, Member, 2>(&e, &[], rest(), PAPER_D0, paper_norm(), &settings)
+            .is_err()
+    );
+    assert!(tle_independent::<F64x4, _, 2>(&e, &m, rest(), 0.0, paper_norm(), &settings).is_err());
 }

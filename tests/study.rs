@@ -88,6 +88,73 @@ record = 10
 q = { lo = 0.05, hi = 0.3, step = 0.001 }
 "#;
 
+/// Duffing–Ueda's initial-condition plane (no impact surface), with the exponent.
+const DUFFING: &str = r#"
+name = "duffing"
+[system]
+model = "duffing_ueda"
+[grid]
+x = { parameter = "x0", start = -3.0, end = 3.0, points = 4 }
+y = { parameter = "v0", start = -3.0, end = 3.0, points = 3 }
+[periods]
+transient = 30
+record = 10
+[record]
+lyapunov = { periods = 10 }
+"#;
+
+/// The 2-DOF impact oscillator with its stop moving along the grid (lanes are grouped by
+/// the surface), impacts on it counted, the exponent recorded.
+const TWO_DOF_GAPS: &str = r#"
+name = "two_dof_gaps"
+[system]
+model = "two_dof_impact"
+[grid]
+x = { parameter = "gap", start = 0.02, end = 0.2, points = 3 }
+y = { parameter = "omega", start = 0.5, end = 0.9, points = 3 }
+[periods]
+transient = 40
+record = 10
+[record]
+lyapunov = { periods = 10 }
+q = { lo = 0.5, hi = 20.0, step = 0.01 }
+"#;
+
+#[test]
+fn lanes_of_any_system_give_the_scalar_records_to_the_bit() {
+    // Duffing–Ueda and the 2-DOF impact oscillator run in lanes like the paper's model
+    // (`StudySystem::run_batch`); `compute_point` is their scalar path.
+    let capped = TWO_DOF_GAPS.replace(
+        "name = \"two_dof_gaps\"",
+        "name = \"capped\"\n[integration]\nmax_steps = 2500",
+    );
+    for text in [DUFFING, TWO_DOF_GAPS, capped.as_str()] {
+        let study = Study::from_toml(text).unwrap();
+        let lanes = run_shard(&study, Shard::WHOLE, || {});
+        assert_eq!(lanes.len(), study.points());
+        let mut failed = 0;
+        let mut impacts = 0.0;
+        for (i, got) in lanes.iter().enumerate() {
+            let want = compute_point(&study, i);
+            assert_eq!(
+                format!("{got:?}"),
+                format!("{want:?}"),
+                "point {i} of\n{text}"
+            );
+            failed += usize::from(!got.is_ok());
+            impacts += got.impacts_per_period.max(0.0);
+        }
+        if text == capped {
+            assert!(failed > 0, "the step cap must fail some points");
+        } else {
+            assert_eq!(failed, 0, "{text}");
+        }
+        if text == TWO_DOF_GAPS {
+            assert!(impacts > 0.0, "the stop must be hit somewhere on the grid");
+        }
+    }
+}
+
 #[test]
 fn lanes_give_the_scalar_records_to_the_bit() {
     // `run_shard` runs the paper model's points in SIMD lanes; `compute_point` is the

@@ -3,25 +3,27 @@
 use nalgebra::SVector;
 
 use super::kernel::{LaneState, StepConsts, StepOut, row};
-use super::model::Member;
 use crate::LaneDynamics;
-use crate::drive::{Observer, Outcome, Termination};
+use crate::drive::{Observer, Outcome, RunError, Termination};
 use crate::drive::{Scan, Sides, check_work, step_limit, time_scale};
-use crate::error::Result;
 use crate::event::{Event, EventFunction, EventHistory, EventSet, MAX_EVENTS, ZenoGuard};
 use crate::integrate::{DenseOutput, IntegrateError, Stats, StepOptions, Tolerances};
 use crate::lanes::{LaneMath, Lanes, Simd, TRUE};
 use crate::validate::ParameterError;
 
-/// One trajectory of an ensemble: its model (any [`LaneDynamics`] of state size `M`; the
-/// paper's [`Member`] by default), its start and end, and an optional landing grid
+/// `Result` with the driver's [`RunError`]: the ensemble's runs fail as the scalar
+/// [`Simulation`](crate::drive::Simulation)'s do.
+type Result<T, E = RunError> = std::result::Result<T, E>;
+
+/// One trajectory of an ensemble: its model (any [`LaneDynamics`] of state size `M`),
+/// its start and end, and an optional landing grid
 /// `origin + i·dt` that every step lands on (the sweeps' sections at `t = i·2π/ω`).
 ///
 /// The constructors validate; values set through the public fields are validated when a
 /// run starts ([`check`](Self::check)), and an invalid trajectory is an error in its own
 /// result slot of [`Ensemble::run`].
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct MemberRun<D = Member, const M: usize = 2> {
+pub struct MemberRun<D, const M: usize = 2> {
     /// The model.
     pub member: D,
     /// Start time.
@@ -95,18 +97,6 @@ impl<D, const M: usize> MemberRun<D, M> {
         crate::validate::positive("dt", dt)?;
         self.grid = Some((origin, dt));
         Ok(self)
-    }
-}
-
-impl MemberRun {
-    /// `periods` forcing periods `2π/ω` of the paper's member from `(0, y0)`, every step
-    /// landing on `t = i·2π/ω` (the sweeps' setting).
-    ///
-    /// # Errors
-    /// As [`new`](Self::new); [`ParameterError`] unless `periods` is finite and > 0.
-    pub fn periods(member: Member, y0: SVector<f64, 2>, periods: f64) -> Result<Self> {
-        let tau = member.period();
-        Self::periods_of(member, y0, tau, periods)
     }
 }
 
@@ -762,7 +752,7 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
         .scan_step(sides, &mut observers[j]);
         let (t, y) = restart.unwrap_or((dense.t1, dense.y1));
         match res {
-            Err(e) => self.finish(i, Err(e.into()), observers, out),
+            Err(e) => self.finish(i, Err(e), observers, out),
             Ok(Some(termination)) => self.finish(i, Ok((t, y, termination)), observers, out),
             Ok(None) => {
                 if restart.is_some() {

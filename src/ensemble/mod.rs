@@ -14,7 +14,8 @@
 //!   excitations with lane forms — every built-in one
 //!   ([`LaneLaw`](crate::force::LaneLaw), [`LaneExcitation`](crate::excite::LaneExcitation)),
 //!   tuples and arrays of them, any coordinates, mass matrix, `K` and `C`;
-//! * the paper's oscillator family as a [`Member`] (the same lane form);
+//! * the paper's oscillator family as a [`Member`](crate::systems::paper::Member) (the
+//!   same lane form);
 //! * any other [`Dynamics`](crate::Dynamics), a law of one's own included, through
 //!   [`LaneByLane`](crate::LaneByLane): the right-hand side is then evaluated lane by lane
 //!   (correct, and slower by the share of the right-hand side in a step), everything else
@@ -88,13 +89,18 @@
 //! With few trajectories per thread, wide types leave lanes idle at the end of the queue.
 //!
 //! # Where ensembles are used
-//! * [`sweep_independent`] (and [`sweep_independent_parallel`]): a bifurcation sweep with
-//!   independent starts, one parameter value per lane, returning the records of
-//!   [`sweep`](crate::sweep::sweep) — to the bit with [`LaneMath::Exact`].
-//! * [`sweep_starts`]: independent starts, each from its own initial state, with a result
-//!   per start — the points of a basin picture or a parameter plane; the study tool
-//!   (`study`, feature `cli`) runs the paper model's points through it.
-//! * [`tle_independent`] (and [`tle_independent_parallel`]): the two-trajectory top
+//! The instruments built on the ensemble live with their scalar forms, for any model with a
+//! lane form:
+//! * [`sweep::sweep_independent`](crate::sweep::sweep_independent) (and
+//!   [`sweep_independent_parallel`](crate::sweep::sweep_independent_parallel)): a
+//!   bifurcation sweep with independent starts, one parameter value per lane, returning
+//!   the records of [`sweep`](crate::sweep::sweep) — to the bit with [`LaneMath::Exact`].
+//! * [`sweep::sweep_starts`](crate::sweep::sweep_starts): independent starts, each from
+//!   its own initial state, with a result per start — the points of a basin picture or a
+//!   parameter plane; the study tool (`study`, feature `cli`) runs the points of every
+//!   system with a lane form in an ensemble.
+//! * [`lyapunov::tle_independent`](crate::lyapunov::tle_independent) (and
+//!   [`tle_independent_parallel`](crate::lyapunov::tle_independent_parallel)): the two-trajectory top
 //!   exponent of many parameter values from the same start, both copies of every pair in
 //!   lanes, renormalized every interval as
 //!   [`TwoTrajectory`](crate::lyapunov::TwoTrajectory) does; each copy has its own step,
@@ -102,7 +108,8 @@
 //!   the bit (see its docs).
 //! * The entropy index of the inter-impact intervals is computed from the records of a
 //!   sweep ([`SweepPoint::intervals`](crate::sweep::SweepPoint::intervals)): an entropy
-//!   scan over ω is [`sweep_independent`] followed by the histogram and index of
+//!   scan over ω is [`sweep_independent`](crate::sweep::sweep_independent) followed by the
+//!   histogram and index of
 //!   [`entropy`](crate::entropy) per value.
 //!
 //! A continuation sweep (and the continuation TLE diagram) starts each value from the end
@@ -113,15 +120,15 @@
 //! ```
 //! use nalgebra::Vector2;
 //! use nonsmooth::drive::Simulation;
-//! use nonsmooth::ensemble::{Ensemble, F64x4, Member, MemberRun};
+//! use nonsmooth::ensemble::{Ensemble, F64x4, MemberRun};
 //! use nonsmooth::integrate::{Dopri5, Tolerances};
-//! use nonsmooth::systems::paper::PAPER;
+//! use nonsmooth::systems::paper::{Member, PAPER};
 //!
 //! let tol = Tolerances::per_component(1e-8, [1e-12, 1e-10])?;
 //! let y0 = Vector2::new(PAPER.static_equilibrium()?, 0.0);
 //! // Eight forcing frequencies, 5 periods each, in lanes of four.
-//! let jobs: Vec<MemberRun> = (0..8)
-//!     .map(|i| MemberRun::periods(Member::paper(17.5 + i as f64)?, y0, 5.0))
+//! let jobs: Vec<MemberRun<Member>> = (0..8)
+//!     .map(|i| Ok(MemberRun::periods(Member::paper(17.5 + i as f64)?, y0, 5.0)?))
 //!     .collect::<nonsmooth::Result<_>>()?;
 //! let mut observers = vec![(); jobs.len()];
 //! let out = Ensemble::new(tol)?.run::<F64x4, _, _>(&jobs, &mut observers)?;
@@ -136,16 +143,6 @@
 
 mod engine;
 mod kernel;
-mod lyapunov;
-mod model;
-mod sweep;
 
 pub use crate::lanes::{F64x2, F64x4, F64x8, F64x16, LaneMath, Lanes, Simd};
 pub use engine::{Ensemble, LaneDense, MemberRun};
-pub use lyapunov::tle_independent;
-#[cfg(feature = "parallel")]
-pub use lyapunov::tle_independent_parallel;
-pub use model::Member;
-#[cfg(feature = "parallel")]
-pub use sweep::sweep_independent_parallel;
-pub use sweep::{IndependentSweep, sweep_independent, sweep_starts};

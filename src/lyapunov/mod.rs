@@ -99,6 +99,7 @@
 
 mod diagram;
 pub mod hybrid;
+mod lanes;
 mod tangent;
 mod two_trajectory;
 
@@ -106,6 +107,9 @@ pub use diagram::{
     Diagram, DiagramDirection, DiagramPoint, DiagramSettings, IntervalRule, tle_diagram,
 };
 pub use hybrid::{HybridTangentSpace, HybridTwoTrajectory, Saltation};
+pub use lanes::tle_independent;
+#[cfg(feature = "parallel")]
+pub use lanes::tle_independent_parallel;
 pub use tangent::{Spectrum, TangentSpace, Variational, tangent_tolerances};
 pub use two_trajectory::{
     PerturbedPair, SeparationPoint, TwoTrajectory, decades, pair_tolerances, separation_study,

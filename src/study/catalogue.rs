@@ -5,21 +5,24 @@
 //! parameters and [`scalar::run_smooth`] or [`scalar::run_rigid`]) and a line in
 //! [`CATALOGUE`].
 
+use std::collections::BTreeMap;
 use std::sync::Arc;
 
 use nalgebra::Vector2;
 
 use super::StudyError;
 use super::mechanical::{Described, Description};
-use super::scalar;
-use super::system::{ParameterDef, ParameterPoint, PointRun, RunSettings, StudySystem};
-use crate::ensemble::IndependentSweep;
+use super::system::{ParameterDef, ParameterPoint, PointRun, PointStart, RunSettings, StudySystem};
+use super::{lanes, scalar};
+use crate::ensemble::{Ensemble, F64x8, F64x16, Simd};
 use crate::event::Stop;
 use crate::integrate::{Dopri5, Tolerances};
 use crate::lyapunov::{Norm, TwoTrajectory};
 use crate::sample::Regime;
-use crate::sweep::{SweepPoint, SweepSystem, run_point};
-use crate::systems::paper::{PAPER, PaperParameters};
+use crate::sweep::{
+    IndependentSweep, LaneStart, SweepError, SweepPoint, SweepSystem, run_point, sweep_starts,
+};
+use crate::systems::paper::{Member, PAPER, PaperParameters};
 use crate::systems::{BouncingBallTable, DuffingUeda, TwoDofImpact};
 use crate::{Dynamics, ParameterError};
 
@@ -219,6 +222,72 @@ impl Paper {
     }
 }
 
+impl Paper {
+    /// The points in SIMD lanes ([`sweep_starts`] over [`Member`]s, grouped by the impact
+    /// surface `x_I`): the results of [`run`](StudySystem::run), to the bit, with the same
+    /// messages for what fails.
+    fn batch(points: &[PointStart], s: &RunSettings) -> Vec<Result<PointRun, String>> {
+        let (tol, settings) = match Self::integration(s) {
+            Ok(v) => v,
+            Err(m) => return vec![Err(m); points.len()],
+        };
+        let mut out: Vec<Option<Result<PointRun, String>>> = vec![None; points.len()];
+        // One impact surface per ensemble: points are grouped by x_I (a grid axis may move
+        // it). The record's parameter is 0, as in the scalar run.
+        let mut groups: BTreeMap<u64, Vec<(usize, LaneStart<Member, 2>)>> = BTreeMap::new();
+        for (k, p) in points.iter().enumerate() {
+            let start = p.as_ref().map_err(Clone::clone).and_then(|(p, y0)| {
+                let (q, omega) = Self::at(p);
+                let y0 = match y0[..] {
+                    [x, v] => Vector2::new(x, v),
+                    _ => return Err("internal: the paper's state has two components".into()),
+                };
+                let m = Member::new(q, omega).map_err(|e| crate::Error::from(e).to_string())?;
+                Ok((q.x_i, m.start(y0)))
+            });
+            match start {
+                Err(m) => out[k] = Some(Err(m)),
+                Ok((x_i, st)) => groups
+                    .entry(x_i.to_bits())
+                    .or_default()
+                    .push((k, LaneStart { param: 0.0, ..st })),
+            }
+        }
+        // Sixteen lanes pay on AVX-512, eight on AVX2 (the `ensemble` module docs); the
+        // records are the same either way.
+        let run_lanes = if Simd::Auto.resolve() == Simd::Avx512 {
+            sweep_starts::<F64x16, Member, Stop, 2>
+        } else {
+            sweep_starts::<F64x8, Member, Stop, 2>
+        };
+        for group in groups.values() {
+            let stop = Self::impact_stop(group[0].1.system.params());
+            let starts: Vec<LaneStart<Member, 2>> = group.iter().map(|(_, st)| *st).collect();
+            let run = Ensemble::new(tol)
+                .map_err(|e| SweepError::failed(0.0, e))
+                .and_then(|e| run_lanes(&e, &settings, &starts, Some(stop)));
+            match run {
+                Err(e) => {
+                    for (k, _) in group {
+                        out[*k] = Some(Err(e.to_string()));
+                    }
+                }
+                Ok(results) => {
+                    for ((k, st), r) in group.iter().zip(results) {
+                        let m = st.system;
+                        out[*k] = Some(r.map_err(|e| e.to_string()).map(|pt| {
+                            Self::point_run(s, || Ok(*m.scalar()), m.period(), &tol, &pt)
+                        }));
+                    }
+                }
+            }
+        }
+        out.into_iter()
+            .map(|r| r.unwrap_or_else(|| Err("internal: not computed".into())))
+            .collect()
+    }
+}
+
 impl StudySystem for Paper {
     fn name(&self) -> &str {
         "paper"
@@ -289,8 +358,11 @@ impl StudySystem for Paper {
         .map_err(|x| e(&x))?;
         Ok(Self::point_run(s, make, period, &tol, &pt))
     }
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
+    fn in_lanes(&self) -> bool {
+        true
+    }
+    fn run_batch(&self, points: &[PointStart], s: &RunSettings) -> Vec<Result<PointRun, String>> {
+        Self::batch(points, s)
     }
 }
 
@@ -361,8 +433,17 @@ impl StudySystem for Duffing {
         let model = d.model::<f64>().map_err(|e| e.to_string())?;
         scalar::run_smooth::<2, 4, _, Stop>(s, model, Vec::new(), d.period(), y0)
     }
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
+    fn in_lanes(&self) -> bool {
+        true
+    }
+    fn run_batch(&self, points: &[PointStart], s: &RunSettings) -> Vec<Result<PointRun, String>> {
+        let starts = points.iter().map(|p| {
+            let (p, y0) = p.as_ref().map_err(Clone::clone)?;
+            let d = Self::at(p);
+            let model = d.model::<f64>().map_err(|e| e.to_string())?;
+            Ok((model, Vec::<Stop>::new(), d.period(), y0.clone()))
+        });
+        lanes::run_smooth_batch::<2, 4, _, _>(s, starts.collect())
     }
 }
 
@@ -455,8 +536,19 @@ impl StudySystem for TwoDof {
         let stop = d.stop::<f64>().map_err(e)?;
         scalar::run_smooth::<4, 8, _, _>(s, model, vec![stop], TwoDofImpact::period(omega), y0)
     }
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
+    fn in_lanes(&self) -> bool {
+        true
+    }
+    fn run_batch(&self, points: &[PointStart], s: &RunSettings) -> Vec<Result<PointRun, String>> {
+        let starts = points.iter().map(|p| {
+            let (p, y0) = p.as_ref().map_err(Clone::clone)?;
+            let (d, omega) = Self::at(p);
+            let e = |e: crate::Error| e.to_string();
+            let model = d.model::<f64>(omega).map_err(e)?;
+            let stop = d.stop::<f64>().map_err(e)?;
+            Ok((model, vec![stop], TwoDofImpact::period(omega), y0.clone()))
+        });
+        lanes::run_smooth_batch::<4, 8, _, _>(s, starts.collect())
     }
 }
 
@@ -533,8 +625,5 @@ impl StudySystem for Ball {
         let model = b.model::<f64>().map_err(e)?;
         let impact = b.impact::<f64>().map_err(e)?;
         scalar::run_rigid::<1, 2, _, _, _>(s, model, impact, b.period(), y0)
-    }
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
     }
 }

@@ -1,18 +1,10 @@
 //! The computation at one grid point, and a shard's share of them.
 
-use std::collections::BTreeMap;
-
-use nalgebra::Vector2;
-
-use super::catalogue::Paper;
 use super::record::PointRecord;
 use super::shard::{Shard, shard_indices};
 use super::spec::{Study, apply_axis};
-use super::system::{ParameterPoint, PointRun, RunSettings, fill};
-use crate::ensemble::{Ensemble, F64x8, F64x16, Member, Simd, sweep_starts};
+use super::system::{ParameterPoint, PointRun, PointStart, RunSettings, fill};
 use crate::entropy::{Histogram, QRange, entropy_index};
-use crate::sweep::SweepError;
-use crate::systems::paper::PaperParameters;
 
 /// Computes grid point `index` of `study` (a failure is recorded in the point's `status`,
 /// never lost).
@@ -78,17 +70,6 @@ pub(crate) fn run_settings(study: &Study) -> RunSettings {
             .map(|l| (l.periods, l.d0.unwrap_or(system.d0()))),
         scales: study.scales(),
     }
-}
-
-/// The paper model's parameters, ω and initial state (the rest state where not given).
-fn paper_start(
-    point: &ParameterPoint,
-    given: Option<Vec<f64>>,
-) -> Result<(PaperParameters, f64, Vector2<f64>), String> {
-    let (p, omega) = Paper::at(point);
-    let rest = [p.static_equilibrium().map_err(|e| e.to_string())?, 0.0];
-    let y = fill(given.as_deref(), &rest);
-    Ok((p, omega, Vector2::new(y[0], y[1])))
 }
 
 /// The point's record from its run: period, sections, fingerprint, `q` and the top
@@ -183,118 +164,62 @@ fn failed(study: &Study, index: usize, message: String) -> PointRecord {
     r
 }
 
-/// Points per batch of the paper model's lanes (a batch runs on one thread).
+/// Points per batch of a system that runs in lanes (a batch runs on one thread).
 const BATCH: usize = 64;
-
-/// THE DISPATCH TO LANES: the system of `study` if its points run in SIMD lanes — today the
-/// paper's model only ([`sweep_starts`] over [`Member`], the paper's oscillator family);
-/// every other system runs point by point on the scalar path ([`compute_point`]). Lanes
-/// for other systems are added here.
-fn lanes(study: &Study) -> Option<&Paper> {
-    study.system().as_any().downcast_ref::<Paper>()
-}
 
 /// Computes the points of `shard` in parallel (rayon, in the current pool), calling
 /// `progress` after each point; returned in index order. The result does not depend on the
 /// number of threads: each point depends only on the spec and its index.
 ///
-/// The paper model's points run in SIMD lanes ([`sweep_starts`] with
-/// [`LaneMath::Exact`](crate::ensemble::LaneMath::Exact), batches of 64 points per
-/// task), which gives each point's run to the bit as [`compute_point`] does (tested); the
-/// Lyapunov exponent, where recorded, is the scalar two-trajectory estimate from the run's
-/// end state. The points of every other system run on the scalar path.
+/// The points of a system with a lane form (the paper's model, Duffing–Ueda, the 2-DOF
+/// impact oscillator: [`StudySystem::in_lanes`](super::system::StudySystem::in_lanes))
+/// run in SIMD lanes, 64 points per task, with
+/// [`LaneMath::Exact`](crate::lanes::LaneMath::Exact): each point's record is
+/// [`compute_point`]'s to the bit (tested), failure messages included; the Lyapunov
+/// exponent, where recorded, is the scalar two-trajectory estimate from the run's end
+/// state. The points of every other system run one by one on the scalar path.
 pub fn run_shard<F: Fn() + Sync>(study: &Study, shard: Shard, progress: F) -> Vec<PointRecord> {
     use rayon::prelude::*;
     let idx: Vec<usize> = shard_indices(study.points(), shard).collect();
-    match lanes(study) {
-        Some(_) => idx
-            .par_chunks(BATCH)
+    if study.system().in_lanes() {
+        idx.par_chunks(BATCH)
             .flat_map_iter(|batch| {
-                let recs = paper_batch(study, batch);
+                let recs = batch_records(study, batch);
                 batch.iter().for_each(|_| progress());
                 recs
             })
-            .collect(),
-        None => idx
-            .par_iter()
+            .collect()
+    } else {
+        idx.par_iter()
             .map(|&i| {
                 let r = compute_point(study, i);
                 progress();
                 r
             })
-            .collect(),
+            .collect()
     }
 }
 
-/// The paper model's points `indices` in lanes: the records of [`compute_point`], to the
-/// bit, with the same messages for what fails.
-fn paper_batch(study: &Study, indices: &[usize]) -> Vec<PointRecord> {
-    let run_settings = run_settings(study);
-    let (tol, settings) = match Paper::integration(&run_settings) {
-        Ok(v) => v,
-        Err(m) => {
-            return indices
-                .iter()
-                .map(|&i| PointRecord::failed(i, m.clone()))
-                .collect();
-        }
-    };
-    let mut recs: Vec<Option<PointRecord>> = vec![None; indices.len()];
-    // One impact surface per batch of lanes: points are grouped by x_I (a grid axis may
-    // move it).
-    let mut groups: BTreeMap<u64, Vec<(usize, Member, Vector2<f64>)>> = BTreeMap::new();
-    for (k, &i) in indices.iter().enumerate() {
-        let start = point_setup(study, i).and_then(|(point, y0)| paper_start(&point, y0));
-        match start {
-            Err(m) => recs[k] = Some(PointRecord::failed(i, m)),
-            Ok((p, omega, y0)) => match Member::new(p, omega) {
-                Err(e) => recs[k] = Some(PointRecord::failed(i, crate::Error::from(e).to_string())),
-                Ok(m) => groups.entry(p.x_i.to_bits()).or_default().push((k, m, y0)),
-            },
-        }
-    }
-    // Sixteen lanes pay on AVX-512, eight on AVX2 (the `ensemble` module docs); the
-    // records are the same either way.
-    let run_lanes = if Simd::Auto.resolve() == Simd::Avx512 {
-        sweep_starts::<F64x16>
-    } else {
-        sweep_starts::<F64x8>
-    };
-    for group in groups.values() {
-        let stop = Paper::impact_stop(group[0].1.params());
-        let starts: Vec<(Member, Vector2<f64>)> = group.iter().map(|(_, m, y)| (*m, *y)).collect();
-        let run = Ensemble::new(tol)
-            .map_err(|e| SweepError::failed(0.0, e))
-            .and_then(|e| run_lanes(&e, &settings, &starts, stop));
-        match run {
-            Err(e) => {
-                for (k, _, _) in group {
-                    recs[*k] = Some(PointRecord::failed(indices[*k], e.to_string()));
-                }
-            }
-            Ok(points) => {
-                for ((k, m, _), r) in group.iter().zip(points) {
-                    let i = indices[*k];
-                    recs[*k] = Some(match r {
-                        Err(e) => PointRecord::failed(i, SweepError::failed(0.0, e).to_string()),
-                        Ok(pt) => record(
-                            study,
-                            i,
-                            Paper::point_run(
-                                &run_settings,
-                                || Ok(*m.scalar()),
-                                m.period(),
-                                &tol,
-                                &pt,
-                            ),
-                        ),
-                    });
-                }
-            }
-        }
-    }
-    recs.into_iter()
-        .zip(indices)
-        .map(|(r, &i)| r.unwrap_or_else(|| PointRecord::failed(i, "internal: not computed".into())))
+/// The points `indices` run together ([`StudySystem::run_batch`](super::system::StudySystem::run_batch)):
+/// the records of [`compute_point`], to the bit.
+fn batch_records(study: &Study, indices: &[usize]) -> Vec<PointRecord> {
+    let system = study.system();
+    let starts: Vec<PointStart> = indices
+        .iter()
+        .map(|&i| {
+            let (point, given) = point_setup(study, i)?;
+            let rest = system.rest_state(&point)?;
+            let y0 = fill(given.as_deref(), &rest);
+            Ok((point, y0))
+        })
+        .collect();
+    let runs = system.run_batch(&starts, &run_settings(study));
+    indices
+        .iter()
+        .zip(runs)
+        .map(|(&i, r)| match r {
+            Ok(run) => record(study, i, run),
+            Err(m) => failed(study, i, m),
+        })
         .collect()
 }

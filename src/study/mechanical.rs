@@ -822,9 +822,6 @@ impl StudySystem for Described {
             n => Err(format!("{n} masses; at most {MAX_DESCRIBED_DOFS}")),
         }
     }
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
-    }
 }
 
 #[cfg(test)]

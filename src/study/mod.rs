@@ -16,15 +16,17 @@
 //! trajectories from the end of the window) and the entropy index `q*` of the inter-impact
 //! intervals; and the attractor's fingerprint. Records hold whole states (`(x, v)` for one
 //! degree of freedom, `(x1 … xN, v1 … vN)` for `N`) and, for a system with two or more
-//! impact surfaces, the impacts per period on each. A shard runs the paper model's points in
-//! SIMD lanes ([`ensemble::sweep_starts`](crate::ensemble::sweep_starts), exact math),
-//! 64 points per task, which reproduces [`compute_point`]'s scalar run to the bit (tested
-//! field by field, failures included); the Lyapunov exponent stays a scalar run. Every
-//! other system runs point by point on the scalar path: one
-//! [`Simulation`](crate::drive::Simulation) with its impact surfaces as events, or, for a
-//! rigid stop with Newton restitution (the ball on the table),
-//! [`run_with_sticking`](crate::drive::run_with_sticking) through chattering and sticking;
-//! its exponent by two trajectories ([`TwoTrajectory`](crate::lyapunov::TwoTrajectory), or
+//! impact surfaces, the impacts per period on each. A shard runs the points of a system with
+//! a lane form — the paper's model, Duffing–Ueda, the 2-DOF impact oscillator — in SIMD
+//! lanes ([`sweep_starts`](crate::sweep::sweep_starts) or an [`Ensemble`](crate::ensemble::Ensemble)
+//! with the scalar run's events and observers, exact math), 64 points per task, which
+//! reproduces [`compute_point`]'s scalar run to the bit (tested field by field, failures
+//! included); the Lyapunov exponent stays a scalar run. Every other system runs point by
+//! point on the scalar path: one [`Simulation`](crate::drive::Simulation) with its impact
+//! surfaces as events, or, for a rigid stop with Newton restitution (the ball on the
+//! table), [`run_with_sticking`](crate::drive::run_with_sticking) through chattering and
+//! sticking; its exponent by two trajectories
+//! ([`TwoTrajectory`](crate::lyapunov::TwoTrajectory), or
 //! [`HybridTwoTrajectory`](crate::lyapunov::HybridTwoTrajectory) across the resets of a
 //! rigid stop).
 //!
@@ -156,6 +158,7 @@
 mod attractor;
 mod catalogue;
 mod compute;
+mod lanes;
 mod mechanical;
 mod merge;
 mod plan;

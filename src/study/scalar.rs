@@ -64,7 +64,7 @@ impl<const M: usize, G: EventFunction<f64, M>> EventSet<f64, M> for SurfaceEvent
 /// The impacts of a run: rising crossings of surface `k` (event `k`) from `record_from` on,
 /// with the interval since the surface's previous impact.
 #[derive(Debug, Clone)]
-struct ImpactLog {
+pub(super) struct ImpactLog {
     record_from: f64,
     last: Vec<Option<f64>>,
     /// `(t, surface)` in time order.
@@ -104,7 +104,7 @@ fn per_period(counts: &[u64], period: usize) -> f64 {
 }
 
 /// The tolerances of a state of dimension `M`.
-fn tolerances<const M: usize>(s: &RunSettings) -> Result<Tolerances<f64, M>, String> {
+pub(super) fn tolerances<const M: usize>(s: &RunSettings) -> Result<Tolerances<f64, M>, String> {
     let atol: [f64; M] = s.atol.as_slice().try_into().map_err(|_| {
         format!(
             "internal: {} absolute tolerances for {M} state components",
@@ -114,7 +114,7 @@ fn tolerances<const M: usize>(s: &RunSettings) -> Result<Tolerances<f64, M>, Str
     Tolerances::per_component(s.rtol, atol).map_err(|e| e.to_string())
 }
 
-fn state<const M: usize>(y: &[f64]) -> Result<SVector<f64, M>, String> {
+pub(super) fn state<const M: usize>(y: &[f64]) -> Result<SVector<f64, M>, String> {
     if y.len() != M {
         return Err(format!(
             "internal: initial state of {} components for {M}",
@@ -124,16 +124,18 @@ fn state<const M: usize>(y: &[f64]) -> Result<SVector<f64, M>, String> {
     Ok(SVector::from_column_slice(y))
 }
 
+/// The observers of a run: the sections and the impacts on each surface.
+pub(super) type Observers<const M: usize> = (Stroboscopic<f64, M>, ImpactLog);
+
 /// The observers of a run and the window they record.
-struct Recording<const M: usize> {
-    strobe: Stroboscopic<f64, M>,
-    impacts: ImpactLog,
+pub(super) struct Recording<const M: usize> {
+    pub obs: Observers<M>,
     t_rec: f64,
-    t_end: f64,
+    pub t_end: f64,
 }
 
 impl<const M: usize> Recording<M> {
-    fn new(s: &RunSettings, period: f64, surfaces: usize) -> Result<Self, String> {
+    pub fn new(s: &RunSettings, period: f64, surfaces: usize) -> Result<Self, String> {
         if !(period.is_finite() && period > 0.0) {
             return Err(format!("invalid forcing period {period}"));
         }
@@ -142,24 +144,25 @@ impl<const M: usize> Recording<M> {
         // Sections at i·period for i = transient+1 ..= transient+record.
         let strobe = Stroboscopic::<f64, M>::periodic(0.0, period, t_rec + 0.5 * period, 1 << 20)
             .map_err(|e| e.to_string())?;
+        let impacts = ImpactLog {
+            record_from: t_rec,
+            last: vec![None; surfaces],
+            impacts: Vec::new(),
+            intervals: Vec::new(),
+        };
         Ok(Self {
-            strobe,
-            impacts: ImpactLog {
-                record_from: t_rec,
-                last: vec![None; surfaces],
-                impacts: Vec::new(),
-                intervals: Vec::new(),
-            },
+            obs: (strobe, impacts),
             t_rec,
             t_end,
         })
     }
 
     /// The record of the window (without the exponent).
-    fn finish(self, s: &RunSettings, period: f64) -> PointRun {
+    pub fn finish(self, s: &RunSettings, period: f64) -> PointRun {
+        let (strobe, impacts) = self.obs;
         // A run through modes restarts its observers at each mode change: a section at the
         // change is seen twice.
-        let mut points = self.strobe.points().to_vec();
+        let mut points = strobe.points().to_vec();
         points.dedup_by_key(|p| p.index);
         let poincare: Vec<SVector<f64, M>> = points.iter().map(|p| p.y).collect();
         let mut scale = SVector::<f64, M>::zeros();
@@ -175,10 +178,10 @@ impl<const M: usize> Recording<M> {
         };
         // At least one recorded period (the spec's check; one bucket all the same).
         let n = (s.record as usize).max(1);
-        let surfaces = self.impacts.last.len();
+        let surfaces = impacts.last.len();
         let mut counts = vec![vec![0u64; n]; surfaces];
         let mut total = vec![0u64; n];
-        for &(t, k) in &self.impacts.impacts {
+        for &(t, k) in &impacts.impacts {
             // `as` saturates (NaN to 0): every impact lands in a bucket of the window.
             let i = (((t - self.t_rec) / period).floor().max(0.0) as usize).min(n - 1);
             if let Some(c) = counts.get_mut(k) {
@@ -191,7 +194,7 @@ impl<const M: usize> Recording<M> {
             poincare: poincare.iter().map(|p| p.as_slice().to_vec()).collect(),
             impacts_per_period: per_period(&total, period_n),
             impacts_per_surface: counts.iter().map(|c| per_period(c, period_n)).collect(),
-            intervals: self.impacts.intervals,
+            intervals: impacts.intervals,
             lyapunov: None,
         }
     }
@@ -263,8 +266,20 @@ where
         .map_err(|e| e.to_string())?
         .max_steps(s.max_steps)
         .map_err(|e| e.to_string())?;
-    let mut obs = (&mut rec.strobe, &mut rec.impacts);
-    let out = sim.run(0.0, y0, rec.t_end, &mut obs).map_err(fail)?;
+    let out = sim.run(0.0, y0, rec.t_end, &mut rec.obs).map_err(fail)?;
+    Ok(smooth_record::<M, M2, S>(s, rec, system, period, out.y))
+}
+
+/// The record of a smooth run from its observers and end state `y_end` (after a whole
+/// number of periods), with the exponent if asked for: two trajectories in one augmented
+/// state from `y_end` at phase 0.
+pub(super) fn smooth_record<const M: usize, const M2: usize, S: Dynamics<f64, M> + Clone>(
+    s: &RunSettings,
+    rec: Recording<M>,
+    system: S,
+    period: f64,
+    y_end: SVector<f64, M>,
+) -> PointRun {
     let mut run = rec.finish(s, period);
     run.lyapunov = lyapunov::<M>(s, |tol, norm, d0, periods| {
         let mut est = TwoTrajectory::<f64, M, M2, _, _>::with_tolerances(
@@ -275,11 +290,11 @@ where
             norm,
         )?;
         // The run ended after a whole number of periods: t = 0 has the same phase.
-        est.start(0.0, out.y)?;
+        est.start(0.0, y_end)?;
         let e = est.estimate(period, periods)?;
         Ok((e.exponent, e.spread))
     });
-    Ok(run)
+    run
 }
 
 /// Runs a mechanical system with one rigid impact surface (Newton restitution) through
@@ -305,7 +320,6 @@ where
     let y0 = state::<M>(y0)?;
     let tol = tolerances::<M>(s)?;
     let mut rec = Recording::<M>::new(s, period, 1)?;
-    let mut obs = (&mut rec.strobe, &mut rec.impacts);
     let (out, _) = run_with_sticking(
         &model,
         &impact,
@@ -314,7 +328,7 @@ where
         y0,
         rec.t_end,
         s.max_steps,
-        &mut obs,
+        &mut rec.obs,
     )
     .map_err(|e| e.to_string())?;
     let mut run = rec.finish(s, period);

@@ -105,13 +105,16 @@ pub(crate) struct PointRun {
     pub lyapunov: Option<Result<(f64, f64), String>>,
 }
 
+/// The start of one point: its parameters and initial state, or why it has none.
+pub(crate) type PointStart = Result<(ParameterPoint, Vec<f64>), String>;
+
 /// A system a study can run: a model of the catalogue or one described in the study file.
 ///
 /// The study asks it for its parameters (names and defaults), builds a [`ParameterPoint`]
 /// per grid point, and runs the point from an initial state with [`run`](Self::run), which
 /// builds the model at the point and drives it on the scalar path
-/// ([`scalar`](super::scalar)). The paper's model is the exception: a shard runs its
-/// points in SIMD lanes (see `compute::lanes`).
+/// ([`scalar`](super::scalar)). A system with a lane form runs a shard's points together
+/// in SIMD lanes ([`run_batch`](Self::run_batch), [`lanes`](super::lanes)).
 pub(crate) trait StudySystem: std::fmt::Debug + Send + Sync {
     /// The name in `system.model`.
     fn name(&self) -> &str;
@@ -168,8 +171,25 @@ pub(crate) trait StudySystem: std::fmt::Debug + Send + Sync {
     /// What failed, as the point's status.
     fn run(&self, p: &ParameterPoint, y0: &[f64], s: &RunSettings) -> Result<PointRun, String>;
 
-    /// The system as [`Any`](std::any::Any), for the dispatch to lanes.
-    fn as_any(&self) -> &dyn std::any::Any;
+    /// Whether a shard runs this system's points together in SIMD lanes
+    /// ([`run_batch`](Self::run_batch)) rather than one by one. Default: no.
+    fn in_lanes(&self) -> bool {
+        false
+    }
+
+    /// Runs `points` together (each its parameter point and initial state, or why it has
+    /// none): a result per point, what [`run`](Self::run) gives for it, to the bit and with
+    /// the same messages. Default: one by one through [`run`](Self::run); a system with a
+    /// lane form runs them in SIMD lanes (and says so in [`in_lanes`](Self::in_lanes)).
+    fn run_batch(&self, points: &[PointStart], s: &RunSettings) -> Vec<Result<PointRun, String>> {
+        points
+            .iter()
+            .map(|p| match p {
+                Ok((p, y0)) => self.run(p, y0, s),
+                Err(m) => Err(m.clone()),
+            })
+            .collect()
+    }
 
     /// The names of the state components: `x, v` for one degree of freedom, `x1 … xN,
     /// v1 … vN` for `N` (section columns, attractor centroids).

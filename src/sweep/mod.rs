@@ -18,8 +18,12 @@
 //! attractors); [`transitions`] lists the parameter steps where the number of impacts per
 //! period or the period changes (grazing and period-doubling points).
 
+mod lanes;
 mod ramp;
 
+#[cfg(feature = "parallel")]
+pub use lanes::sweep_independent_parallel;
+pub use lanes::{IndependentSweep, LaneStart, sweep_independent, sweep_starts};
 pub use ramp::{RampImpact, RampRecord, RampSection, ramp, ramp_with_capacity};
 
 use nalgebra::SVector;
@@ -29,7 +33,9 @@ use crate::Dynamics;
 use crate::drive::{RunError, Simulation};
 use crate::event::{Direction, Event, EventFunction};
 use crate::integrate::Stepper;
-use crate::sample::{ImpactSequence, PeriodSummary, Regime, Stroboscopic, Surface, detect_period};
+use crate::sample::{
+    ImpactSequence, PeriodSummary, Periodic, Regime, Stroboscopic, Surface, detect_period,
+};
 
 /// Sweep errors.
 #[derive(Debug, Clone, Error)]
@@ -444,7 +450,6 @@ where
         return Err(SweepError::InvalidPeriod { param, period });
     }
     let stop = sys.stop;
-    let t_rec = transient as f64 * period;
     // In f64: `transient + record` may not fit a u32.
     let t_end = (f64::from(transient) + f64::from(config.record)) * period;
     let ev = Event::new(SurfaceEvent(stop.clone()), Direction::Rising);
@@ -454,13 +459,43 @@ where
         .map_err(|e| fail(e.into()))?
         .max_steps(config.max_steps)
         .map_err(|e| fail(e.into()))?;
+    let mut obs = point_observers::<N, G>(param, period, transient, stop)?;
+    let out = sim.run(0.0, y0, t_end, &mut obs).map_err(fail)?;
+    Ok(point_record(
+        (config.record, config.period_tol, config.max_period),
+        param,
+        &obs,
+        out.y,
+    ))
+}
+
+/// The observers of one parameter value: its sections, and the impacts and per-period
+/// margins on its surface (none without one).
+pub(crate) type PointObservers<const N: usize, G> = (
+    Stroboscopic<f64, N>,
+    Option<ImpactSequence<f64, G>>,
+    Option<PeriodSummary<f64, Periodic<f64>, G>>,
+);
+
+/// The observers of one value with forcing period `period`: sections at `i·period` for
+/// `i = transient+1 ..= transient+record`, impacts and per-period margins on `stop` from
+/// `t = transient·period` (extrema are kept of component 0, the first position of a
+/// mechanical state; only the margins are used).
+pub(crate) fn point_observers<const N: usize, G: Surface<f64, N> + Clone>(
+    param: f64,
+    period: f64,
+    transient: u32,
+    stop: Option<G>,
+) -> Result<PointObservers<N, G>, SweepError> {
+    let fail = |e: RunError| SweepError::failed(param, e);
+    if !(period.is_finite() && period > 0.0) {
+        return Err(SweepError::InvalidPeriod { param, period });
+    }
     let cap = 1 << 20;
-    // Sections at i·period for i = transient+1 ..= transient+record.
-    let mut strobe = Stroboscopic::<f64, N>::periodic(0.0, period, t_rec + 0.5 * period, cap)
+    let t_rec = transient as f64 * period;
+    let strobe = Stroboscopic::<f64, N>::periodic(0.0, period, t_rec + 0.5 * period, cap)
         .map_err(|e| fail(e.into()))?;
-    // Impacts and per-period margins on the surface (none without one). Extrema are kept
-    // of component 0 (the first position of a mechanical state); only margins are used.
-    let (mut impacts, mut periods) = match stop.clone() {
+    let (impacts, periods) = match stop {
         Some(g) => (
             Some(ImpactSequence::on_surface(0, g.clone(), t_rec, cap).map_err(|e| fail(e.into()))?),
             Some(
@@ -471,8 +506,18 @@ where
         ),
         None => (None, None),
     };
-    let mut obs = (&mut strobe, &mut impacts, &mut periods);
-    let out = sim.run(0.0, y0, t_end, &mut obs).map_err(fail)?;
+    Ok((strobe, impacts, periods))
+}
+
+/// The record of one value from its observers after the run and its end state;
+/// `(record, period_tol, max_period)` are the window length and the period detection.
+pub(crate) fn point_record<const N: usize, G>(
+    (record, period_tol, max_period): (u32, f64, usize),
+    param: f64,
+    obs: &PointObservers<N, G>,
+    end_state: SVector<f64, N>,
+) -> SweepPoint<N> {
+    let (strobe, impacts, periods) = obs;
     let no_impacts: &[crate::sample::Impact<f64>] = &[];
     let no_periods: &[crate::sample::PeriodRecord<f64>] = &[];
     let impact_list = impacts.as_ref().map_or(no_impacts, |i| i.impacts());
@@ -485,31 +530,31 @@ where
             scale[c] = scale[c].max(p[c].abs());
         }
     }
-    let regime = detect_period(&poincare, &scale, config.period_tol, config.max_period);
+    let regime = detect_period(&poincare, &scale, period_tol, max_period);
     let intervals: Vec<f64> = impact_list.iter().filter_map(|i| i.interval).collect();
     let impact_velocities = impact_list.iter().map(|i| i.velocity).collect();
     let grazing_margin = period_list
         .iter()
         .map(|p| p.margin)
         .fold(f64::INFINITY, f64::min);
-    Ok(SweepPoint {
+    SweepPoint {
         param,
         poincare,
         intervals,
         impact_velocities,
         impacts: impact_count,
-        impacts_per_period: impacts_per_period(period_list, regime, impact_count, config.record),
+        impacts_per_period: impacts_per_period(period_list, regime, impact_count, record),
         regime,
         grazing_margin,
-        end_state: out.y,
-    })
+        end_state,
+    }
 }
 
 /// Impacts per forcing period: for a period-`p` orbit counted over the largest whole number
 /// of orbit periods in the window (a 50-period window holds no whole number of period-3
 /// orbits, and the plain average would flicker between neighbouring values); otherwise the
 /// average over the window.
-pub(crate) fn impacts_per_period(
+fn impacts_per_period(
     periods: &[crate::sample::PeriodRecord<f64>],
     regime: Regime,
     total: u64,

@@ -64,11 +64,13 @@
 mod experiment;
 mod fit;
 pub mod lyapunov;
+mod member;
 
 pub use experiment::{Forcing, SyntheticExperiment, SyntheticRecord};
 pub use fit::{
     PAPER_FIT_PARAMETERS, PaperFit, PaperFitReport, paper_parameter, set_paper_parameter,
 };
+pub use member::Member;
 
 use crate::Real;
 use crate::error::Result;

@@ -2,8 +2,11 @@
 
 use nalgebra::{SMatrix, SVector};
 
+use super::{PaperOscillator, PaperParameters};
+use crate::drive::RunError;
+use crate::ensemble::MemberRun;
 use crate::lanes::{LaneMath, Lanes};
-use crate::systems::paper::{PaperOscillator, PaperParameters};
+use crate::sweep::LaneStart;
 use crate::validate::ParameterError;
 use crate::{Dynamics, LaneDynamics};
 
@@ -49,7 +52,7 @@ impl Member {
     /// # Errors
     /// [`ParameterError`] unless `omega` is finite and > 0 (with `m0e·ω³` finite).
     pub fn paper(omega: f64) -> Result<Self, ParameterError> {
-        Self::new(crate::systems::paper::PAPER, omega)
+        Self::new(super::PAPER, omega)
     }
 
     /// The parameters.
@@ -65,6 +68,18 @@ impl Member {
     /// The forcing period `2π/ω`.
     pub fn period(&self) -> f64 {
         core::f64::consts::TAU / self.omega
+    }
+
+    /// This member from `y0` at `t = 0` as a start of a lane sweep
+    /// ([`sweep_independent`](crate::sweep::sweep_independent)): the record's parameter is
+    /// `ω`, the sections are at `t = i·2π/ω`.
+    pub fn start(&self, y0: SVector<f64, 2>) -> LaneStart<Self, 2> {
+        LaneStart {
+            param: self.omega,
+            system: *self,
+            period: self.period(),
+            y0,
+        }
     }
 
     /// The same model on the scalar path.
@@ -120,5 +135,17 @@ impl LaneDynamics<2> for Member {
         dy: &mut [V; 2],
     ) {
         PaperOscillator::<f64>::rhs_lanes(packed, math, t, time, y, dy)
+    }
+}
+
+impl MemberRun<Member, 2> {
+    /// `periods` forcing periods `2π/ω` of the paper's member from `(0, y0)`, every step
+    /// landing on `t = i·2π/ω` (the sweeps' setting).
+    ///
+    /// # Errors
+    /// As [`MemberRun::new`]; [`ParameterError`] unless `periods` is finite and > 0.
+    pub fn periods(member: Member, y0: SVector<f64, 2>, periods: f64) -> Result<Self, RunError> {
+        let tau = member.period();
+        Self::periods_of(member, y0, tau, periods)
     }
 }

@@ -1,21 +1,35 @@
-//! The two-trajectory (Benettin) top exponent in lanes, for many parameter values at once.
+//! The two-trajectory (Benettin) top exponent in the lanes of an
+//! [`Ensemble`], for many parameter values at once, of any model with a lane form.
 
 use nalgebra::SVector;
 
-use super::{Ensemble, Lanes, Member, MemberRun};
-use crate::drive::Outcome;
-use crate::error::Result;
+use super::{DiagramPoint, DiagramSettings, LyapunovError, Norm, block_standard_error, grid_time};
+use crate::LaneDynamics;
+use crate::drive::{Outcome, RunError};
+use crate::ensemble::{Ensemble, Lanes, MemberRun};
 use crate::integrate::Stats;
-use crate::lyapunov::{DiagramPoint, DiagramSettings, LyapunovError, Norm};
 
-/// The top Lyapunov exponent of every member from the same initial state (independent
-/// starts), by the two-trajectory method with the renormalization rule of
+/// `Result` with [`LyapunovError`].
+type Result<T, E = LyapunovError> = std::result::Result<T, E>;
+
+/// The ensemble's outcomes of a batch (outer error: the batch could not run).
+type Outcomes<const M: usize> =
+    std::result::Result<Vec<std::result::Result<Outcome<f64, M>, RunError>>, RunError>;
+
+/// The top Lyapunov exponent of every `(p, system)` of `systems` from the same initial
+/// state (independent starts), by the two-trajectory method with the renormalization rule of
 /// [`TwoTrajectory`](crate::lyapunov::TwoTrajectory), both trajectories of every pair in
 /// lanes of `V`.
 ///
-/// For each member: the reference starts at `(settings.t0, y0)`, the perturbed copy at
+/// Any model with a lane form runs ([`LaneDynamics`]: an
+/// [`Oscillator`](crate::model::Oscillator), a [`Mechanical`](crate::model::Mechanical),
+/// any [`Dynamics`](crate::Dynamics) through [`LaneByLane`](crate::LaneByLane)); `p` is
+/// the parameter value the record carries and gives the interval `τ =
+/// settings.interval.interval(p)`.
+///
+/// For each system: the reference starts at `(settings.t0, y0)`, the perturbed copy at
 /// `y0 + d0·e` with `e` the unit vector along the norm's scales; `settings.first_transient`
-/// intervals of `τ = settings.interval.interval(ω)` are run and renormalized without being
+/// intervals of `τ` are run and renormalized without being
 /// recorded (a separation lost to rounding there is re-seeded along `e`), then
 /// `settings.intervals` recorded ones: after each, `d = ‖ỹ − y‖`, the local rate
 /// `ln(d/d_start)/τ` is recorded and `ỹ ← y + (ỹ − y)·d0/d`. The estimate is the mean of
@@ -31,17 +45,18 @@ use crate::lyapunov::{DiagramPoint, DiagramSettings, LyapunovError, Norm};
 /// (tested on the paper's model: periodic and chaotic values).
 ///
 /// # Errors
-/// [`LyapunovError`] for empty `members`, a bad `d0`, norm, interval or block count, a
-/// separation lost in a recorded interval; the first integration error in member order.
-pub fn tle_independent<V: Lanes>(
-    ensemble: &Ensemble,
-    members: &[Member],
-    y0: SVector<f64, 2>,
+/// [`LyapunovError`] for empty `systems`, a bad `d0`, norm, interval or block count, a
+/// separation lost in a recorded interval; the first integration error in the order of
+/// `systems` ([`LyapunovError::Run`]).
+pub fn tle_independent<V: Lanes, D: LaneDynamics<M> + Clone, const M: usize>(
+    ensemble: &Ensemble<(), M>,
+    systems: &[(f64, D)],
+    y0: SVector<f64, M>,
     d0: f64,
-    norm: Norm<f64, 2>,
+    norm: Norm<f64, M>,
     settings: &DiagramSettings<f64>,
 ) -> Result<Vec<DiagramPoint<f64>>> {
-    estimate(members, y0, d0, norm, settings, |jobs| {
+    estimate(systems, y0, d0, norm, settings, |jobs| {
         let mut obs = vec![(); jobs.len()];
         ensemble.run::<V, _, _>(jobs, &mut obs)
     })
@@ -53,45 +68,46 @@ pub fn tle_independent<V: Lanes>(
 /// # Errors
 /// As [`tle_independent`]; a parameter error if `chunk == 0`.
 #[cfg(feature = "parallel")]
-pub fn tle_independent_parallel<V: Lanes>(
-    ensemble: &Ensemble,
-    members: &[Member],
-    y0: SVector<f64, 2>,
+pub fn tle_independent_parallel<V: Lanes, D: LaneDynamics<M> + Clone + Sync, const M: usize>(
+    ensemble: &Ensemble<(), M>,
+    systems: &[(f64, D)],
+    y0: SVector<f64, M>,
     d0: f64,
-    norm: Norm<f64, 2>,
+    norm: Norm<f64, M>,
     settings: &DiagramSettings<f64>,
     chunk: usize,
 ) -> Result<Vec<DiagramPoint<f64>>> {
-    estimate(members, y0, d0, norm, settings, |jobs| {
+    estimate(systems, y0, d0, norm, settings, |jobs| {
         let mut obs = vec![(); jobs.len()];
         ensemble.run_parallel::<V, _, _>(jobs, &mut obs, chunk)
     })
 }
 
 /// One pair's state between intervals.
-struct Pair {
-    member: Member,
+struct Pair<D, const M: usize> {
+    param: f64,
+    system: D,
     tau: f64,
-    a: SVector<f64, 2>,
-    b: SVector<f64, 2>,
+    a: SVector<f64, M>,
+    b: SVector<f64, M>,
     d_start: f64,
     local: Vec<f64>,
     stats: Stats,
 }
 
-fn estimate(
-    members: &[Member],
-    y0: SVector<f64, 2>,
+fn estimate<D: LaneDynamics<M> + Clone, const M: usize>(
+    systems: &[(f64, D)],
+    y0: SVector<f64, M>,
     d0: f64,
-    norm: Norm<f64, 2>,
+    norm: Norm<f64, M>,
     settings: &DiagramSettings<f64>,
-    run: impl Fn(&[MemberRun]) -> Result<Vec<Result<Outcome<f64, 2>>>>,
+    run: impl Fn(&[MemberRun<D, M>]) -> Outcomes<M>,
 ) -> Result<Vec<DiagramPoint<f64>>> {
-    if members.is_empty() {
-        return Err(LyapunovError::NoParameters.into());
+    if systems.is_empty() {
+        return Err(LyapunovError::NoParameters);
     }
     if !(d0.is_finite() && d0 > 0.0) {
-        return Err(LyapunovError::InvalidSeparation { d0 }.into());
+        return Err(LyapunovError::InvalidSeparation { d0 });
     }
     norm.validate()?;
     let n = settings.intervals;
@@ -99,35 +115,33 @@ fn estimate(
         return Err(LyapunovError::TooFewIntervals {
             intervals: n,
             minimum: 2,
-        }
-        .into());
+        });
     }
     if settings.blocks < 2 {
         return Err(LyapunovError::InvalidBlocks {
             blocks: settings.blocks,
-        }
-        .into());
+        });
     }
     let t0 = settings.t0;
     if !(t0.is_finite() && y0.iter().all(|v| v.is_finite())) {
         return Err(LyapunovError::NonFinite {
             what: "t0 or y0",
             value: t0,
-        }
-        .into());
+        });
     }
     let w = norm.scales();
     let dir = w / norm.norm(&w);
     let y1 = y0 + dir * d0;
     let realized = norm.norm(&(y1 - y0));
     if !((realized - d0).abs() <= 1e-3 * d0) {
-        return Err(LyapunovError::UnresolvedSeparation { d0, realized }.into());
+        return Err(LyapunovError::UnresolvedSeparation { d0, realized });
     }
-    let mut pairs = Vec::with_capacity(members.len());
-    for m in members {
+    let mut pairs = Vec::with_capacity(systems.len());
+    for (p, system) in systems {
         pairs.push(Pair {
-            member: *m,
-            tau: settings.interval.interval(m.omega())?,
+            param: *p,
+            system: system.clone(),
+            tau: settings.interval.interval(*p)?,
             a: y0,
             b: y1,
             d_start: realized,
@@ -136,7 +150,7 @@ fn estimate(
         });
     }
     let transient = settings.first_transient;
-    let mut jobs = Vec::with_capacity(2 * members.len());
+    let mut jobs = Vec::with_capacity(2 * systems.len());
     for k in 0..transient + n {
         let recording = k >= transient;
         // The scalar estimator's clock: `t_s + τ·j` from the start `t_s` of each stage.
@@ -144,13 +158,13 @@ fn estimate(
         jobs.clear();
         for p in &pairs {
             let start = if recording {
-                grid(t0, p.tau, transient)
+                grid_time(t0, p.tau, transient)
             } else {
                 t0
             };
-            let (t_a, t_b) = (grid(start, p.tau, j), grid(start, p.tau, j + 1));
-            jobs.push(MemberRun::new(p.member, t_a, p.a, t_b)?);
-            jobs.push(MemberRun::new(p.member, t_a, p.b, t_b)?);
+            let (t_a, t_b) = (grid_time(start, p.tau, j), grid_time(start, p.tau, j + 1));
+            jobs.push(MemberRun::new(p.system.clone(), t_a, p.a, t_b)?);
+            jobs.push(MemberRun::new(p.system.clone(), t_a, p.b, t_b)?);
         }
         let out = run(&jobs)?;
         let mut out = out.into_iter();
@@ -174,8 +188,7 @@ fn estimate(
                 return Err(LyapunovError::SeparationLost {
                     t: oa.t,
                     separation: d,
-                }
-                .into());
+                });
             }
             if recording {
                 p.local.push((d / p.d_start).ln() / p.tau);
@@ -186,8 +199,7 @@ fn estimate(
                 return Err(LyapunovError::UnresolvedSeparation {
                     d0,
                     realized: p.d_start,
-                }
-                .into());
+                });
             }
             p.a = a;
             p.b = b_new;
@@ -198,37 +210,11 @@ fn estimate(
         .map(|p| {
             let sum: f64 = p.local.iter().fold(0.0, |s, &x| s + x);
             DiagramPoint {
-                parameter: p.member.omega(),
+                parameter: p.param,
                 exponent: sum / n as f64,
-                spread: block_standard_error(&p.local, settings.blocks.min(n)),
+                spread: block_standard_error(n, settings.blocks.min(n), |k| p.local[k]),
                 stats: p.stats,
             }
         })
         .collect())
-}
-
-/// `t0 + τ·k` (never accumulated).
-fn grid(t0: f64, tau: f64, k: usize) -> f64 {
-    t0 + tau * k as f64
-}
-
-/// The scalar estimator's block standard error (`2 ≤ blocks ≤ x.len()`).
-fn block_standard_error(x: &[f64], blocks: usize) -> f64 {
-    let n = x.len();
-    let block_mean = |b: usize| {
-        let (lo, hi) = (b * n / blocks, (b + 1) * n / blocks);
-        x[lo..hi].iter().fold(0.0, |s, &v| s + v) / (hi - lo) as f64
-    };
-    let bf = blocks as f64;
-    let mut mean = 0.0;
-    for b in 0..blocks {
-        mean += block_mean(b);
-    }
-    mean /= bf;
-    let mut ss = 0.0;
-    for b in 0..blocks {
-        let d = block_mean(b) - mean;
-        ss += d * d;
-    }
-    (ss / (bf * (bf - 1.0))).sqrt()
 }
