@@ -434,3 +434,424 @@ fn relay_feedback_converges_to_its_sliding_orbit_with_the_exact_period_and_multi
     assert!(mus.iter().any(|m| (m - 1.0).norm() < 1e-6), "{mus:?}");
     assert!(mus.iter().any(|m| m.norm() < 1e-6), "{mus:?}");
 }
+
+// ---------------------------------------------------------------------------------------
+// Den Hartog's forced oscillator with Coulomb friction and no viscous damping,
+// ẍ + x + F sgn ẋ ∋ cos ωt (m = k = F₀ = 1), as a Filippov system on H = ẋ.
+struct DenHartog {
+    friction: f64,
+    w: f64,
+}
+
+impl Filippov<f64, 2, 1> for DenHartog {
+    fn surface(&self, _i: usize, _t: f64, x: &SVector<f64, 2>) -> f64 {
+        x[1]
+    }
+    fn gradient(&self, _i: usize, _t: f64, _x: &SVector<f64, 2>) -> SVector<f64, 2> {
+        SVector::from([0.0, 1.0])
+    }
+    fn field(&self, sides: &[Side; 1], t: f64, x: &SVector<f64, 2>, dx: &mut SVector<f64, 2>) {
+        let friction = -sides[0].sign::<f64>() * self.friction;
+        *dx = SVector::from([x[1], -x[0] + (self.w * t).cos() + friction]);
+    }
+    fn time_scale(&self, _t: f64) -> Option<f64> {
+        Some(TAU / self.w / 16.0)
+    }
+}
+
+fn tol2() -> Tolerances<f64, 2> {
+    Tolerances::new(1e-12, 1e-14).unwrap()
+}
+
+/// Den Hartog's steady amplitude without stops, `X/(F₀/k)`.
+fn den_hartog_amplitude(r: f64, friction: f64) -> f64 {
+    let u = (PI / (2.0 * r)).tan() / r;
+    (1.0 / (1.0 - r * r).powi(2) - friction * friction * u * u).sqrt()
+}
+
+/// The start on Den Hartog's steady orbit: at the top `x = X`, `ẋ = 0` at the forcing
+/// phase `ωt₀` where the half cycle with friction `+F` (ẋ < 0) ends at `(−X, 0)` after
+/// `π/ω`: solved from the closed-form solution of `ẍ + x = F + cos ωt` by bisection on the
+/// phase.
+fn den_hartog_start(w: f64, friction: f64, amplitude: f64) -> f64 {
+    let c = 1.0 / (1.0 - w * w);
+    // x(t) = F + c cos ωt + C₁ cos(t − t₀) + C₂ sin(t − t₀), x(t₀) = X, ẋ(t₀) = 0.
+    let end_velocity = |t0: f64| {
+        let c1 = amplitude - friction - c * (w * t0).cos();
+        let c2 = c * w * (w * t0).sin();
+        let tau = PI / w;
+        let t = t0 + tau;
+        -c * w * (w * t).sin() - c1 * tau.sin() + c2 * tau.cos()
+    };
+    let end_position = |t0: f64| {
+        let c1 = amplitude - friction - c * (w * t0).cos();
+        let c2 = c * w * (w * t0).sin();
+        let tau = PI / w;
+        friction + c * (w * (t0 + tau)).cos() + c1 * tau.cos() + c2 * tau.sin()
+    };
+    // Scan the phase for the zero of the end velocity with end position −X.
+    let n = 2000;
+    let period = TAU / w;
+    for k in 0..n {
+        let (a, b) = (
+            k as f64 * period / n as f64,
+            (k + 1) as f64 * period / n as f64,
+        );
+        let (va, vb) = (end_velocity(a), end_velocity(b));
+        if va * vb <= 0.0 {
+            let (mut lo, mut hi) = (a, b);
+            for _ in 0..200 {
+                let m = 0.5 * (lo + hi);
+                if end_velocity(lo) * end_velocity(m) <= 0.0 {
+                    hi = m;
+                } else {
+                    lo = m;
+                }
+            }
+            if (end_position(lo) + amplitude).abs() < 1e-9 {
+                return lo;
+            }
+        }
+    }
+    panic!("no start phase on the steady orbit");
+}
+
+#[test]
+fn den_hartog_non_sticking_amplitude_matches_the_closed_form() {
+    for (r, friction) in [(1.5, 0.3), (2.0, 0.5)] {
+        let w = r;
+        let x_amp = den_hartog_amplitude(r, friction);
+        let t0 = den_hartog_start(w, friction, x_amp);
+        let mut sim = FilippovSimulation::new(DenHartog { friction, w }, Dopri5::new(tol2()));
+        let periods = 20.0;
+        let run = sim
+            .run(
+                t0,
+                SVector::from([x_amp, 0.0]),
+                t0 + periods * TAU / w,
+                &mut (),
+            )
+            .unwrap();
+        // Two velocity reversals per period, each at |x| = X, never sliding (no stops).
+        let reversals: Vec<&Transition<f64, 2, 1>> = run
+            .transitions
+            .iter()
+            .filter(|tr| tr.kind == TransitionKind::Crossing)
+            .collect();
+        assert!(run.transitions.iter().all(|tr| !tr.to.is_sliding()));
+        assert!(
+            reversals.len() as f64 >= 2.0 * periods - 1.0,
+            "{}",
+            reversals.len()
+        );
+        let mut worst: f64 = 0.0;
+        for tr in &reversals {
+            worst = worst.max((tr.x[0].abs() - x_amp).abs());
+        }
+        println!(
+            "Den Hartog r = {r}, F/F₀ = {friction}: X = {x_amp:.12}, worst |X − |x|| at reversals {worst:.2e}"
+        );
+        assert!(worst < 1e-9, "amplitude error {worst:e}");
+    }
+}
+
+/// Checks the static limit `|cos ωt − x| ≤ F` and rest (`ẋ = 0`) at 16 interior points of
+/// every stuck (sliding) step.
+struct StaticLimit {
+    friction: f64,
+    w: f64,
+    worst_excess: f64,
+    worst_rate: f64,
+    samples: usize,
+    region_steps: usize,
+}
+
+impl SlidingObserver<f64, 2, 1> for StaticLimit {
+    fn on_step<D: DenseOutput<f64, 2>>(
+        &mut self,
+        mode: &Mode<1>,
+        step: &StepView<'_, f64, 2, D>,
+    ) -> nonsmooth::drive::Control {
+        if !mode.is_sliding() {
+            self.region_steps += 1;
+            return nonsmooth::drive::Control::Continue;
+        }
+        let mut y = SVector::zeros();
+        for k in 0..=16 {
+            let t = step.t0 + (step.t1 - step.t0) * k as f64 / 16.0;
+            step.state_at(t, &mut y);
+            let need = ((self.w * t).cos() - y[0]).abs();
+            self.worst_excess = self.worst_excess.max(need - self.friction);
+            self.worst_rate = self.worst_rate.max(y[1].abs());
+            self.samples += 1;
+        }
+        nonsmooth::drive::Control::Continue
+    }
+}
+
+#[test]
+fn den_hartog_sticking_regime_holds_the_static_limit_between_step_ends() {
+    let (w, friction) = (0.5, 0.8);
+    let mut sim = FilippovSimulation::new(DenHartog { friction, w }, Dopri5::new(tol2()));
+    let mut watch = StaticLimit {
+        friction,
+        w,
+        worst_excess: f64::NEG_INFINITY,
+        worst_rate: 0.0,
+        samples: 0,
+        region_steps: 0,
+    };
+    let run = sim
+        .run(0.0, SVector::from([0.0, 0.0]), 10.0 * TAU / w, &mut watch)
+        .unwrap();
+    let sticks = run
+        .transitions
+        .iter()
+        .filter(|tr| tr.kind == TransitionKind::SlidingEntry)
+        .count();
+    assert!(sticks >= 10, "{sticks} sticks");
+    assert!(watch.samples > 100 && watch.region_steps > 10);
+    // Stuck: the force needed to hold never exceeds the limit, the velocity stays zero.
+    assert!(
+        watch.worst_excess <= 1e-12,
+        "static limit exceeded by {:e}",
+        watch.worst_excess
+    );
+    assert!(
+        watch.worst_rate <= 1e-14,
+        "|ẋ| while stuck {:e}",
+        watch.worst_rate
+    );
+    // Each stick ends where the needed force reaches the limit.
+    let mut worst_exit: f64 = 0.0;
+    for tr in run
+        .transitions
+        .iter()
+        .filter(|tr| tr.kind == TransitionKind::SlidingExit)
+    {
+        let need = ((w * tr.t).cos() - tr.x[0]).abs();
+        worst_exit = worst_exit.max((need - friction).abs());
+    }
+    println!(
+        "Den Hartog sticking: {sticks} sticks, static limit excess ≤ {:.2e} over {} dense samples, |ẋ| ≤ {:.2e}, exits at the limit within {worst_exit:.2e}",
+        watch.worst_excess, watch.samples, watch.worst_rate
+    );
+    assert!(worst_exit < 1e-9, "exit off the limit by {worst_exit:e}");
+}
+
+// ---------------------------------------------------------------------------------------
+// The dry-friction oscillator on a belt (di Bernardo, Kowalczyk & Nordmark, IJBC 13(10),
+// 2003): m ẍ + k x = F₀ cos ωt − F_k sgn(ẋ − u), here m = k = 1, against StickSlip with
+// F_s = F_k.
+const BELT_U: f64 = 0.5;
+const BELT_FK: f64 = 1.0;
+const BELT_F0: f64 = 0.8;
+const BELT_W: f64 = 1.3;
+
+fn slip_mode(mode: &Mode<1>) -> SlipMode {
+    match (mode.sliding, mode.sides[0]) {
+        (Some(_), _) => SlipMode::Stick,
+        (None, Side::Plus) => SlipMode::Forward,
+        (None, Side::Minus) => SlipMode::Backward,
+    }
+}
+
+#[test]
+fn belt_oscillator_filippov_path_equals_stick_slip() {
+    let t_end = 60.0;
+    let belt = Switched::new(
+        |x: &SVector<f64, 2>| x[1] - BELT_U,
+        |_x: &SVector<f64, 2>| SVector::from([0.0, 1.0]),
+        |t: f64, x: &SVector<f64, 2>| {
+            SVector::from([x[1], -x[0] + BELT_F0 * (BELT_W * t).cos() + BELT_FK])
+        },
+        |t: f64, x: &SVector<f64, 2>| {
+            SVector::from([x[1], -x[0] + BELT_F0 * (BELT_W * t).cos() - BELT_FK])
+        },
+    );
+    let mut sim = FilippovSimulation::new(belt, Dopri5::new(tol2()));
+    let run = sim
+        .run(0.0, SVector::from([0.0, 0.0]), t_end, &mut ())
+        .unwrap();
+    let got: Vec<(f64, SlipMode)> = run
+        .transitions
+        .iter()
+        .filter(|tr| tr.kind != TransitionKind::Graze)
+        .map(|tr| (tr.t, slip_mode(&tr.to)))
+        .collect();
+    let model = Mechanical::with_masses([1.0])
+        .unwrap()
+        .with_elements(Element::on_dof(0, LinearSpring::new(1.0).unwrap()).unwrap())
+        .with_loads(Load::on_dof(0, Harmonic::cosine(BELT_F0, BELT_W).unwrap()).unwrap());
+    let friction = Coulomb::new(
+        Coordinate::dof(0).unwrap(),
+        Constant::new(BELT_U).unwrap(),
+        BELT_FK,
+        BELT_FK,
+    )
+    .unwrap();
+    let mut system = StickSlip::new(&model, friction, || Dopri5::new(tol2()));
+    let y0 = SVector::from([0.0, 0.0]);
+    let start = system.mode_at(0.0, &y0);
+    assert_eq!(start, slip_mode(&run.start_mode));
+    let want = run_modes(&mut system, start, 0.0, y0, t_end, 100_000, &mut ())
+        .unwrap()
+        .transitions;
+    assert_eq!(got.len(), want.len(), "{got:?}\nvs\n{want:?}");
+    let sticks = want.iter().filter(|w| w.1 == SlipMode::Stick).count();
+    assert!(sticks >= 5, "{sticks} sticks");
+    let mut worst: f64 = 0.0;
+    for (g, w) in got.iter().zip(&want) {
+        assert_eq!(g.1, w.1, "at t = {}", w.0);
+        worst = worst.max((g.0 - w.0).abs());
+    }
+    println!(
+        "belt: {} transitions ({sticks} sticks), worst |Δt| Filippov vs StickSlip {worst:.2e}",
+        got.len()
+    );
+    assert!(worst < 1e-10, "stick/slip times differ by {worst:e}");
+}
+
+// ---------------------------------------------------------------------------------------
+// Error paths and settings.
+
+/// Two surfaces `x₀ = 0`, `x₁ = 0` and the constant field (1, 1) in every quadrant.
+#[derive(Debug)]
+struct Corner;
+
+impl Filippov<f64, 2, 2> for Corner {
+    fn surface(&self, i: usize, _t: f64, x: &SVector<f64, 2>) -> f64 {
+        x[i]
+    }
+    fn gradient(&self, i: usize, _t: f64, _x: &SVector<f64, 2>) -> SVector<f64, 2> {
+        let mut g = SVector::zeros();
+        g[i] = 1.0;
+        g
+    }
+    fn field(&self, _sides: &[Side; 2], _t: f64, _x: &SVector<f64, 2>, dx: &mut SVector<f64, 2>) {
+        *dx = SVector::from([1.0, 1.0]);
+    }
+}
+
+#[test]
+fn two_surfaces_met_at_once_are_a_codimension_2_error() {
+    let mut sim = FilippovSimulation::new(Corner, Dopri5::new(tol2()));
+    match sim.run(0.0, SVector::from([-1.0, -1.0]), 3.0, &mut ()) {
+        Err(FilippovError::Codimension2 {
+            t, first, second, ..
+        }) => {
+            assert!((t - 1.0).abs() < 1e-9, "t = {t}");
+            let mut s = [first, second];
+            s.sort();
+            assert_eq!(s, [0, 1]);
+        }
+        other => panic!("expected a codimension-2 error, got {other:?}"),
+    }
+    // Off the corner, both surfaces are crossed one after the other.
+    let run = sim
+        .run(0.0, SVector::from([-1.0, -1.5]), 3.0, &mut ())
+        .unwrap();
+    let times: Vec<(f64, usize, TransitionKind)> = run
+        .transitions
+        .iter()
+        .map(|tr| (tr.t, tr.surface, tr.kind))
+        .collect();
+    assert_eq!(times.len(), 2, "{times:?}");
+    assert!((times[0].0 - 1.0).abs() < 1e-10 && times[0].1 == 0);
+    assert!((times[1].0 - 1.5).abs() < 1e-10 && times[1].1 == 1);
+    assert_eq!(run.mode.sides, [Side::Plus, Side::Plus]);
+    let msg = FilippovError::Codimension2 {
+        t: 1.0,
+        first: 0,
+        second: 1,
+        value: 1e-13,
+        tolerance: 1e-9,
+    }
+    .to_string();
+    assert!(
+        msg.contains("t = 1") && msg.contains("surfaces 0 and 1"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn repelling_surface_and_invalid_inputs_are_errors() {
+    let away = Switched::new(
+        |x: &SVector<f64, 1>| x[0],
+        |_x: &SVector<f64, 1>| SVector::from([1.0]),
+        |_t, _x: &SVector<f64, 1>| SVector::from([-1.0]),
+        |_t, _x: &SVector<f64, 1>| SVector::from([1.0]),
+    );
+    let mut sim =
+        FilippovSimulation::new(away, Dopri5::new(Tolerances::new(1e-10, 1e-12).unwrap()));
+    match sim.run(0.5, SVector::from([0.0]), 1.0, &mut ()) {
+        Err(FilippovError::Repelling {
+            t,
+            surface,
+            rate_minus,
+            rate_plus,
+        }) => {
+            assert_eq!((t, surface, rate_minus, rate_plus), (0.5, 0, -1.0, 1.0));
+        }
+        other => panic!("expected Repelling, got {other:?}"),
+    }
+    // Off the surface it runs; bad spans and states are rejected, never a panic.
+    assert!(sim.run(0.0, SVector::from([0.5]), 1.0, &mut ()).is_ok());
+    assert!(sim.run(1.0, SVector::from([0.5]), 1.0, &mut ()).is_err());
+    assert!(
+        sim.run(0.0, SVector::from([f64::NAN]), 1.0, &mut ())
+            .is_err()
+    );
+    assert!(
+        sim.run(0.0, SVector::from([0.5]), f64::INFINITY, &mut ())
+            .is_err()
+    );
+    let mut settings = *sim.settings();
+    settings.drift = -1.0;
+    let err = FilippovSimulation::new(Corner, Dopri5::new(tol2()))
+        .with_settings(settings)
+        .unwrap_err();
+    assert!(
+        err.to_string().contains("drift") && err.to_string().contains("-1"),
+        "{err}"
+    );
+    // A wrong augmented dimension for the monodromy is named.
+    let mut relay = FilippovSimulation::new(Relay::new(), Dopri5::new(tol3()));
+    match relay.monodromy(
+        0.0,
+        SVector::from([0.1, 0.0, 0.0]),
+        0.1,
+        Tolerances::<f64, 9>::new(1e-8, 1e-10).unwrap(),
+    ) {
+        Err(FilippovError::Dimension {
+            expected: 12,
+            got: 9,
+            ..
+        }) => {}
+        other => panic!("expected a dimension error, got {other:?}"),
+    }
+}
+
+#[test]
+fn f32_relay_slides_on_its_surface() {
+    let relay = Switched::new(
+        |x: &SVector<f32, 1>| x[0],
+        |_x: &SVector<f32, 1>| SVector::from([1.0f32]),
+        |_t, _x: &SVector<f32, 1>| SVector::from([1.5f32]),
+        |_t, _x: &SVector<f32, 1>| SVector::from([-0.5f32]),
+    );
+    let mut sim =
+        FilippovSimulation::new(relay, Dopri5::new(Tolerances::new(1e-5f32, 1e-6).unwrap()));
+    let run = sim
+        .run(0.0f32, SVector::from([-1.0f32]), 2.0, &mut ())
+        .unwrap();
+    assert_eq!(run.transitions.len(), 1);
+    assert_eq!(run.transitions[0].kind, TransitionKind::SlidingEntry);
+    assert!((run.transitions[0].t - 1.0 / 1.5).abs() < 1e-5);
+    // On the surface within the rounding band of f32 (16 ε).
+    assert!(
+        run.mode.is_sliding() && run.x[0].abs() <= 16.0 * f32::EPSILON,
+        "{}",
+        run.x[0]
+    );
+}

@@ -187,13 +187,14 @@ pub struct Settings<T> {
     /// Absolute event-time tolerance (default 10⁻¹², plus 4·ε·|t|).
     pub event_tol: T,
     /// A normal rate `|∇H·F + ∂H/∂t|` below this times `‖∇H‖·‖F‖` is a tangency, decided
-    /// by the second-order test (default 10⁻⁹).
+    /// by the second-order test (default 10⁻⁹, at least `1000·ε`).
     pub tangency: T,
     /// Another surface within this (relative) of zero at an event is met at once: a
-    /// codimension-2 point (default 10⁻⁹).
+    /// codimension-2 point (default 10⁻⁹, at least `1000·ε`).
     pub coincidence: T,
     /// The largest relative `|H|` allowed while sliding, checked at step ends and at
-    /// [`drift_samples`](Self::drift_samples) interior points of each step (default 10⁻⁹;
+    /// [`drift_samples`](Self::drift_samples) interior points of each step (default 10⁻⁹,
+    /// at least `1000·ε`;
     /// a linear surface is held to rounding, a curved one to the local error between the
     /// projections at step ends).
     pub drift: T,
@@ -211,11 +212,13 @@ pub struct Settings<T> {
 
 impl<T: Real> Default for Settings<T> {
     fn default() -> Self {
+        // 10⁻⁹, but not below a thousand roundings (f32).
+        let rel = lit::<T>(1e-9).max(lit::<T>(1e3) * T::default_epsilon());
         Self {
             event_tol: lit(1e-12),
-            tangency: lit(1e-9),
-            coincidence: lit(1e-9),
-            drift: lit(1e-9),
+            tangency: rel,
+            coincidence: rel,
+            drift: rel,
             drift_samples: 3,
             exit_samples: 3,
             max_steps: 100_000_000,
