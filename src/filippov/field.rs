@@ -123,8 +123,7 @@ pub(crate) fn departure<T, const N: usize, const S: usize, Sys>(
     i: usize,
     sides: &[Side; S],
     side: Side,
-    t: T,
-    x: &SVector<T, N>,
+    (t, x): (T, &SVector<T, N>),
     rates: &Rates<T, N>,
     tangency: T,
 ) -> i8

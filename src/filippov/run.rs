@@ -327,8 +327,8 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
     {
         let r = rates(&self.system, i, sides, t, x);
         let tang = self.settings.tangency;
-        let sm = departure(&self.system, i, sides, Side::Minus, t, x, &r, tang);
-        let sp = departure(&self.system, i, sides, Side::Plus, t, x, &r, tang);
+        let sm = departure(&self.system, i, sides, Side::Minus, (t, x), &r, tang);
+        let sp = departure(&self.system, i, sides, Side::Plus, (t, x), &r, tang);
         let repelling = || FilippovError::Repelling {
             t: to_f64(t),
             surface: i,
@@ -470,8 +470,7 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
                 i,
                 &mode.sides,
                 target,
-                t,
-                x,
+                (t, x),
                 &r2,
                 self.settings.tangency,
             );
