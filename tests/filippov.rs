@@ -855,3 +855,60 @@ fn f32_relay_slides_on_its_surface() {
         run.x[0]
     );
 }
+
+/// The belt oscillator at forcing `f0`, `ω = 2`, `u = 0.5`, `F_k = 1`.
+fn belt(f0: f64) -> impl Filippov<f64, 2, 1> {
+    const W: f64 = 2.0;
+    Switched::new(
+        |x: &SVector<f64, 2>| x[1] - 0.5,
+        |_x: &SVector<f64, 2>| SVector::from([0.0, 1.0]),
+        move |t: f64, x: &SVector<f64, 2>| SVector::from([x[1], -x[0] + f0 * (W * t).cos() + 1.0]),
+        move |t: f64, x: &SVector<f64, 2>| SVector::from([x[1], -x[0] + f0 * (W * t).cos() - 1.0]),
+    )
+}
+
+/// The closest approach of the belt oscillator's orbit to `ẋ = u` over two forcing periods
+/// from the pure-slip steady state `x = F_k + F₀ cos ωt/(1 − ω²)` (exact while it slips),
+/// and whether it slid.
+fn belt_approach(f0: f64) -> (f64, bool) {
+    let system = belt(f0);
+    let mut approach = nonsmooth::filippov::Approach::new(&system, 0, 0.0, 8);
+    let mut sim = FilippovSimulation::new(&system, Dopri5::new(tol2()));
+    let x0 = SVector::from([1.0 + f0 / (1.0 - 4.0), 0.0]);
+    sim.run(0.0, x0, 2.0 * PI, &mut approach).unwrap();
+    (approach.value().unwrap(), approach.sliding)
+}
+
+#[test]
+fn grazing_sliding_of_the_belt_oscillator_is_located_by_its_test_function() {
+    // Slipping, max ẋ = F₀ω/|1 − ω²|: the orbit grazes ẋ = u at F₀* = u|1 − ω²|/ω = 0.75.
+    let closed = |f0: f64| 0.5 - f0 * 2.0 / 3.0;
+    for f0 in [0.3, 0.6, 0.7] {
+        let (g, slid) = belt_approach(f0);
+        assert!(!slid);
+        assert!(
+            (g - closed(f0)).abs() < 1e-11,
+            "F₀ = {f0}: {g} vs {}",
+            closed(f0)
+        );
+    }
+    // Secant on the test function from below the bifurcation.
+    let (mut a, mut b) = (0.6, 0.7);
+    let (mut ga, mut gb) = (belt_approach(a).0, belt_approach(b).0);
+    for _ in 0..20 {
+        let c = b - gb * (b - a) / (gb - ga);
+        if (c - b).abs() < 1e-13 {
+            break;
+        }
+        (a, ga) = (b, gb);
+        b = c;
+        gb = belt_approach(b).0;
+    }
+    println!("grazing-sliding at F₀ = {b:.15} (closed form 0.75), test function there {gb:.2e}");
+    assert!((b - 0.75).abs() < 1e-9, "located at {b}");
+    // Confirmed by simulation on both sides: the sliding segment appears past it.
+    let (below, slid_below) = belt_approach(b * (1.0 - 1e-6));
+    let (_, slid_above) = belt_approach(b * (1.0 + 1e-6));
+    assert!(!slid_below && below > 0.0, "below: {below}");
+    assert!(slid_above, "no sliding above the bifurcation");
+}

@@ -97,12 +97,14 @@
 //! M. di Bernardo, C. J. Budd, A. R. Champneys, P. Kowalczyk, *Piecewise-smooth Dynamical
 //! Systems*, Springer, 2008 (saltation matrices, sliding bifurcations).
 
+mod approach;
 mod error;
 mod field;
 mod run;
 mod system;
 mod tangent;
 
+pub use approach::Approach;
 pub use error::FilippovError;
 pub use run::{
     FilippovRun, FilippovSimulation, Plain, Settings, SlidingObserver, Transition, TransitionKind,
