@@ -433,6 +433,31 @@ fn relay_feedback_converges_to_its_sliding_orbit_with_the_exact_period_and_multi
     }
     assert!(mus.iter().any(|m| (m - 1.0).norm() < 1e-6), "{mus:?}");
     assert!(mus.iter().any(|m| m.norm() < 1e-6), "{mus:?}");
+    // Shooting: Newton on the period map (period unknown, phase fixed by a section) from
+    // the unconverged state at t = 10 and a rounded period finds the same orbit.
+    let x10 = sim.run(0.0, SVector::from(X0), 10.0, &mut ()).unwrap().x;
+    let guess = (exact_period * 100.0).round() / 100.0;
+    let tol12 = Tolerances::<f64, 12>::new(1e-12, 1e-14).unwrap();
+    let orbit = sim
+        .find_orbit(0.0, x10, guess, true, tol12, 1e-11, 20)
+        .unwrap();
+    let mode = sim.mode_at::<3, 1>(0.0, &orbit.state).unwrap();
+    let back = exact.flow_for(piece_of(&mode), orbit.state, orbit.period);
+    let closure = (back - orbit.state).amax();
+    println!(
+        "shooting: {} iterations, period {:.15} (exact {exact_period:.15}), exact flow closes within {closure:.2e}, start off by {:.2e}",
+        orbit.iterations,
+        orbit.period,
+        (x10 - orbit.state).amax()
+    );
+    assert!(
+        (orbit.period - exact_period).abs() < 1e-9,
+        "{}",
+        orbit.period
+    );
+    assert!(closure < 1e-9, "the exact flow does not close: {closure:e}");
+    let shot = orbit.monodromy.multipliers();
+    assert!((shot[1] - ex[1]).norm() < 1e-6, "{shot:?} vs {ex:?}");
 }
 
 // ---------------------------------------------------------------------------------------

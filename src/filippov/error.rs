@@ -95,6 +95,25 @@ pub enum FilippovError {
         /// `H` (or the first non-finite gradient component).
         value: f64,
     },
+    /// Newton's method for a periodic orbit did not converge.
+    #[error(
+        "periodic orbit: no convergence after {iterations} Newton iterations (residual {residual}, last step {step})"
+    )]
+    NoConvergence {
+        /// Iterations done.
+        iterations: usize,
+        /// `‖φ_T(x) − x‖∞` at the last iterate.
+        residual: f64,
+        /// `‖Δ‖∞` of the last Newton step.
+        step: f64,
+    },
+    /// The Newton system of a periodic orbit is singular (e.g. the phase condition is
+    /// tangent to the section, or a multiplier is 1 for a forced orbit).
+    #[error("periodic orbit: singular Newton system at iteration {iteration}")]
+    Singular {
+        /// The iteration.
+        iteration: usize,
+    },
     /// A dimension given as a const parameter does not match (the augmented state of the
     /// variational equations must have `N + N²` components).
     #[error("dimension {got} given, {expected} required ({what})")]

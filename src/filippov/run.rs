@@ -458,7 +458,10 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
             // α left [0, 1]: exit to the side of the bound reached, if that field moves
             // the state off the surface (second-order test at the tangency).
             let r = rates(&self.system, i, &mode.sides, t, x);
-            let target = if r.alpha() < lit(0.5) {
+            let a = r.alpha();
+            let slack = lit::<T>(1e3) * self.settings.tangency;
+            let clearly_out = a < -slack || a > T::one() + slack;
+            let target = if a < lit(0.5) {
                 Side::Minus
             } else {
                 Side::Plus
@@ -474,7 +477,7 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
                 &r2,
                 self.settings.tangency,
             );
-            if s == 0 || (s > 0) != (target == Side::Plus) {
+            if !clearly_out && (s == 0 || (s > 0) != (target == Side::Plus)) {
                 return Ok((mode, i, TransitionKind::Graze));
             }
             return Ok((
@@ -630,8 +633,9 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
                 if let Some((t, y)) = restart {
                     self.stepper.reset_state(t, y);
                 }
-                match out? {
+                let terminal = match out? {
                     None => {
+                        let mut forced = None;
                         if let Some(i) = mode.sliding {
                             // Drift correction: back onto the surface at the step end.
                             let (t, y) = self.stepper.current();
@@ -642,9 +646,24 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
                                 project(&self.system, i, t, &mut y);
                                 self.stepper.reset_state(t, y);
                             }
+                            // The equivalent control out of [0, 1] at a step end without an
+                            // exit event (after an exit was judged a touch): exit here.
+                            let a = rates(&self.system, i, &mode.sides, t, &y).alpha();
+                            let slack = lit::<T>(1e3) * self.settings.tangency;
+                            if a < -slack || a > T::one() + slack {
+                                forced = Some(S);
+                            }
                         }
+                        forced
                     }
-                    Some(Termination::TerminalEvent(k)) => {
+                    Some(Termination::TerminalEvent(k)) => Some(k),
+                    Some(_) => {
+                        stopped = true;
+                        break 'modes;
+                    }
+                };
+                if let Some(k) = terminal {
+                    {
                         let (t, y) = self.stepper.current();
                         let mut y = *y;
                         let (next, surface, kind) = self.next_mode(mode, k, t, &mut y)?;
@@ -679,10 +698,6 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
                             break 'modes;
                         }
                         continue 'modes;
-                    }
-                    Some(_) => {
-                        stopped = true;
-                        break 'modes;
                     }
                 }
             }

@@ -179,3 +179,120 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
         Ok(Monodromy { matrix: phi, run })
     }
 }
+
+/// A periodic orbit of a Filippov system found by shooting
+/// ([`FilippovSimulation::find_orbit`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SlidingOrbit<T: Real, const N: usize, const S: usize> {
+    /// A point of the orbit (at the start time).
+    pub state: SVector<T, N>,
+    /// The period.
+    pub period: T,
+    /// The monodromy over one period from `state`.
+    pub monodromy: Monodromy<T, N, S>,
+    /// Newton iterations taken.
+    pub iterations: usize,
+}
+
+impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
+    /// A periodic orbit through (near) `x0` at `t0` by Newton's method on the period map,
+    /// with the [`monodromy`](Self::monodromy) (variational equations and saltation
+    /// matrices through crossings and sliding) as its Jacobian.
+    ///
+    /// - `autonomous = false`: a forced system of period `period` (fixed);
+    ///   `(Φ − I)Δx = −(φ(x) − x)`.
+    /// - `autonomous = true`: the period is unknown too (`period` is the guess), and the
+    ///   phase is fixed by the section through `x0` normal to the field there:
+    ///   `[[Φ − I, F(φ)], [F(x₀)ᵀ, 0]] (Δx, ΔT) = −(φ(x) − x, F(x₀)·(x − x₀))`.
+    ///
+    /// Converged when the step is within `xtol·(1 + ‖x‖∞)`; at most `max_iter` iterations.
+    ///
+    /// # Errors
+    /// [`FilippovError::NoConvergence`], [`FilippovError::Singular`], a non-finite or
+    /// non-positive period ([`FilippovError::Run`] with a parameter error), and the errors
+    /// of the runs and of the monodromy.
+    #[allow(clippy::too_many_arguments)]
+    pub fn find_orbit<const N: usize, const S: usize, const M: usize>(
+        &mut self,
+        t0: T,
+        x0: SVector<T, N>,
+        period: T,
+        autonomous: bool,
+        tol: Tolerances<T, M>,
+        xtol: T,
+        max_iter: usize,
+    ) -> Result<SlidingOrbit<T, N, S>>
+    where
+        Sys: Filippov<T, N, S>,
+        St: Stepper<T, N>,
+    {
+        crate::validate::positive("period", period)?;
+        crate::validate::positive("xtol", xtol)?;
+        let mut x = x0;
+        let mut p = period;
+        // The section's normal: the field at the start.
+        let mode0 = self.mode_at(t0, &x0)?;
+        let mut normal = SVector::<T, N>::zeros();
+        ModeField {
+            sys: self.system(),
+            mode: mode0,
+            exit_samples: 0,
+        }
+        .eval(t0, &x0, &mut normal);
+        let dim = if autonomous { N + 1 } else { N };
+        let (mut residual, mut step) = (T::zero(), T::zero());
+        for it in 0..max_iter {
+            let mono = self.monodromy(t0, x, t0 + p, tol)?;
+            let r = mono.run.x - x;
+            residual = r.amax();
+            let mut a = nalgebra::DMatrix::<T>::zeros(dim, dim);
+            let mut b = nalgebra::DVector::<T>::zeros(dim);
+            for i in 0..N {
+                for j in 0..N {
+                    a[(i, j)] = mono.matrix[(i, j)];
+                }
+                a[(i, i)] -= T::one();
+                b[i] = -r[i];
+            }
+            if autonomous {
+                let mut f_end = SVector::<T, N>::zeros();
+                ModeField {
+                    sys: self.system(),
+                    mode: mono.run.mode,
+                    exit_samples: 0,
+                }
+                .eval(mono.run.t, &mono.run.x, &mut f_end);
+                for i in 0..N {
+                    a[(i, N)] = f_end[i];
+                    a[(N, i)] = normal[i];
+                }
+                b[N] = -normal.dot(&(x - x0));
+            }
+            let Some(d) = a.lu().solve(&b) else {
+                return Err(FilippovError::Singular { iteration: it });
+            };
+            step = d.amax();
+            for i in 0..N {
+                x[i] += d[i];
+            }
+            if autonomous {
+                p += d[N];
+                crate::validate::positive("period", p)?;
+            }
+            if step <= xtol * (T::one() + x.amax()) {
+                let monodromy = self.monodromy(t0, x, t0 + p, tol)?;
+                return Ok(SlidingOrbit {
+                    state: x,
+                    period: p,
+                    monodromy,
+                    iterations: it + 1,
+                });
+            }
+        }
+        Err(FilippovError::NoConvergence {
+            iterations: max_iter,
+            residual: crate::scalar::to_f64(residual),
+            step: crate::scalar::to_f64(step),
+        })
+    }
+}
