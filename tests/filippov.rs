@@ -937,3 +937,92 @@ fn grazing_sliding_of_the_belt_oscillator_is_located_by_its_test_function() {
     assert!(!slid_below && below > 0.0, "below: {below}");
     assert!(slid_above, "no sliding above the bifurcation");
 }
+
+// ---------------------------------------------------------------------------------------
+// The second-order tangency test.
+
+#[test]
+fn a_grazing_arrival_stays_in_its_region() {
+    // Below x₀ = 0: ẋ₀ = x₁, ẋ₁ = −1 from (−0.5 + δ, 1) rises δ = 1e-9 above the surface
+    // around t = 1, with normal velocity ±√(2δ) = ±4.5e-5 where it crosses, and turns
+    // back (L²H = −1). With the tangency tolerance at 1e-3 that arrival is a tangency,
+    // decided by the second-order test: it stays below. Above, the field pushes down
+    // (h₊ = −1), so a first-order decision would make it slide.
+    let delta = 1e-9;
+    let touch = Switched::new(
+        |x: &SVector<f64, 2>| x[0],
+        |_x: &SVector<f64, 2>| SVector::from([1.0, 0.0]),
+        |_t, x: &SVector<f64, 2>| SVector::from([x[1], -1.0]),
+        |_t, x: &SVector<f64, 2>| SVector::from([x[1] - 1.0, -1.0]),
+    );
+    let mut sim = FilippovSimulation::new(&touch, Dopri5::new(tol2()));
+    let mut settings = *sim.settings();
+    settings.tangency = 1e-3;
+    let mut sim = sim.with_settings(settings).unwrap();
+    let run = sim
+        .run(0.0, SVector::from([-0.5 + delta, 1.0]), 2.0, &mut ())
+        .unwrap();
+    assert_eq!(run.transitions.len(), 1, "{:?}", run.transitions);
+    let graze = run.transitions[0];
+    assert_eq!(graze.kind, TransitionKind::Graze);
+    assert!(
+        (graze.t - 1.0).abs() < 1e-4 && !graze.to.is_sliding(),
+        "{graze:?}"
+    );
+    assert_eq!(run.mode.sides, [Side::Minus]);
+    // x₀ = −0.5 + δ + t − t²/2, x₁ = 1 − t.
+    assert!(
+        (run.x[0] + 0.5 - delta).abs() < 1e-12 && (run.x[1] + 1.0).abs() < 1e-12,
+        "{:?}",
+        run.x
+    );
+    // With the default tolerance (1e-9) the same arrival is transversal: it slides, until
+    // the equivalent control α = x₁ reaches 0 at x₁ = 0, and leaves below.
+    let mut sim = FilippovSimulation::new(&touch, Dopri5::new(tol2()));
+    let run = sim
+        .run(0.0, SVector::from([-0.5 + delta, 1.0]), 2.0, &mut ())
+        .unwrap();
+    let kinds: Vec<TransitionKind> = run.transitions.iter().map(|tr| tr.kind).collect();
+    assert_eq!(
+        kinds,
+        [TransitionKind::SlidingEntry, TransitionKind::SlidingExit]
+    );
+}
+
+#[test]
+fn a_field_tangent_beyond_the_surface_that_turns_back_slides() {
+    // Below x₀ = 0: ẋ = (1, 0) reaches the surface at t = 1 with x₁ = 0. Above: ẋ = (x₁, −1)
+    // is tangent there (h₊ = x₁ = 0) and turns back (L²_{F₊}H = −1): the second-order test
+    // makes it slide, with α = 1/(1 − x₁), so ẋ₁ = −α and x₁ = 1 − √(1 + 2(t − 1)).
+    let system = Switched::new(
+        |x: &SVector<f64, 2>| x[0],
+        |_x: &SVector<f64, 2>| SVector::from([1.0, 0.0]),
+        |_t, _x: &SVector<f64, 2>| SVector::from([1.0, 0.0]),
+        |_t, x: &SVector<f64, 2>| SVector::from([x[1], -1.0]),
+    );
+    let mut sim = FilippovSimulation::new(system, Dopri5::new(tol2()));
+    let mut modes = Vec::new();
+    struct Names<'a>(&'a mut Vec<&'static str>);
+    impl nonsmooth::drive::Observer<f64, 2> for Names<'_> {
+        fn on_mode(&mut self, _t: f64, mode: &'static str) {
+            self.0.push(mode);
+        }
+    }
+    let mut plain = nonsmooth::filippov::Plain(Names(&mut modes));
+    let run = sim
+        .run(0.0, SVector::from([-1.0, 0.0]), 2.0, &mut plain)
+        .unwrap();
+    assert_eq!(run.transitions.len(), 1, "{:?}", run.transitions);
+    let entry = run.transitions[0];
+    assert_eq!(entry.kind, TransitionKind::SlidingEntry);
+    assert!((entry.t - 1.0).abs() < 1e-12, "{}", entry.t);
+    assert!(run.mode.is_sliding());
+    let x1 = 1.0 - 3.0_f64.sqrt();
+    assert!(
+        run.x[0].abs() < 1e-15 && (run.x[1] - x1).abs() < 1e-10,
+        "{:?}",
+        run.x
+    );
+    // The driver's observer saw the start mode and the mode change.
+    assert_eq!(modes, ["region", "sliding"]);
+}

@@ -663,42 +663,40 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
                     }
                 };
                 if let Some(k) = terminal {
-                    {
-                        let (t, y) = self.stepper.current();
-                        let mut y = *y;
-                        let (next, surface, kind) = self.next_mode(mode, k, t, &mut y)?;
-                        let last_t = transitions.last().map(|tr: &Transition<T, N, S>| tr.t);
-                        let stall_tol = self.settings.event_tol
-                            + lit::<T>(4.0) * T::default_epsilon() * t.abs();
-                        if last_t.is_some_and(|lt| (t - lt).abs() <= stall_tol) {
-                            stalls += 1;
-                            if stalls >= self.settings.max_stalls {
-                                return Err(FilippovError::NoProgress {
-                                    t: to_f64(t),
-                                    count: stalls,
-                                    mode: next.name(),
-                                });
-                            }
-                        } else {
-                            stalls = 0;
+                    let (t, y) = self.stepper.current();
+                    let mut y = *y;
+                    let (next, surface, kind) = self.next_mode(mode, k, t, &mut y)?;
+                    let last_t = transitions.last().map(|tr: &Transition<T, N, S>| tr.t);
+                    let stall_tol =
+                        self.settings.event_tol + lit::<T>(4.0) * T::default_epsilon() * t.abs();
+                    if last_t.is_some_and(|lt| (t - lt).abs() <= stall_tol) {
+                        stalls += 1;
+                        if stalls >= self.settings.max_stalls {
+                            return Err(FilippovError::NoProgress {
+                                t: to_f64(t),
+                                count: stalls,
+                                mode: next.name(),
+                            });
                         }
-                        let tr = Transition {
-                            t,
-                            x: y,
-                            surface,
-                            kind,
-                            from: mode,
-                            to: next,
-                        };
-                        transitions.push(tr);
-                        self.stepper.reset_state(t, y);
-                        mode = next;
-                        if observer.on_transition(&tr) == Control::Stop {
-                            stopped = true;
-                            break 'modes;
-                        }
-                        continue 'modes;
+                    } else {
+                        stalls = 0;
                     }
+                    let tr = Transition {
+                        t,
+                        x: y,
+                        surface,
+                        kind,
+                        from: mode,
+                        to: next,
+                    };
+                    transitions.push(tr);
+                    self.stepper.reset_state(t, y);
+                    mode = next;
+                    if observer.on_transition(&tr) == Control::Stop {
+                        stopped = true;
+                        break 'modes;
+                    }
+                    continue 'modes;
                 }
             }
         }
