@@ -955,7 +955,7 @@ fn a_grazing_arrival_stays_in_its_region() {
         |_t, x: &SVector<f64, 2>| SVector::from([x[1], -1.0]),
         |_t, x: &SVector<f64, 2>| SVector::from([x[1] - 1.0, -1.0]),
     );
-    let mut sim = FilippovSimulation::new(&touch, Dopri5::new(tol2()));
+    let sim = FilippovSimulation::new(&touch, Dopri5::new(tol2()));
     let mut settings = *sim.settings();
     settings.tangency = 1e-3;
     let mut sim = sim.with_settings(settings).unwrap();
