@@ -110,4 +110,4 @@ pub use run::{
     FilippovRun, FilippovSimulation, Plain, Settings, SlidingObserver, Transition, TransitionKind,
 };
 pub use system::{Filippov, Mode, Side, Switched};
-pub use tangent::{Monodromy, SlidingOrbit, saltation};
+pub use tangent::{Exponents, Monodromy, SlidingOrbit, saltation};
