@@ -781,6 +781,23 @@ impl Filippov<f64, 2, 2> for Corner {
     }
 }
 
+/// Two surfaces `x₀ = 0` (attracting: `ẋ₀ = −sgn x₀`) and `x₁ = 0` (`ẋ₁ = 1`).
+struct SlideIntoCorner;
+
+impl Filippov<f64, 2, 2> for SlideIntoCorner {
+    fn surface(&self, i: usize, _t: f64, x: &SVector<f64, 2>) -> f64 {
+        x[i]
+    }
+    fn gradient(&self, i: usize, _t: f64, _x: &SVector<f64, 2>) -> SVector<f64, 2> {
+        let mut g = SVector::zeros();
+        g[i] = 1.0;
+        g
+    }
+    fn field(&self, sides: &[Side; 2], _t: f64, _x: &SVector<f64, 2>, dx: &mut SVector<f64, 2>) {
+        *dx = SVector::from([-sides[0].sign::<f64>(), 1.0]);
+    }
+}
+
 #[test]
 fn two_surfaces_met_at_once_are_a_codimension_2_error() {
     let mut sim = FilippovSimulation::new(Corner, Dopri5::new(tol2()));
@@ -808,6 +825,17 @@ fn two_surfaces_met_at_once_are_a_codimension_2_error() {
     assert!((times[0].0 - 1.0).abs() < 1e-10 && times[0].1 == 0);
     assert!((times[1].0 - 1.5).abs() < 1e-10 && times[1].1 == 1);
     assert_eq!(run.mode.sides, [Side::Plus, Side::Plus]);
+    // Sliding on x₀ = 0 (both sides push into it) until x₁ = 0 is met at t = 2.
+    let mut sim = FilippovSimulation::new(SlideIntoCorner, Dopri5::new(tol2()));
+    match sim.run(0.0, SVector::from([-1.0, -2.0]), 3.0, &mut ()) {
+        Err(FilippovError::Codimension2 {
+            t, first, second, ..
+        }) => {
+            assert!((t - 2.0).abs() < 1e-9, "t = {t}");
+            assert_eq!((first, second), (0, 1));
+        }
+        other => panic!("expected a codimension-2 error, got {other:?}"),
+    }
     let msg = FilippovError::Codimension2 {
         t: 1.0,
         first: 0,

@@ -95,6 +95,17 @@ pub enum FilippovError {
         /// `H` (or the first non-finite gradient component).
         value: f64,
     },
+    /// A crossing with zero normal rate (a grazing decided by the second-order test): its
+    /// saltation matrix is unbounded, the monodromy does not exist.
+    #[error(
+        "the crossing of surface {surface} at t = {t} is tangential: its saltation matrix is unbounded (a grazing), the monodromy does not exist"
+    )]
+    GrazingSaltation {
+        /// Time.
+        t: f64,
+        /// The surface.
+        surface: usize,
+    },
     /// Newton's method for a periodic orbit did not converge.
     #[error(
         "periodic orbit: no convergence after {iterations} Newton iterations (residual {residual}, last step {step})"

@@ -55,6 +55,13 @@
 //!   into the surface's tangent space (`∇H·S = 0` for a linear surface): a multiplier 0;
 //! - sliding exit: `S = I` (`F_s = F_b` where `α` reaches its bound).
 //!
+//! [`FilippovSimulation::find_orbit`] finds periodic orbits with sliding segments by
+//! Newton's method on the period map with this monodromy as its Jacobian (a forced system's
+//! period, or an autonomous orbit's unknown period with a phase section), and
+//! [`FilippovSimulation::exponents`] the Lyapunov spectrum by re-orthonormalizing the
+//! monodromy of successive intervals. A sliding entry collapses the direction normal to
+//! the surface: a Floquet multiplier 0, a Lyapunov exponent `−∞`.
+//!
 //! While sliding, `J` is the Jacobian of the sliding field,
 //! $$ J_s = J_- + \alpha (J_+ - J_-) + (F_+ - F_-)\nabla\alpha^{\mathsf T}, \qquad
 //!    \nabla\alpha = \frac{h_-\nabla h_+ - h_+\nabla h_-}{(h_- - h_+)^2}, $$
@@ -65,6 +72,23 @@
 //! at `α = 0` versus `1`), `h±` at an arrival (a crossing turning into a sliding entry where
 //! `h₊` changes sign: crossing-sliding), and a [`TransitionKind::Graze`] (the minimum of
 //! `H` along a region's orbit reaching zero: grazing-sliding).
+//!
+//! # Dry friction: `StickSlip` is this path
+//! A mass whose coordinate rubs on a surface of velocity `u` with Coulomb friction of
+//! static limit equal to the kinetic force `F_k` is the Filippov system with the surface
+//! `H = w·q̇ − u` and the fields of slip with the friction force `∓F_k`: sticking is
+//! sliding on `H = 0`, the stick force is the equivalent control
+//! (`F = F_k(1 − 2α)`), and a stick ends where `α` reaches 0 or 1, i.e. where the force
+//! needed to hold reaches `F_k`. [`StickSlip`](crate::drive::StickSlip) with
+//! `F_s = F_k` gives the same modes at the same times (checked in the tests on a forced
+//! oscillator on a belt); with `F_s > F_k` (a static limit above the kinetic force) the
+//! law is not a Filippov convexification and `StickSlip` is the model.
+//!
+//! # Time dependence
+//! Fields and surfaces may depend on `t`. While the state slides (or sticks), it can stay
+//! nearly constant while the forcing changes, so a system with forcing declares its
+//! [`time_scale`](Filippov::time_scale) (e.g. a sixteenth of the forcing period): no step
+//! is longer, and the exit event cannot be stepped over.
 //!
 //! # Example
 //! ```

@@ -121,7 +121,8 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
     ///
     /// # Errors
     /// [`FilippovError::Dimension`] unless `M == N + N²`; the run's errors; the variational
-    /// integration's ([`FilippovError::Run`]).
+    /// integration's ([`FilippovError::Run`]); [`FilippovError::GrazingSaltation`] at a
+    /// crossing with zero normal rate.
     pub fn monodromy<const N: usize, const S: usize, const M: usize>(
         &mut self,
         t0: T,
@@ -172,6 +173,14 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
             }
             if let Some(tr) = tr {
                 let s = saltation(system, tr.surface, tr.kind, &tr.from, &tr.to, tr.t, &tr.x);
+                if !s.iter().all(|v| v.is_finite()) {
+                    // A crossing decided by the second-order test (h_a = 0): the saltation
+                    // matrix of a grazing is unbounded.
+                    return Err(FilippovError::GrazingSaltation {
+                        t: crate::scalar::to_f64(tr.t),
+                        surface: tr.surface,
+                    });
+                }
                 phi = s * phi;
                 seg_start = (tr.t, tr.to, tr.x);
             }
