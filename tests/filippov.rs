@@ -764,7 +764,7 @@ fn belt_oscillator_filippov_path_equals_stick_slip() {
 // Error paths and settings.
 
 /// Two surfaces `x₀ = 0`, `x₁ = 0` and the constant field (1, 1) in every quadrant.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 struct Corner;
 
 impl Filippov<f64, 2, 2> for Corner {
@@ -1076,4 +1076,19 @@ fn a_field_tangent_beyond_the_surface_that_turns_back_slides() {
     );
     // The driver's observer saw the start mode and the mode change.
     assert_eq!(modes, ["region", "sliding"]);
+}
+
+#[test]
+fn public_types_are_send_sync_clone() {
+    fn check<T: Send + Sync + Clone + std::fmt::Debug>() {}
+    check::<FilippovError>();
+    check::<nonsmooth::filippov::Settings<f64>>();
+    check::<Mode<2>>();
+    check::<Side>();
+    check::<Transition<f64, 3, 1>>();
+    check::<nonsmooth::filippov::FilippovRun<f64, 3, 1>>();
+    check::<nonsmooth::filippov::Monodromy<f64, 3, 1>>();
+    check::<nonsmooth::filippov::SlidingOrbit<f64, 3, 1>>();
+    check::<nonsmooth::filippov::Exponents<f64, 3>>();
+    check::<FilippovSimulation<f64, Corner, Dopri5<f64, 2>>>();
 }
