@@ -753,8 +753,39 @@ fn belt_oscillator_filippov_path_equals_stick_slip() {
         assert_eq!(g.1, w.1, "at t = {}", w.0);
         worst = worst.max((g.0 - w.0).abs());
     }
+    // The same system built from the parts (the Mechanical model and the Coulomb contact
+    // StickSlip runs): the same modes at the same times.
+    let parts = nonsmooth::filippov::DryFriction::new(&model, friction).unwrap();
+    let mut sim = FilippovSimulation::new(parts, Dopri5::new(tol2()));
+    let from_parts = sim.run(0.0, y0, t_end, &mut ()).unwrap();
+    let parts_modes: Vec<(f64, SlipMode)> = from_parts
+        .transitions
+        .iter()
+        .filter(|tr| tr.kind != TransitionKind::Graze)
+        .map(|tr| (tr.t, slip_mode(&tr.to)))
+        .collect();
+    assert_eq!(parts_modes.len(), want.len());
+    let mut worst_parts: f64 = 0.0;
+    for (g, w) in parts_modes.iter().zip(&want) {
+        assert_eq!(g.1, w.1, "at t = {}", w.0);
+        worst_parts = worst_parts.max((g.0 - w.0).abs());
+    }
+    assert!(
+        worst_parts < 1e-10,
+        "DryFriction vs StickSlip {worst_parts:e}"
+    );
+    // A static limit above the kinetic force is not a Filippov system.
+    let stiction = Coulomb::new(
+        Coordinate::dof(0).unwrap(),
+        Constant::new(BELT_U).unwrap(),
+        1.2,
+        1.0,
+    )
+    .unwrap();
+    let err = nonsmooth::filippov::DryFriction::new(&model, stiction).unwrap_err();
+    assert!(err.to_string().contains("1.2"), "{err}");
     println!(
-        "belt: {} transitions ({sticks} sticks), worst |Δt| Filippov vs StickSlip {worst:.2e}",
+        "belt: {} transitions ({sticks} sticks), worst |Δt| Filippov vs StickSlip {worst:.2e} (closures), {worst_parts:.2e} (DryFriction)",
         got.len()
     );
     assert!(worst < 1e-10, "stick/slip times differ by {worst:e}");

@@ -79,7 +79,9 @@
 //! `H = w·q̇ − u` and the fields of slip with the friction force `∓F_k`: sticking is
 //! sliding on `H = 0`, the stick force is the equivalent control
 //! (`F = F_k(1 − 2α)`), and a stick ends where `α` reaches 0 or 1, i.e. where the force
-//! needed to hold reaches `F_k`. [`StickSlip`](crate::drive::StickSlip) with
+//! needed to hold reaches `F_k`. [`DryFriction`] builds this system from a
+//! [`Mechanical`](crate::model::Mechanical) model and a
+//! [`Coulomb`](crate::drive::Coulomb) contact. [`StickSlip`](crate::drive::StickSlip) with
 //! `F_s = F_k` gives the same modes at the same times (checked in the tests on a forced
 //! oscillator on a belt); with `F_s > F_k` (a static limit above the kinetic force) the
 //! law is not a Filippov convexification and `StickSlip` is the model.
@@ -124,12 +126,14 @@
 mod approach;
 mod error;
 mod field;
+mod friction;
 mod run;
 mod system;
 mod tangent;
 
 pub use approach::Approach;
 pub use error::FilippovError;
+pub use friction::DryFriction;
 pub use run::{
     FilippovRun, FilippovSimulation, Plain, Settings, SlidingObserver, Transition, TransitionKind,
 };
