@@ -5,72 +5,48 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
-use nonsmooth::filippov::{Filippov, FilippovSimulation, Side, Switched};
+use nalgebra::{Matrix3, SVector, Vector3};
+use nonsmooth::filippov::{FilippovSimulation, LinearRelay, Switched};
 use nonsmooth::integrate::{Dopri5, Tolerances};
 
-/// The relay feedback system `ẋ = A x − B sgn(x₁)` (ζ = 0.05, ω = 25, σ = 1).
-struct Relay {
-    a: Matrix3<f64>,
-    b: Vector3<f64>,
+/// The relay feedback system `ẋ = A x − b sgn(x₁)` (ζ = 0.05, ω = 25, σ = 1).
+fn relay() -> LinearRelay<f64, 3> {
+    let (z, w, s) = (0.05, 25.0, 1.0);
+    let a = Matrix3::new(
+        -(2.0 * z * w + 1.0),
+        1.0,
+        0.0,
+        -(2.0 * z * w + w * w),
+        0.0,
+        1.0,
+        -w * w,
+        0.0,
+        0.0,
+    );
+    LinearRelay::new(
+        a,
+        Vector3::new(1.0, -2.0 * s, 1.0),
+        Vector3::new(1.0, 0.0, 0.0),
+    )
+    .expect("finite relay matrices")
 }
 
-impl Relay {
-    fn new() -> Self {
-        let (z, w, s) = (0.05, 25.0, 1.0);
-        Self {
-            a: Matrix3::new(
-                -(2.0 * z * w + 1.0),
-                1.0,
-                0.0,
-                -(2.0 * z * w + w * w),
-                0.0,
-                1.0,
-                -w * w,
-                0.0,
-                0.0,
-            ),
-            b: Vector3::new(1.0, -2.0 * s, 1.0),
-        }
-    }
-}
-
-impl Filippov<f64, 3, 1> for Relay {
-    fn surface(&self, _i: usize, _t: f64, x: &SVector<f64, 3>) -> f64 {
-        x[0]
-    }
-    fn gradient(&self, _i: usize, _t: f64, _x: &SVector<f64, 3>) -> SVector<f64, 3> {
-        SVector::from([1.0, 0.0, 0.0])
-    }
-    fn field(&self, sides: &[Side; 1], _t: f64, x: &SVector<f64, 3>, dx: &mut SVector<f64, 3>) {
-        *dx = self.a * x - self.b * sides[0].sign::<f64>();
-    }
-    fn field_jacobian(
-        &self,
-        _s: &[Side; 1],
-        _t: f64,
-        _x: &SVector<f64, 3>,
-    ) -> Option<SMatrix<f64, 3, 3>> {
-        Some(self.a)
-    }
-}
-
-fn relay(c: &mut Criterion) {
+fn relay_runs(c: &mut Criterion) {
     let tol = Tolerances::new(1e-10, 1e-12).unwrap();
     let x0 = SVector::from([0.0, -0.001, -0.02]);
     c.bench_function("filippov_relay_10s_rtol1e-10", |b| {
         b.iter(|| {
-            let mut sim = FilippovSimulation::new(Relay::new(), Dopri5::new(tol));
+            let mut sim = FilippovSimulation::new(relay(), Dopri5::new(tol));
             black_box(sim.run(0.0, black_box(x0), 10.0, &mut ()).unwrap())
         })
     });
     // A point of the orbit (after 40 s from x₀) and its period.
-    let mut sim = FilippovSimulation::new(Relay::new(), Dopri5::new(tol));
+    let mut sim = FilippovSimulation::new(relay(), Dopri5::new(tol));
     let run = sim.run(0.0, x0, 40.0, &mut ()).unwrap();
     let tol12 = Tolerances::<f64, 12>::new(1e-10, 1e-12).unwrap();
     c.bench_function("filippov_relay_monodromy_one_period", |b| {
         b.iter(|| {
-            let mut sim = FilippovSimulation::new(Relay::new(), Dopri5::new(tol));
+            let mut sim = FilippovSimulation::new(relay(), Dopri5::new(tol));
             black_box(
                 sim.monodromy(40.0, run.x, 40.0 + 5.961836942608, tol12)
                     .unwrap(),
@@ -100,5 +76,5 @@ fn belt(c: &mut Criterion) {
     });
 }
 
-criterion_group!(benches, relay, belt);
+criterion_group!(benches, relay_runs, belt);
 criterion_main!(benches);

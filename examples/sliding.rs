@@ -15,58 +15,35 @@
 use std::f64::consts::PI;
 use std::path::PathBuf;
 
-use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
+use nalgebra::{Matrix3, SVector, Vector3};
 use nonsmooth::drive::{Control, StepView};
 use nonsmooth::filippov::{
-    Approach, Filippov, FilippovSimulation, Mode, Side, SlidingObserver, Switched, TransitionKind,
+    Approach, Filippov, FilippovSimulation, LinearRelay, Mode, SlidingObserver, Switched,
+    TransitionKind,
 };
 use nonsmooth::integrate::{DenseOutput, Dopri5, Tolerances};
 use nonsmooth::output::csv::write_table_path;
 
-/// The relay feedback system `ẋ = A x − B sgn(x₁)` (ζ = 0.05, ω = 25, σ = 1).
-struct Relay {
-    a: Matrix3<f64>,
-    b: Vector3<f64>,
-}
-
-impl Relay {
-    fn new() -> Self {
-        let (z, w, s) = (0.05, 25.0, 1.0);
-        Self {
-            a: Matrix3::new(
-                -(2.0 * z * w + 1.0),
-                1.0,
-                0.0,
-                -(2.0 * z * w + w * w),
-                0.0,
-                1.0,
-                -w * w,
-                0.0,
-                0.0,
-            ),
-            b: Vector3::new(1.0, -2.0 * s, 1.0),
-        }
-    }
-}
-
-impl Filippov<f64, 3, 1> for Relay {
-    fn surface(&self, _i: usize, _t: f64, x: &SVector<f64, 3>) -> f64 {
-        x[0]
-    }
-    fn gradient(&self, _i: usize, _t: f64, _x: &SVector<f64, 3>) -> SVector<f64, 3> {
-        SVector::from([1.0, 0.0, 0.0])
-    }
-    fn field(&self, sides: &[Side; 1], _t: f64, x: &SVector<f64, 3>, dx: &mut SVector<f64, 3>) {
-        *dx = self.a * x - self.b * sides[0].sign::<f64>();
-    }
-    fn field_jacobian(
-        &self,
-        _s: &[Side; 1],
-        _t: f64,
-        _x: &SVector<f64, 3>,
-    ) -> Option<SMatrix<f64, 3, 3>> {
-        Some(self.a)
-    }
+/// The relay feedback system `ẋ = A x − b sgn(x₁)` (ζ = 0.05, ω = 25, σ = 1).
+fn relay() -> LinearRelay<f64, 3> {
+    let (z, w, s) = (0.05, 25.0, 1.0);
+    let a = Matrix3::new(
+        -(2.0 * z * w + 1.0),
+        1.0,
+        0.0,
+        -(2.0 * z * w + w * w),
+        0.0,
+        1.0,
+        -w * w,
+        0.0,
+        0.0,
+    );
+    LinearRelay::new(
+        a,
+        Vector3::new(1.0, -2.0 * s, 1.0),
+        Vector3::new(1.0, 0.0, 0.0),
+    )
+    .expect("finite relay matrices")
 }
 
 /// Dense samples `(t, x, sliding)` after `t_from`, and the largest `|x₁|` while sliding.
@@ -194,7 +171,7 @@ fn run() -> Result<(), String> {
 
     // The relay feedback system.
     let tol = Tolerances::new(1e-12, 1e-14).map_err(|e| e.to_string())?;
-    let mut sim = FilippovSimulation::new(Relay::new(), Dopri5::new(tol));
+    let mut sim = FilippovSimulation::new(relay(), Dopri5::new(tol));
     let x0 = SVector::from([0.0, -0.001, -0.02]);
     let mut samples = Samples {
         t_from: 34.0,

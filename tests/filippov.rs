@@ -363,6 +363,13 @@ fn relay_feedback_converges_to_its_sliding_orbit_with_the_exact_period_and_multi
         (period - exact_period).abs() < 1e-9,
         "period {period} vs exact {exact_period}"
     );
+    // The crate's LinearRelay is the same system: the same transitions, bit for bit.
+    let library =
+        nonsmooth::filippov::LinearRelay::new(relay_a(), relay_b(), Vector3::new(1.0, 0.0, 0.0))
+            .unwrap();
+    let mut lib_sim = FilippovSimulation::new(library, Dopri5::new(tol3()));
+    let lib_run = lib_sim.run(0.0, SVector::from(X0), t_end, &mut ()).unwrap();
+    assert_eq!(lib_run.transitions, run.transitions);
     // Refine the orbit point by following the exact flow further, then the monodromy
     // over one period from the middle of the first region piece after a sliding exit.
     let (_, piece, x_ref) = *want
@@ -924,6 +931,17 @@ fn repelling_surface_and_invalid_inputs_are_errors() {
     );
     // A wrong augmented dimension for the monodromy is named.
     let mut relay = FilippovSimulation::new(Relay::new(), Dopri5::new(tol3()));
+    let nan = nonsmooth::filippov::LinearRelay::new(
+        relay_a(),
+        Vector3::new(1.0, f64::NAN, 1.0),
+        Vector3::new(1.0, 0.0, 0.0),
+    )
+    .unwrap_err();
+    assert!(
+        nan.to_string().contains("b") && nan.to_string().contains("NaN"),
+        "{nan}"
+    );
+    assert!(nonsmooth::filippov::LinearRelay::new(relay_a(), relay_b(), Vector3::zeros()).is_err());
     match relay.monodromy(
         0.0,
         SVector::from([0.1, 0.0, 0.0]),

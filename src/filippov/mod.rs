@@ -127,6 +127,7 @@ mod approach;
 mod error;
 mod field;
 mod friction;
+mod relay;
 mod run;
 mod system;
 mod tangent;
@@ -134,6 +135,7 @@ mod tangent;
 pub use approach::Approach;
 pub use error::FilippovError;
 pub use friction::DryFriction;
+pub use relay::LinearRelay;
 pub use run::{
     FilippovRun, FilippovSimulation, Plain, Settings, SlidingObserver, Transition, TransitionKind,
 };
