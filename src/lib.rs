@@ -56,6 +56,7 @@ pub mod error;
 pub mod event;
 pub mod excite;
 pub mod fastmath;
+pub mod filippov;
 pub mod force;
 pub mod identify;
 pub mod integrate;

@@ -105,6 +105,16 @@ impl<T: Real, const N: usize, U: Excitation<T>> Coulomb<T, N, U> {
         self.coordinate.rate(&y.as_slice()[N..]) - self.surface_velocity.force(t)
     }
 
+    /// The coordinate the friction acts on.
+    pub fn coordinate(&self) -> &Coordinate<T, N> {
+        &self.coordinate
+    }
+
+    /// The surface velocity `u(t)`.
+    pub fn surface_velocity(&self) -> &U {
+        &self.surface_velocity
+    }
+
     /// The static limit `F_s`.
     pub fn static_limit(&self) -> T {
         self.static_limit

@@ -1,0 +1,295 @@
+//! Sliding motion in Filippov systems (`nonsmooth::filippov`):
+//! - the relay feedback system of di Bernardo, Johansson & Vasca (the test problem of
+//!   Piiroinen & Kuznetsov) from `x₀ = (0, −0.001, −0.02)`: its periodic orbit with sliding
+//!   segments, `|H|` while sliding, the period and the Floquet multipliers;
+//! - the dry-friction oscillator on a belt over the forcing amplitude: the bifurcation
+//!   diagram (largest velocity, fraction of time stuck) with the grazing-sliding point
+//!   located by a secant on its test function (the closest approach to the belt speed) and
+//!   marked.
+//!
+//! `cargo run --release --example sliding -- [--out DIR]`
+//!
+//! Writes `relay_orbit.csv`, `belt_diagram.csv` and `belt_bifurcation.csv` into
+//! `out/sliding`. Prints the checks; exits non-zero if one fails.
+
+use std::f64::consts::PI;
+use std::path::PathBuf;
+
+use nalgebra::{Matrix3, SVector, Vector3};
+use nonsmooth::drive::{Control, StepView};
+use nonsmooth::filippov::{
+    Approach, Filippov, FilippovSimulation, LinearRelay, Mode, SlidingObserver, Switched,
+    TransitionKind,
+};
+use nonsmooth::integrate::{DenseOutput, Dopri5, Tolerances};
+use nonsmooth::output::csv::write_table_path;
+
+/// The relay feedback system `ẋ = A x − b sgn(x₁)` (ζ = 0.05, ω = 25, σ = 1).
+fn relay() -> LinearRelay<f64, 3> {
+    let (z, w, s) = (0.05, 25.0, 1.0);
+    let a = Matrix3::new(
+        -(2.0 * z * w + 1.0),
+        1.0,
+        0.0,
+        -(2.0 * z * w + w * w),
+        0.0,
+        1.0,
+        -w * w,
+        0.0,
+        0.0,
+    );
+    LinearRelay::new(
+        a,
+        Vector3::new(1.0, -2.0 * s, 1.0),
+        Vector3::new(1.0, 0.0, 0.0),
+    )
+    .expect("finite relay matrices")
+}
+
+/// Dense samples `(t, x, sliding)` after `t_from`, and the largest `|x₁|` while sliding.
+struct Samples {
+    t_from: f64,
+    rows: Vec<[f64; 5]>,
+    worst_h: f64,
+}
+
+impl SlidingObserver<f64, 3, 1> for Samples {
+    fn on_step<D: DenseOutput<f64, 3>>(
+        &mut self,
+        mode: &Mode<1>,
+        step: &StepView<'_, f64, 3, D>,
+    ) -> Control {
+        let mut y = SVector::zeros();
+        for k in 0..8 {
+            let t = step.t0 + (step.t1 - step.t0) * k as f64 / 8.0;
+            step.state_at(t, &mut y);
+            if mode.is_sliding() {
+                self.worst_h = self.worst_h.max(y[0].abs());
+            }
+            if t >= self.t_from {
+                let s = if mode.is_sliding() { 1.0 } else { 0.0 };
+                self.rows.push([t, y[0], y[1], y[2], s]);
+            }
+        }
+        Control::Continue
+    }
+}
+
+/// The belt oscillator `ẍ + x = F₀ cos 2t − sgn(ẋ − 0.5)`.
+fn belt(f0: f64) -> impl Filippov<f64, 2, 1> {
+    Switched::new(
+        |x: &SVector<f64, 2>| x[1] - 0.5,
+        |_x: &SVector<f64, 2>| SVector::from([0.0, 1.0]),
+        move |t: f64, x: &SVector<f64, 2>| {
+            SVector::from([x[1], -x[0] + f0 * (2.0 * t).cos() + 1.0])
+        },
+        move |t: f64, x: &SVector<f64, 2>| {
+            SVector::from([x[1], -x[0] + f0 * (2.0 * t).cos() - 1.0])
+        },
+    )
+}
+
+/// Largest velocity and fraction of time stuck over the last `keep` of `periods` forcing
+/// periods from the pure-slip steady state, and the closest approach to the belt speed.
+fn belt_point(f0: f64, periods: f64, keep: f64) -> Result<(f64, f64, f64), String> {
+    struct Stats {
+        t_from: f64,
+        vmax: f64,
+        stuck: f64,
+    }
+    impl SlidingObserver<f64, 2, 1> for Stats {
+        fn on_step<D: DenseOutput<f64, 2>>(
+            &mut self,
+            mode: &Mode<1>,
+            step: &StepView<'_, f64, 2, D>,
+        ) -> Control {
+            if step.t1 <= self.t_from {
+                return Control::Continue;
+            }
+            let t0 = step.t0.max(self.t_from);
+            if mode.is_sliding() {
+                self.stuck += step.t1 - t0;
+            }
+            let mut y = SVector::zeros();
+            for k in 0..=8 {
+                step.state_at(t0 + (step.t1 - t0) * k as f64 / 8.0, &mut y);
+                self.vmax = self.vmax.max(y[1]);
+            }
+            Control::Continue
+        }
+    }
+    let system = belt(f0);
+    let period = PI; // 2π/ω, ω = 2
+    let t_from = (periods - keep) * period;
+    let mut obs = Pair(
+        Stats {
+            t_from,
+            vmax: f64::NEG_INFINITY,
+            stuck: 0.0,
+        },
+        Approach::new(&system, 0, t_from, 8),
+    );
+    let tol = Tolerances::new(1e-12, 1e-14).map_err(|e| e.to_string())?;
+    let mut sim = FilippovSimulation::new(&system, Dopri5::new(tol));
+    let x0 = SVector::from([1.0 - f0 / 3.0, 0.0]);
+    sim.run(0.0, x0, periods * period, &mut obs)
+        .map_err(|e| e.to_string())?;
+    let g = obs.1.value().ok_or("no approach recorded")?;
+    Ok((obs.0.vmax, obs.0.stuck / (keep * period), g))
+}
+
+/// Two observers in one.
+impl<A: SlidingObserver<f64, 2, 1>, B: SlidingObserver<f64, 2, 1>> SlidingObserver<f64, 2, 1>
+    for Pair<A, B>
+{
+    fn on_step<D: DenseOutput<f64, 2>>(
+        &mut self,
+        mode: &Mode<1>,
+        step: &StepView<'_, f64, 2, D>,
+    ) -> Control {
+        self.0.on_step(mode, step);
+        self.1.on_step(mode, step)
+    }
+}
+struct Pair<A, B>(A, B);
+
+fn main() {
+    if let Err(e) = run() {
+        eprintln!("sliding: {e}");
+        std::process::exit(1);
+    }
+}
+
+fn run() -> Result<(), String> {
+    let mut out = PathBuf::from("out/sliding");
+    let args: Vec<String> = std::env::args().collect();
+    if let Some(i) = args.iter().position(|a| a == "--out") {
+        out = PathBuf::from(args.get(i + 1).ok_or("--out needs a directory")?);
+    }
+    std::fs::create_dir_all(&out).map_err(|e| e.to_string())?;
+    let mut failures = Vec::new();
+
+    // The relay feedback system.
+    let tol = Tolerances::new(1e-12, 1e-14).map_err(|e| e.to_string())?;
+    let mut sim = FilippovSimulation::new(relay(), Dopri5::new(tol));
+    let x0 = SVector::from([0.0, -0.001, -0.02]);
+    let mut samples = Samples {
+        t_from: 34.0,
+        rows: Vec::new(),
+        worst_h: 0.0,
+    };
+    let run = sim
+        .run(0.0, x0, 40.0, &mut samples)
+        .map_err(|e| e.to_string())?;
+    let entries: Vec<f64> = run
+        .transitions
+        .iter()
+        .filter(|tr| tr.kind == TransitionKind::SlidingEntry)
+        .map(|tr| tr.t)
+        .collect();
+    // Each half period (the orbit is symmetric under x → −x) starts after a long region
+    // piece; the period spans two.
+    let marks: Vec<f64> = entries
+        .windows(2)
+        .filter(|w| w[1] - w[0] > 1.0)
+        .map(|w| w[1])
+        .collect();
+    let n = marks.len();
+    if n < 4 {
+        return Err(format!("relay: {n} half periods"));
+    }
+    let period = marks[n - 1] - marks[n - 3];
+    let drift = (period - (marks[n - 2] - marks[n - 4])).abs();
+    let per_period = entries
+        .iter()
+        .filter(|&&t| t >= marks[n - 3] && t < marks[n - 1])
+        .count();
+    println!(
+        "relay: period {period:.12} (change over the last period {drift:.1e}), {per_period} sliding segments per period, |H| while sliding ≤ {:.1e}",
+        samples.worst_h
+    );
+    let tol12 = Tolerances::<f64, 12>::new(1e-12, 1e-14).map_err(|e| e.to_string())?;
+    let start = run
+        .transitions
+        .iter()
+        .rev()
+        .find(|tr| tr.kind == TransitionKind::SlidingExit)
+        .ok_or("no sliding exit")?;
+    let mono = sim
+        .monodromy(start.t, start.x, start.t + period, tol12)
+        .map_err(|e| e.to_string())?;
+    let mus = mono.multipliers();
+    println!("relay: Floquet multipliers {mus:?}");
+    if samples.worst_h > 1e-12 {
+        failures.push(format!("|H| while sliding {:e} > 1e-12", samples.worst_h));
+    }
+    if drift > 1e-9 {
+        failures.push(format!("period not converged: {drift:e}"));
+    }
+    if !mus.iter().any(|m| (m - 1.0).norm() < 1e-6) || !mus.iter().any(|m| m.norm() < 1e-6) {
+        failures.push(format!(
+            "multipliers {mus:?} miss the trivial 1 and the sliding 0"
+        ));
+    }
+    write_table_path(
+        out.join("relay_orbit.csv"),
+        &["t", "x1", "x2", "x3", "sliding"],
+        samples.rows.iter().map(|r| r.iter().copied()),
+    )
+    .map_err(|e| e.to_string())?;
+
+    // The belt oscillator over F₀: the diagram and the grazing-sliding point.
+    let mut rows = Vec::new();
+    for k in 0..=90 {
+        let f0 = 0.3 + 0.01 * k as f64;
+        let (vmax, stuck, g) = belt_point(f0, 24.0, 4.0)?;
+        rows.push([f0, vmax, stuck, g]);
+    }
+    let (mut a, mut b) = (0.5, 0.6);
+    let (mut ga, mut gb) = (belt_point(a, 2.0, 2.0)?.2, belt_point(b, 2.0, 2.0)?.2);
+    for _ in 0..30 {
+        let c = b - gb * (b - a) / (gb - ga);
+        if (c - b).abs() < 1e-14 {
+            break;
+        }
+        (a, ga) = (b, gb);
+        b = c;
+        gb = belt_point(b, 2.0, 2.0)?.2;
+    }
+    let closed = 0.5 * 3.0 / 2.0; // u|1 − ω²|/ω
+    let below = belt_point(b * (1.0 - 1e-6), 2.0, 2.0)?;
+    let above = belt_point(b * (1.0 + 1e-6), 2.0, 2.0)?;
+    println!(
+        "belt: grazing-sliding at F₀ = {b:.13} (closed form {closed}), stuck fraction {:.1e} below, {:.1e} above",
+        below.1, above.1
+    );
+    if (b - closed).abs() > 1e-9 {
+        failures.push(format!("grazing-sliding at {b}, closed form {closed}"));
+    }
+    if below.1 != 0.0 || above.1 <= 0.0 {
+        failures.push("the sliding segment does not appear at the bifurcation".into());
+    }
+    write_table_path(
+        out.join("belt_diagram.csv"),
+        &["f0", "max_velocity", "stuck_fraction", "closest_approach"],
+        rows.iter().map(|r| r.iter().copied()),
+    )
+    .map_err(|e| e.to_string())?;
+    write_table_path(
+        out.join("belt_bifurcation.csv"),
+        &["kind", "f0", "closed_form"],
+        [[
+            nonsmooth::output::csv::Cell::Text("grazing-sliding"),
+            b.into(),
+            closed.into(),
+        ]],
+    )
+    .map_err(|e| e.to_string())?;
+    println!("wrote {}", out.display());
+    if failures.is_empty() {
+        println!("all checks passed");
+        Ok(())
+    } else {
+        Err(failures.join("; "))
+    }
+}
