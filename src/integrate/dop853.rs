@@ -5,10 +5,8 @@
 
 use nalgebra::SVector;
 
-use super::{
-    Controller, Core, DenseOutput, HermiteDense, IntegrateError, Stats, StepOptions, Stepper,
-    Tolerances, Trial, adaptive_checks, adaptive_constructors, core_accessors, dense_endpoints,
-};
+use super::adaptive::{Adaptive, Interpolant, Method, MethodDense, StepParts, sealed};
+use super::{HermiteDense, IntegrateError, Trial};
 use crate::scalar::lit;
 use crate::{Dynamics, Real};
 
@@ -244,32 +242,41 @@ const D: [[f64; 16]; 4] = [
 
 /// The explicit Runge–Kutta method DOP853 of Dormand and Prince (order 8, error estimated
 /// by combined 5th- and 3rd-order embedded formulas, 12 stages, FSAL) with its 7th-order
-/// dense output (three extra stages, computed only when a step is accepted).
+/// dense output (three extra stages, computed only when a step is accepted): the
+/// [`Adaptive`] stepper of [`Dop853Method`].
 ///
 /// # References
 /// E. Hairer, S. P. Nørsett, G. Wanner, *Solving ODEs I*, Sect. II.10 (DOP853).
-#[derive(Debug, Clone)]
-pub struct Dop853<T: Real, const N: usize> {
-    tol: Tolerances<T, N>,
-    ctrl: Controller<T>,
-    core: Core<T, N>,
-    dense: Dop853Dense<T, N>,
-}
+pub type Dop853<T, const N: usize> = Adaptive<T, N, Dop853Method>;
 
 /// Dense output of a [`Dop853`] step.
+pub type Dop853Dense<T, const N: usize> = MethodDense<T, N, Dop853Interpolant<T, N>>;
+
+/// The DOP853 method (see [`Dop853`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Dop853Method;
+
+/// The 7th-order continuous extension of a [`Dop853`] step (Hairer's `contd8`).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Dop853Dense<T: Real, const N: usize> {
-    ends: HermiteDense<T, N>,
+pub struct Dop853Interpolant<T: Real, const N: usize> {
     h: T,
     r: [SVector<T, N>; 7],
 }
 
-impl<T: Real, const N: usize> DenseOutput<T, N> for Dop853Dense<T, N> {
-    dense_endpoints!();
+impl sealed::Sealed for Dop853Method {}
+impl<T: Real, const N: usize> sealed::Sealed for Dop853Interpolant<T, N> {}
+
+impl<T: Real, const N: usize> Interpolant<T, N> for Dop853Interpolant<T, N> {
+    fn empty() -> Self {
+        Self {
+            h: T::zero(),
+            r: [SVector::zeros(); 7],
+        }
+    }
 
     #[inline(always)]
-    fn interpolate_unchecked(&self, t: T, out: &mut SVector<T, N>) {
-        let (t0, y0) = (self.ends.t0, &self.ends.y0);
+    fn eval(&self, ends: &HermiteDense<T, N>, t: T, out: &mut SVector<T, N>) {
+        let (t0, y0) = (ends.t0, &ends.y0);
         let s = (t - t0) / self.h;
         let s1 = T::one() - s;
         let r = &self.r;
@@ -280,96 +287,82 @@ impl<T: Real, const N: usize> DenseOutput<T, N> for Dop853Dense<T, N> {
     }
 }
 
-impl<T: Real, const N: usize> Dop853Dense<T, N> {
-    fn empty() -> Self {
-        Self {
-            ends: HermiteDense::zeros(),
-            h: T::zero(),
-            r: [SVector::zeros(); 7],
-        }
+/// Stage `i`: `k[i] = f(t + c_i h, y + h Σ a_ij k_j)`.
+#[inline(always)]
+fn stage<T: Real, const N: usize, S: Dynamics<T, N>>(
+    sys: &S,
+    t: T,
+    y: &SVector<T, N>,
+    h: T,
+    k: &mut [SVector<T, N>; 16],
+    i: usize,
+) {
+    let mut acc = SVector::<T, N>::zeros();
+    for &(j, a) in A[i] {
+        acc += k[j] * lit::<T>(a);
     }
+    let yt = y + acc * h;
+    let mut out = SVector::zeros();
+    sys.rhs(t + lit::<T>(C[i]) * h, &yt, &mut out);
+    k[i] = out;
 }
 
-adaptive_constructors!(Dop853, Dop853Dense, 8.0);
+impl<T: Real, const N: usize> Method<T, N> for Dop853Method {
+    const ORDER: u8 = 8;
+    const ERROR_ORDER: f64 = 8.0;
+    type Poly = Dop853Interpolant<T, N>;
 
-impl<T: Real, const N: usize> Dop853<T, N> {
-    #[inline(always)]
-    fn stage<S: Dynamics<T, N>>(
+    fn advance<S: Dynamics<T, N>>(
+        parts: StepParts<'_, T, N>,
         sys: &S,
-        t: T,
-        y: &SVector<T, N>,
-        h: T,
-        k: &mut [SVector<T, N>; 16],
-        i: usize,
-    ) {
-        let mut acc = SVector::<T, N>::zeros();
-        for &(j, a) in A[i] {
-            acc += k[j] * lit::<T>(a);
-        }
-        let yt = y + acc * h;
-        let mut out = SVector::zeros();
-        sys.rhs(t + lit::<T>(C[i]) * h, &yt, &mut out);
-        k[i] = out;
-    }
-}
-
-impl<T: Real, const N: usize> Stepper<T, N> for Dop853<T, N> {
-    type Dense = Dop853Dense<T, N>;
-
-    core_accessors!();
-    adaptive_checks!();
-
-    fn step<S: Dynamics<T, N>>(&mut self, sys: &S, t_limit: T) -> Result<(), IntegrateError> {
-        self.core.begin(sys, t_limit)?;
-        let (t, y) = (self.core.t, self.core.y);
-        let h = self
-            .core
-            .proposed(sys, 8, &self.tol, self.ctrl.opts.h_max, t_limit);
+        t_limit: T,
+    ) -> Result<Dop853Dense<T, N>, IntegrateError> {
+        let StepParts { tol, ctrl, core } = parts;
+        core.begin(sys, t_limit)?;
+        let (t, y) = (core.t, core.y);
+        let h = core.proposed(sys, 8, tol, ctrl.opts.h_max, t_limit);
         let mut k = [SVector::<T, N>::zeros(); 16];
-        k[0] = self.core.f;
-        let tol = &self.tol;
-        let a = self
-            .core
-            .adapt(&mut self.ctrl, t_limit, h, |stats, hs, t_new| {
-                for i in 1..12 {
-                    Self::stage(sys, t, &y, hs, &mut k, i);
+        k[0] = core.f;
+        let a = core.adapt(ctrl, t_limit, h, |stats, hs, t_new| {
+            for i in 1..12 {
+                stage(sys, t, &y, hs, &mut k, i);
+            }
+            let mut inc = SVector::<T, N>::zeros();
+            for &(j, a) in A[12] {
+                inc += k[j] * lit::<T>(a);
+            }
+            let y_new = y + inc * hs;
+            let mut f_new = SVector::zeros();
+            sys.rhs(t_new, &y_new, &mut f_new);
+            stats.rhs_evals += 12;
+            Ok(Trial::new(y_new, f_new, || {
+                let mut e3 = inc;
+                for &(j, b) in &BHH {
+                    e3 -= k[j] * lit::<T>(b);
                 }
-                let mut inc = SVector::<T, N>::zeros();
-                for &(j, a) in A[12] {
-                    inc += k[j] * lit::<T>(a);
+                let mut e5 = SVector::<T, N>::zeros();
+                for &(j, e) in &E5 {
+                    e5 += k[j] * lit::<T>(e);
                 }
-                let y_new = y + inc * hs;
-                let mut f_new = SVector::zeros();
-                sys.rhs(t_new, &y_new, &mut f_new);
-                stats.rhs_evals += 12;
-                Ok(Trial::new(y_new, f_new, || {
-                    let mut e3 = inc;
-                    for &(j, b) in &BHH {
-                        e3 -= k[j] * lit::<T>(b);
-                    }
-                    let mut e5 = SVector::<T, N>::zeros();
-                    for &(j, e) in &E5 {
-                        e5 += k[j] * lit::<T>(e);
-                    }
-                    let (mut s5, mut s3) = (T::zero(), T::zero());
-                    for i in 0..N {
-                        let sk = tol.atol[i] + tol.rtol[i] * y[i].abs().max(y_new[i].abs());
-                        s3 += (e3[i] / sk) * (e3[i] / sk);
-                        s5 += (e5[i] / sk) * (e5[i] / sk);
-                    }
-                    let mut deno = s5 + lit::<T>(0.01) * s3;
-                    if deno <= T::zero() {
-                        deno = T::one();
-                    }
-                    hs.abs() * s5 * (T::one() / (lit::<T>(N as f64) * deno)).sqrt()
-                }))
-            })?;
+                let (mut s5, mut s3) = (T::zero(), T::zero());
+                for i in 0..N {
+                    let sk = tol.atol[i] + tol.rtol[i] * y[i].abs().max(y_new[i].abs());
+                    s3 += (e3[i] / sk) * (e3[i] / sk);
+                    s5 += (e5[i] / sk) * (e5[i] / sk);
+                }
+                let mut deno = s5 + lit::<T>(0.01) * s3;
+                if deno <= T::zero() {
+                    deno = T::one();
+                }
+                hs.abs() * s5 * (T::one() / (lit::<T>(N as f64) * deno)).sqrt()
+            }))
+        })?;
         let (hs, y_new, f_new) = (a.hs, a.y, a.f);
         k[12] = f_new;
         for i in 13..16 {
-            Self::stage(sys, t, &y, hs, &mut k, i);
+            stage(sys, t, &y, hs, &mut k, i);
         }
-        self.core.stats.rhs_evals += 3;
+        core.stats.rhs_evals += 3;
         let ydiff = y_new - y;
         let bspl = k[0] * hs - ydiff;
         let mut r = [SVector::<T, N>::zeros(); 7];
@@ -385,16 +378,11 @@ impl<T: Real, const N: usize> Stepper<T, N> for Dop853<T, N> {
             }
             r[3 + m] = acc * hs;
         }
-        self.dense = Dop853Dense {
+        let dense = MethodDense {
             ends: HermiteDense::new(t, a.t_new, y, y_new, k[0], f_new),
-            h: hs,
-            r,
+            poly: Dop853Interpolant { h: hs, r },
         };
-        self.core.accept(&a);
-        Ok(())
-    }
-
-    fn order(&self) -> u8 {
-        8
+        core.accept(&a);
+        Ok(dense)
     }
 }

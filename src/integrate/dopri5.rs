@@ -2,10 +2,8 @@
 
 use nalgebra::SVector;
 
-use super::{
-    Controller, Core, DenseOutput, HermiteDense, IntegrateError, Stats, StepOptions, Stepper,
-    Tolerances, Trial, adaptive_checks, adaptive_constructors, core_accessors, dense_endpoints,
-};
+use super::adaptive::{Adaptive, Interpolant, Method, MethodDense, StepParts, sealed};
+use super::{HermiteDense, IntegrateError, Trial};
 use crate::scalar::lit;
 use crate::{Dynamics, Real};
 
@@ -63,23 +61,24 @@ pub(crate) mod tableau {
 
 /// The explicit Runge–Kutta method of Dormand and Prince, order 5 with an embedded order-4
 /// error estimate, first-same-as-last (6 evaluations per accepted step), and Hairer's
-/// 4th-order dense output.
+/// 4th-order dense output: the [`Adaptive`] stepper of [`Dopri5Method`].
 ///
 /// # References
 /// J. R. Dormand, P. J. Prince, *A family of embedded Runge–Kutta formulae*, J. Comput.
 /// Appl. Math. 6 (1980); E. Hairer, S. P. Nørsett, G. Wanner, *Solving ODEs I*, II.5–II.6.
-#[derive(Debug, Clone)]
-pub struct Dopri5<T: Real, const N: usize> {
-    tol: Tolerances<T, N>,
-    ctrl: Controller<T>,
-    core: Core<T, N>,
-    dense: Dopri5Dense<T, N>,
-}
+pub type Dopri5<T, const N: usize> = Adaptive<T, N, Dopri5Method>;
 
 /// Dense output of a [`Dopri5`] step.
+pub type Dopri5Dense<T, const N: usize> = MethodDense<T, N, Dopri5Interpolant<T, N>>;
+
+/// The Dormand–Prince 5(4) method (see [`Dopri5`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Dopri5Method;
+
+/// Hairer's 4th-order continuous extension of a [`Dopri5`] step:
+/// `y(t0 + θh) = y0 + θ(r2 + (1−θ)(r3 + θ(r4 + (1−θ)r5)))`.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Dopri5Dense<T: Real, const N: usize> {
-    ends: HermiteDense<T, N>,
+pub struct Dopri5Interpolant<T: Real, const N: usize> {
     h: T,
     r2: SVector<T, N>,
     r3: SVector<T, N>,
@@ -87,11 +86,13 @@ pub struct Dopri5Dense<T: Real, const N: usize> {
     r5: SVector<T, N>,
 }
 
-impl<T: Real, const N: usize> Dopri5Dense<T, N> {
+impl sealed::Sealed for Dopri5Method {}
+impl<T: Real, const N: usize> sealed::Sealed for Dopri5Interpolant<T, N> {}
+
+impl<T: Real, const N: usize> Interpolant<T, N> for Dopri5Interpolant<T, N> {
     fn empty() -> Self {
         let z = SVector::zeros();
         Self {
-            ends: HermiteDense::zeros(),
             h: T::zero(),
             r2: z,
             r3: z,
@@ -99,14 +100,10 @@ impl<T: Real, const N: usize> Dopri5Dense<T, N> {
             r5: z,
         }
     }
-}
-
-impl<T: Real, const N: usize> DenseOutput<T, N> for Dopri5Dense<T, N> {
-    dense_endpoints!();
 
     #[inline(always)]
-    fn interpolate_unchecked(&self, t: T, out: &mut SVector<T, N>) {
-        let (t0, y0) = (self.ends.t0, &self.ends.y0);
+    fn eval(&self, ends: &HermiteDense<T, N>, t: T, out: &mut SVector<T, N>) {
+        let (t0, y0) = (ends.t0, &ends.y0);
         let th = (t - t0) / self.h;
         let th1 = T::one() - th;
         for i in 0..N {
@@ -116,20 +113,20 @@ impl<T: Real, const N: usize> DenseOutput<T, N> for Dopri5Dense<T, N> {
     }
 }
 
-adaptive_constructors!(Dopri5, Dopri5Dense, 5.0);
+impl<T: Real, const N: usize> Method<T, N> for Dopri5Method {
+    const ORDER: u8 = 5;
+    const ERROR_ORDER: f64 = 5.0;
+    type Poly = Dopri5Interpolant<T, N>;
 
-impl<T: Real, const N: usize> Stepper<T, N> for Dopri5<T, N> {
-    type Dense = Dopri5Dense<T, N>;
-
-    core_accessors!();
-    adaptive_checks!();
-
-    fn step<S: Dynamics<T, N>>(&mut self, sys: &S, t_limit: T) -> Result<(), IntegrateError> {
-        self.core.begin(sys, t_limit)?;
-        let (t, y, k1) = (self.core.t, self.core.y, self.core.f);
-        let h = self
-            .core
-            .proposed(sys, 5, &self.tol, self.ctrl.opts.h_max, t_limit);
+    fn advance<S: Dynamics<T, N>>(
+        parts: StepParts<'_, T, N>,
+        sys: &S,
+        t_limit: T,
+    ) -> Result<Dopri5Dense<T, N>, IntegrateError> {
+        let StepParts { tol, ctrl, core } = parts;
+        core.begin(sys, t_limit)?;
+        let (t, y, k1) = (core.t, core.y, core.f);
+        let h = core.proposed(sys, 5, tol, ctrl.opts.h_max, t_limit);
         let c = |x: f64| lit::<T>(x);
         let a21 = c(1.0 / 5.0);
         let [a31, a32] = tableau::A3.map(c);
@@ -145,45 +142,40 @@ impl<T: Real, const N: usize> Stepper<T, N> for Dopri5<T, N> {
         let mut k5 = SVector::zeros();
         let mut k6 = SVector::zeros();
         let mut k7 = SVector::zeros();
-        let tol = &self.tol;
-        let a = self
-            .core
-            .adapt(&mut self.ctrl, t_limit, h, |stats, hs, t_new| {
-                let yt = y + k1 * (a21 * hs);
-                sys.rhs(t + c2 * hs, &yt, &mut k2);
-                let yt = y + (k1 * a31 + k2 * a32) * hs;
-                sys.rhs(t + c3 * hs, &yt, &mut k3);
-                let yt = y + (k1 * a41 + k2 * a42 + k3 * a43) * hs;
-                sys.rhs(t + c4 * hs, &yt, &mut k4);
-                let yt = y + (k1 * a51 + k2 * a52 + k3 * a53 + k4 * a54) * hs;
-                sys.rhs(t + c5 * hs, &yt, &mut k5);
-                let yt = y + (k1 * a61 + k2 * a62 + k3 * a63 + k4 * a64 + k5 * a65) * hs;
-                sys.rhs(t_new, &yt, &mut k6);
-                let y_new = y + (k1 * a71 + k3 * a73 + k4 * a74 + k5 * a75 + k6 * a76) * hs;
-                sys.rhs(t_new, &y_new, &mut k7);
-                stats.rhs_evals += 6;
-                Ok(Trial::new(y_new, k7, || {
-                    let errv = (k1 * e1 + k3 * e3 + k4 * e4 + k5 * e5 + k6 * e6 + k7 * e7) * hs;
-                    tol.error_norm(&errv, &y, &y_new)
-                }))
-            })?;
+        let a = core.adapt(ctrl, t_limit, h, |stats, hs, t_new| {
+            let yt = y + k1 * (a21 * hs);
+            sys.rhs(t + c2 * hs, &yt, &mut k2);
+            let yt = y + (k1 * a31 + k2 * a32) * hs;
+            sys.rhs(t + c3 * hs, &yt, &mut k3);
+            let yt = y + (k1 * a41 + k2 * a42 + k3 * a43) * hs;
+            sys.rhs(t + c4 * hs, &yt, &mut k4);
+            let yt = y + (k1 * a51 + k2 * a52 + k3 * a53 + k4 * a54) * hs;
+            sys.rhs(t + c5 * hs, &yt, &mut k5);
+            let yt = y + (k1 * a61 + k2 * a62 + k3 * a63 + k4 * a64 + k5 * a65) * hs;
+            sys.rhs(t_new, &yt, &mut k6);
+            let y_new = y + (k1 * a71 + k3 * a73 + k4 * a74 + k5 * a75 + k6 * a76) * hs;
+            sys.rhs(t_new, &y_new, &mut k7);
+            stats.rhs_evals += 6;
+            Ok(Trial::new(y_new, k7, || {
+                let errv = (k1 * e1 + k3 * e3 + k4 * e4 + k5 * e5 + k6 * e6 + k7 * e7) * hs;
+                tol.error_norm(&errv, &y, &y_new)
+            }))
+        })?;
         let (hs, y_new) = (a.hs, a.y);
         let ydiff = y_new - y;
         let bspl = k1 * hs - ydiff;
         let [d1, d3, d4, d5, d6, d7] = tableau::D.map(c);
-        self.dense = Dopri5Dense {
+        let dense = MethodDense {
             ends: HermiteDense::new(t, a.t_new, y, y_new, k1, k7),
-            h: hs,
-            r2: ydiff,
-            r3: bspl,
-            r4: ydiff - k7 * hs - bspl,
-            r5: (k1 * d1 + k3 * d3 + k4 * d4 + k5 * d5 + k6 * d6 + k7 * d7) * hs,
+            poly: Dopri5Interpolant {
+                h: hs,
+                r2: ydiff,
+                r3: bspl,
+                r4: ydiff - k7 * hs - bspl,
+                r5: (k1 * d1 + k3 * d3 + k4 * d4 + k5 * d5 + k6 * d6 + k7 * d7) * hs,
+            },
         };
-        self.core.accept(&a);
-        Ok(())
-    }
-
-    fn order(&self) -> u8 {
-        5
+        core.accept(&a);
+        Ok(dense)
     }
 }

@@ -22,16 +22,20 @@
 //! fall below `StepOptions::h_min` or below `16·ε_mach·|t|`, never because rejections
 //! accumulated over a long run.
 
+mod adaptive;
 mod dop853;
 pub(crate) mod dopri5;
 mod rk4;
 mod rosenbrock;
 pub mod turning;
 
-pub use dop853::{Dop853, Dop853Dense};
-pub use dopri5::{Dopri5, Dopri5Dense};
+pub use adaptive::{Adaptive, Interpolant, Method, MethodDense};
+pub use dop853::{Dop853, Dop853Dense, Dop853Interpolant, Dop853Method};
+pub use dopri5::{Dopri5, Dopri5Dense, Dopri5Interpolant, Dopri5Method};
 pub use rk4::{HermiteDense, Rk4};
-pub use rosenbrock::{Rosenbrock23, Rosenbrock23Dense};
+pub use rosenbrock::{
+    Rosenbrock23, Rosenbrock23Dense, Rosenbrock23Interpolant, Rosenbrock23Method,
+};
 pub use turning::{SegmentCounts, TurningDense, TurningPoints};
 
 use nalgebra::SVector;
@@ -482,24 +486,6 @@ pub trait Stepper<T: Real, const N: usize> {
     }
 }
 
-/// `check` and `max_step` of the adaptive steppers `{ tol, ctrl, .. }`.
-macro_rules! adaptive_checks {
-    () => {
-        fn check(&self) -> Result<(), IntegrateError> {
-            self.tol
-                .validate()
-                .and_then(|()| self.ctrl.opts.validate())
-                .map_err(IntegrateError::InvalidSettings)
-        }
-
-        fn max_step(&self) -> Option<T> {
-            let h = self.ctrl.opts.h_max;
-            (h.is_finite() && h > T::zero()).then_some(h)
-        }
-    };
-}
-pub(crate) use adaptive_checks;
-
 /// `true` if a trial step `hs` from `t` is below the minimum or does not advance `t` at all
 /// in floating point (`t + hs == t`, or `hs` NaN): the step fails instead of looping.
 #[inline(always)]
@@ -694,86 +680,6 @@ pub(crate) struct Accepted<T: Real, const N: usize> {
     pub(crate) y: SVector<T, N>,
     pub(crate) f: SVector<T, N>,
 }
-
-/// The accessors every stepper implements the same way from its `core` and `dense` fields.
-macro_rules! core_accessors {
-    () => {
-        fn reset_state(&mut self, t: T, y: SVector<T, N>) {
-            self.core.reset(t, y);
-        }
-
-        fn current(&self) -> (T, &SVector<T, N>) {
-            (self.core.t, &self.core.y)
-        }
-
-        fn dense(&self) -> &Self::Dense {
-            &self.dense
-        }
-
-        fn stats(&self) -> &Stats {
-            &self.core.stats
-        }
-
-        fn stats_mut(&mut self) -> &mut Stats {
-            &mut self.core.stats
-        }
-    };
-}
-pub(crate) use core_accessors;
-
-/// The constructors and getters every adaptive stepper `$stepper { tol, ctrl, core, dense }`
-/// shares; `$dense::empty()` is its dense output before the first step, `$order` the order
-/// of its error estimate (for the controller's exponent).
-macro_rules! adaptive_constructors {
-    ($stepper:ident, $dense:ident, $order:expr) => {
-        impl<T: Real, const N: usize> $stepper<T, N> {
-            /// A stepper with the given tolerances and default [`StepOptions`].
-            pub fn new(tol: Tolerances<T, N>) -> Self {
-                Self::with_options(tol, StepOptions::default())
-            }
-
-            /// A stepper with explicit step options.
-            pub fn with_options(tol: Tolerances<T, N>, opts: StepOptions<T>) -> Self {
-                Self {
-                    tol,
-                    ctrl: Controller::new(opts, lit($order)),
-                    core: Core::new(opts.h_init),
-                    dense: $dense::empty(),
-                }
-            }
-
-            /// The tolerances.
-            pub fn tolerances(&self) -> &Tolerances<T, N> {
-                &self.tol
-            }
-
-            /// The step size the controller proposes next.
-            pub fn proposed_step(&self) -> Option<T> {
-                self.core.h
-            }
-        }
-    };
-}
-pub(crate) use adaptive_constructors;
-
-/// The end-point accessors of a dense output that keeps its step's ends in an
-/// `ends: HermiteDense` field.
-macro_rules! dense_endpoints {
-    () => {
-        fn span(&self) -> (T, T) {
-            self.ends.span()
-        }
-
-        fn endpoints(&self) -> (&SVector<T, N>, &SVector<T, N>) {
-            self.ends.endpoints()
-        }
-
-        fn end_derivatives(&self) -> (&SVector<T, N>, &SVector<T, N>) {
-            self.ends.end_derivatives()
-        }
-    };
-}
-pub(crate) use dense_endpoints;
 
 /// PI step-size controller state (shared by the embedded methods).
 #[derive(Debug, Clone, Copy, PartialEq)]

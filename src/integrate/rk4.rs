@@ -2,9 +2,7 @@
 
 use nalgebra::SVector;
 
-use super::{
-    Accepted, Core, DenseOutput, IntegrateError, Stats, Stepper, all_finite, core_accessors,
-};
+use super::{Accepted, Core, DenseOutput, IntegrateError, Stats, Stepper, all_finite};
 use crate::scalar::{lit, to_f64};
 use crate::validate::ParameterError;
 use crate::validate::positive;
@@ -115,7 +113,25 @@ impl<T: Real, const N: usize> Rk4<T, N> {
 impl<T: Real, const N: usize> Stepper<T, N> for Rk4<T, N> {
     type Dense = HermiteDense<T, N>;
 
-    core_accessors!();
+    fn reset_state(&mut self, t: T, y: SVector<T, N>) {
+        self.core.reset(t, y);
+    }
+
+    fn current(&self) -> (T, &SVector<T, N>) {
+        (self.core.t, &self.core.y)
+    }
+
+    fn dense(&self) -> &Self::Dense {
+        &self.dense
+    }
+
+    fn stats(&self) -> &Stats {
+        &self.core.stats
+    }
+
+    fn stats_mut(&mut self) -> &mut Stats {
+        &mut self.core.stats
+    }
 
     fn step<S: Dynamics<T, N>>(&mut self, sys: &S, t_limit: T) -> Result<(), IntegrateError> {
         self.core.begin(sys, t_limit)?;
