@@ -77,6 +77,7 @@ pub mod sweep;
 pub mod systems;
 #[cfg(feature = "testing")]
 pub mod testing;
+pub mod timestep;
 pub(crate) mod validate;
 
 pub use dynamics::{Dynamics, LaneByLane, LaneDynamics};
