@@ -744,10 +744,10 @@ fn ball_on_a_vibrating_table_agrees_with_the_event_driven_engine() {
             let r_ed = *log
                 .release
                 .iter()
-                .filter(|&&t| t <= t_end - 10.0)
-                .last()
+                .rev()
+                .find(|&&t| t <= t_end - 10.0)
                 .unwrap();
-            let r_ts = *ends.iter().filter(|&&t| t <= t_end - 10.0).last().unwrap();
+            let r_ts = *ends.iter().rev().find(|&&t| t <= t_end - 10.0).unwrap();
             let shift = ((r_ed - r_ts) / period).round() * period;
             let seq_ed: Vec<f64> = ed.0.iter().copied().filter(|&t| t > r_ed).collect();
             let seq_ts: Vec<f64> = ts.iter().map(|t| t + shift).filter(|&t| t > r_ed).collect();

@@ -24,14 +24,14 @@
 //! answer.
 //!
 //! # Which solver
-//! - [`Lemke`]: exact (to rounding: the final basis is re-solved by an LU factorization)
+//! - [`Lemke`] is exact (to rounding: the final basis is re-solved by an LU factorization)
 //!   for any `M` for which the method terminates — every P-matrix, hence every symmetric
 //!   positive-definite Delassus matrix; the cost is a pivot count times `O(n²)`,
 //!   usually a few times `n` pivots, exponential in the worst case (Murty's family).
-//! - [`Pgs`]: projected Gauss–Seidel, `O(n²)` per sweep; converges for symmetric
+//! - [`Pgs`], projected Gauss–Seidel, `O(n²)` per sweep; converges for symmetric
 //!   positive-definite `M` (a column or chain of contacts), linearly, slowly when `M` is
 //!   ill-conditioned. Warm-started from the `z` it is given.
-//! - [`Nsgs`]: the block version of PGS for frictional contacts, each 2×2 block solved
+//! - [`Nsgs`], the block version of PGS for frictional contacts, each 2×2 block solved
 //!   exactly (take-off, stick, or slide in either direction).
 //!
 //! # References
@@ -383,7 +383,7 @@ impl<T: Real> Lemke<T> {
         }
         let mut res = residual_unchecked(m, q, z);
         if let Some(polished) = self.polish(m, q, z) {
-            if polished < res || !(res == res) {
+            if polished < res || !(res >= T::zero()) {
                 res = polished;
                 z[..n].copy_from_slice(&self.trial[..n]);
             }

@@ -7,22 +7,22 @@
 //!
 //! # Model
 //! A Lagrangian system ([`Lagrangian`]) with unilateral contacts ([`Contact`]):
-//! $$ M(q)\,\mathrm dv = f(t, q, v)\,\mathrm dt + \sum_i \nabla g_i(q)\,\mathrm dP_{n,i}
-//!    + t_i(q)\,\mathrm dP_{t,i},\qquad g_i(q, t) \ge 0, $$
+//! $$ M(q)\,\mathrm dv = f(t, q, v)\,\mathrm dt + \sum_i \big(\nabla g_i(q)\,\mathrm dP_{n,i} +
+//!    t_i(q)\,\mathrm dP_{t,i}\big),\qquad g_i(q, t) \ge 0, $$
 //! with Newton's impact law and Coulomb friction at each contact in Moreau's velocity form:
 //! $$ 0 \le \dot g_i^+ + e_i \dot g_i^- \;\perp\; P_{n,i} \ge 0 \quad(\text{while } g_i \le 0),
 //!    \qquad |P_{t,i}| \le \mu_i P_{n,i},\; P_{t,i} = -\mu_i P_{n,i}\operatorname{sgn}(u_{t,i}). $$
 //!
 //! # Scheme ([`MoreauJean`])
 //! On the grid `t_k = t₀ + k h`, with `θ ∈ [½, 1]` (default ½) and `γ = ½`:
-//! 1. free velocity: $v_{\rm free} = v_k + h M^{-1}\big((1-\theta) f(t_k, q_k, v_k)
-//!    + \theta f(t_{k+1}, q_k + h v_k, v_k)\big)$ (the forces θ-weighted, explicitly);
+//! 1. free velocity: $v_{\rm free} = v_k + h M^{-1}\big((1-\theta) f(t_k, q_k, v_k) +
+//!    \theta f(t_{k+1}, q_k + h v_k, v_k)\big)$ (the forces θ-weighted, explicitly);
 //! 2. active set: contact `i` enters the step's problem if its predicted gap
 //!    $g_i(q_k, t_k) + \gamma h \dot g_i^-\le 0$, $\dot g_i^- = \nabla g_i\cdot v_k + \partial_t g_i$;
 //! 3. one complementarity problem for the impulses $p$ of the active contacts:
 //!    $$ u = W p + q_{\rm free},\quad W = H M^{-1} H^{\mathsf T},\quad
-//!       q_{{\rm free},n,i} = \nabla g_i\cdot v_{\rm free} + \partial_t g_i(t_{k+1})
-//!       + e_i \dot g_i^- ,$$
+//!    q_{{\rm free},n,i} = \nabla g_i\cdot v_{\rm free} + \partial_t g_i(t_{k+1}) +
+//!    e_i \dot g_i^- ,$$
 //!    so that $u_{n,i} = \dot g_i^+ + e_i\dot g_i^-$; frictionless: LCP(W, q) by [`lcp::Lemke`]
 //!    or [`lcp::Pgs`]; frictional: the planar Signorini–Coulomb problem by [`lcp::Nsgs`];
 //! 4. update: $v_{k+1} = v_{\rm free} + M^{-1}H^{\mathsf T}p$,

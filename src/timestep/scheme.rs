@@ -1,5 +1,8 @@
 //! The Moreau–Jean θ-scheme at velocity level.
 
+// The loops index several arrays of the same length together (state, forces, rows).
+#![allow(clippy::needless_range_loop)]
+
 use crate::Real;
 use crate::drive::Control;
 use crate::scalar::{lit, to_f64};
@@ -690,8 +693,8 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
         // q⁺ = q + h ((1−θ) v + θ v⁺).
         for i in 0..n {
             q[i] += h * ((T::one() - theta) * v[i] + theta * ws.vnew[i]);
-            v[i] = ws.vnew[i];
         }
+        v.copy_from_slice(&ws.vnew);
         Self::nonfinite(k, tb, "position", q)?;
         Ok(report)
     }
