@@ -18,7 +18,9 @@
 //! 1. free velocity: $v_{\rm free} = v_k + h M^{-1}\big((1-\theta) f(t_k, q_k, v_k) +
 //!    \theta f(t_{k+1}, q_k + h v_k, v_k)\big)$ (the forces θ-weighted, explicitly);
 //! 2. active set: contact `i` enters the step's problem if its predicted gap
-//!    $g_i(q_k, t_k) + \gamma h \dot g_i^-\le 0$, $\dot g_i^- = \nabla g_i\cdot v_k + \partial_t g_i$;
+//!    $g_i(q_k, t_k) + \gamma h \dot g_i^-\le \delta$, $\dot g_i^- = \nabla g_i\cdot v_k +
+//!    \partial_t g_i$, with a threshold δ of a few ulps of the positions (rounding must not
+//!    open a resting contact);
 //! 3. one complementarity problem for the impulses $p$ of the active contacts:
 //!    $$ u = W p + q_{\rm free},\quad W = H M^{-1} H^{\mathsf T},\quad
 //!    q_{{\rm free},n,i} = \nabla g_i\cdot v_{\rm free} + \partial_t g_i(t_{k+1}) +

@@ -49,6 +49,7 @@ pub struct MoreauJean<T: Real, S, C> {
     h: T,
     theta: T,
     gamma: T,
+    threshold: Option<T>,
     solver: Solver<T>,
     ws: Workspace<T>,
 }
@@ -171,6 +172,7 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
             h,
             theta: lit(0.5),
             gamma: lit(0.5),
+            threshold: None,
             solver,
             ws,
         })
@@ -190,7 +192,8 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
     }
 
     /// Sets the activation weight `γ ∈ [0, 1]`: contact `i` enters the step's problem when
-    /// its predicted gap `g_i + γ h ġ_i ≤ 0`.
+    /// its predicted gap `g_i + γ h ġ_i ≤ δ` (see
+    /// [`with_activation_threshold`](Self::with_activation_threshold)).
     ///
     /// # Errors
     /// [`ParameterError`] unless `0 ≤ γ ≤ 1`.
@@ -199,6 +202,19 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
             return Err(ParameterError::new("gamma", to_f64(gamma), "in [0, 1]"));
         }
         self.gamma = gamma;
+        Ok(self)
+    }
+
+    /// Sets the activation threshold `δ ≥ 0` (a length, in the units of the gaps): contact
+    /// `i` enters the step's problem when `g_i + γ h ġ_i ≤ δ`. The default,
+    /// `16 ε max(1, ‖q‖∞)`, keeps a resting contact active when rounding leaves its gap a few
+    /// ulps above zero or its velocity a few ulps separating (a stack of balls would
+    /// otherwise lose a contact and let the balls above it fall for a step).
+    ///
+    /// # Errors
+    /// [`ParameterError`] unless `δ` is finite and ≥ 0.
+    pub fn with_activation_threshold(mut self, delta: T) -> Result<Self, ParameterError> {
+        self.threshold = Some(crate::validate::non_negative("delta", delta)?);
         Ok(self)
     }
 
@@ -486,8 +502,15 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
         for i in 0..n {
             self.ws.vfree[i] += v[i];
         }
-        // Active contacts: predicted gap g + γ h ġ ≤ 0.
+        // Active contacts: predicted gap g + γ h ġ ≤ δ.
         let ws = &mut self.ws;
+        let threshold = match self.threshold {
+            Some(d) => d,
+            None => {
+                let scale = q.iter().fold(T::one(), |a, &x| a.max(x.abs()));
+                lit::<T>(16.0) * T::default_epsilon() * scale
+            }
+        };
         ws.rows.clear();
         ws.offsets.clear();
         ws.offsets.push(0);
@@ -531,7 +554,7 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
                     value: to_f64(geo.gap + un + ut),
                 });
             }
-            if geo.gap + self.gamma * h * un <= T::zero() {
+            if geo.gap + self.gamma * h * un <= threshold {
                 ws.active.push(i);
                 ws.gaps.push(geo.gap);
                 ws.pre.push([un, ut]);
