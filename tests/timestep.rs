@@ -931,3 +931,40 @@ fn a_dense_mass_matrix_gives_the_same_motion() {
     // Sliding ends in sticking: the mass is at rest on the floor.
     assert!(v[0].abs() < 1e-12 && v[1].abs() < 1e-12, "{v:?}");
 }
+
+#[test]
+fn stroboscopic_section_samples_the_grid() {
+    // A ball resting on a vibrating table (Γ = 0.5 < 1: it never leaves): sampled once per
+    // period it sits on the table at the section phase, s(t) = A sin(ωt) with ωt = 2πi + 0.3.
+    let (amplitude, omega) = (
+        0.5 * 9.81 / (std::f64::consts::TAU).powi(2),
+        std::f64::consts::TAU,
+    );
+    let ball = nonsmooth::model::Mechanical::with_masses([1.0])
+        .unwrap()
+        .with_loads(
+            nonsmooth::model::Load::on_dof(0, nonsmooth::excite::Constant::new(-9.81).unwrap())
+                .unwrap(),
+        );
+    let table = TableGap {
+        amplitude,
+        omega,
+        e: 0.0,
+    };
+    let h = 1e-4;
+    let mut scheme = MoreauJean::new(ball, vec![table], h).unwrap();
+    let (mut q, mut v) = (vec![0.0], vec![amplitude * omega]);
+    let phase = 0.3 / omega;
+    let mut sec = nonsmooth::timestep::StroboscopicSection::new(phase, 1.0).unwrap();
+    scheme.run(0.0, &mut q, &mut v, 10.0, &mut sec).unwrap();
+    assert_eq!(sec.samples.len(), 10);
+    for (i, s) in sec.samples.iter().enumerate() {
+        assert!((s.t - (phase + i as f64)).abs() < 1e-12);
+        let table_y = amplitude * (omega * s.t).sin();
+        // The ball rides the table: the position error of a step of the scheme, O(h).
+        assert!(
+            (s.q[0] - table_y).abs() < amplitude * omega * h,
+            "{s:?} vs {table_y}"
+        );
+    }
+}

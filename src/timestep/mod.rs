@@ -39,7 +39,8 @@
 //! - per step a [`StepRecord`]: state, [`Energy`] (kinetic, potential, the work of the
 //!   impulses), every active contact's [`ContactRecord`] (gap, velocities before and after,
 //!   impulses) and the solver's [`LcpReport`](lcp::LcpReport) (iterations, residual), to a
-//!   [`StepObserver`]; [`ImpactLog`] turns the impulses into impacts;
+//!   [`StepObserver`]; [`ImpactLog`] turns the impulses into impacts, [`StroboscopicSection`]
+//!   samples the state at `t₀ + i·T`;
 //! - a contact problem that is not solved to its tolerance stops the run with
 //!   [`TimeStepError::Contact`] naming the step, its time and the residual reached.
 //!
@@ -77,7 +78,10 @@ mod scheme;
 mod system;
 
 pub use error::TimeStepError;
-pub use observe::{ContactRecord, Energy, Impact, ImpactLog, StepObserver, StepRecord, Summary};
+pub use observe::{
+    ContactRecord, Energy, Impact, ImpactLog, SectionSample, StepObserver, StepRecord,
+    StroboscopicSection, Summary,
+};
 pub use planar::{PlanarBodies, PlanarContact, Plane, RigidBody};
 pub use scheme::{MoreauJean, Solver};
 pub use system::{Contact, ContactSet, Geometry, Jacobian, Lagrangian};

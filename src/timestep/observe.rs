@@ -214,3 +214,96 @@ impl<T: Real> StepObserver<T> for ImpactLog<T> {
         Control::Continue
     }
 }
+
+/// A state on a stroboscopic section.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SectionSample {
+    /// The section time `t₀ + i·period`.
+    pub t: f64,
+    /// Positions (interpolated linearly between the step ends around `t`).
+    pub q: Vec<f64>,
+    /// Velocities (likewise).
+    pub v: Vec<f64>,
+}
+
+/// Samples the state at `t = t₀ + i·period` (`i = 0, 1, …`; a grid, never accumulated),
+/// interpolating linearly between the ends of the step that contains each section time:
+/// first-order accurate, as the scheme.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StroboscopicSection {
+    t0: f64,
+    period: f64,
+    next: u64,
+    last_t: f64,
+    last_q: Vec<f64>,
+    last_v: Vec<f64>,
+    /// The samples in time order.
+    pub samples: Vec<SectionSample>,
+}
+
+impl StroboscopicSection {
+    /// Sections at `t0 + i·period`.
+    ///
+    /// # Errors
+    /// [`ParameterError`](crate::ParameterError) unless `t0` is finite and `period` finite
+    /// and > 0.
+    pub fn new(t0: f64, period: f64) -> Result<Self, crate::ParameterError> {
+        Ok(Self {
+            t0: crate::validate::finite("t0", t0)?,
+            period: crate::validate::positive("period", period)?,
+            next: 0,
+            last_t: f64::NAN,
+            last_q: Vec::new(),
+            last_v: Vec::new(),
+            samples: Vec::new(),
+        })
+    }
+
+    fn section_time(&self) -> f64 {
+        self.t0 + self.next as f64 * self.period
+    }
+}
+
+impl<T: Real> StepObserver<T> for StroboscopicSection {
+    fn on_start(&mut self, t0: T, q: &[T], v: &[T]) {
+        self.last_t = to_f64(t0);
+        self.last_q = q.iter().map(|&x| to_f64(x)).collect();
+        self.last_v = v.iter().map(|&x| to_f64(x)).collect();
+        // Skip the section times before the run.
+        while self.section_time() < self.last_t {
+            self.next += 1;
+        }
+    }
+    fn on_step(&mut self, s: &StepRecord<'_, T>) -> Control {
+        let t1 = to_f64(s.t1);
+        while self.section_time() <= t1 {
+            let t = self.section_time();
+            let span = t1 - self.last_t;
+            let w = if span > 0.0 {
+                (t - self.last_t) / span
+            } else {
+                1.0
+            };
+            let lerp = |a: &[f64], b: &[T]| -> Vec<f64> {
+                a.iter()
+                    .zip(b)
+                    .map(|(&x, &y)| x + w * (to_f64(y) - x))
+                    .collect()
+            };
+            self.samples.push(SectionSample {
+                t,
+                q: lerp(&self.last_q, s.q),
+                v: lerp(&self.last_v, s.v),
+            });
+            self.next += 1;
+        }
+        self.last_t = t1;
+        for (a, &b) in self.last_q.iter_mut().zip(s.q) {
+            *a = to_f64(b);
+        }
+        for (a, &b) in self.last_v.iter_mut().zip(s.v) {
+            *a = to_f64(b);
+        }
+        Control::Continue
+    }
+}
