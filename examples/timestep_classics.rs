@@ -27,6 +27,9 @@ use nonsmooth::timestep::{
 
 type Res<T> = Result<T, Box<dyn std::error::Error>>;
 
+/// Bodies, contacts and initial positions of a column.
+type Column = (PlanarBodies<f64>, Vec<PlanarContact<f64>>, Vec<f64>);
+
 struct Checks(Vec<(String, bool)>);
 
 impl Checks {
@@ -142,7 +145,7 @@ fn lcp_section(c: &mut Checks) -> Res<()> {
 
 /// Discs of radius `r`, unit mass, stacked on the floor, touching (`r = 1/16` makes every
 /// gap exactly zero).
-fn column(n: usize, r: f64, e: f64) -> Res<(PlanarBodies<f64>, Vec<PlanarContact<f64>>, Vec<f64>)> {
+fn column(n: usize, r: f64, e: f64) -> Res<Column> {
     let bodies = PlanarBodies::new(vec![RigidBody::disc(1.0, r)?; n], 9.81)?;
     let mut contacts = vec![PlanarContact::disc_plane(0, r, Plane::floor(0.0)?, e, 0.0)?];
     for i in 0..n - 1 {

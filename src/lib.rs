@@ -16,6 +16,7 @@
 //! | integrators | DOPRI5, DOP853, RK4, Rosenbrock 2(3) with dense output | [`integrate`] |
 //! | events | crossings located on dense output, grazing pairs, resets, Zeno guard | [`event`] |
 //! | driver | system + stepper + events + observers | [`drive`] |
+//! | time-stepping | many rigid contacts at once: Moreau–Jean with Lemke, projected and nonsmooth Gauss–Seidel | [`timestep`] |
 //! | samplers | stroboscopic sections, impact sequences, period summaries | [`sample`] |
 //! | sweeps | up/down continuation, hysteresis, transitions, ramps | [`sweep`] |
 //! | chaos measures | top Lyapunov exponents (two-trajectory and QR), Tsallis entropy index | [`lyapunov`], [`entropy`] |

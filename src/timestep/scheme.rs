@@ -160,7 +160,7 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
             Solver::Nsgs(Nsgs::new())
         } else {
             let mut l = Lemke::new();
-            l.reserve(m.min(256));
+            l.reserve(m.min(1024));
             Solver::Lemke(l)
         };
         let mut ws = Workspace::new(n, m);
