@@ -968,3 +968,48 @@ fn stroboscopic_section_samples_the_grid() {
         );
     }
 }
+
+#[test]
+fn the_scheme_runs_in_f32() {
+    // A ball dropped on a rough floor and a block resting on it, in single precision: the
+    // ball comes to rest and the solvers meet their f32 tolerances.
+    let bodies = PlanarBodies::new(
+        vec![
+            RigidBody::<f32>::disc(1.0, 0.1).unwrap(),
+            RigidBody::rectangle(2.0, 0.2, 0.1).unwrap(),
+        ],
+        9.81,
+    )
+    .unwrap();
+    let floor = Plane::floor(0.0f32).unwrap();
+    let contacts = vec![
+        PlanarContact::disc_plane(0, 0.1, floor, 0.5, 0.3).unwrap(),
+        PlanarContact::corner_plane(1, [-0.2, -0.1], floor, 0.0, 0.3).unwrap(),
+        PlanarContact::corner_plane(1, [0.2, -0.1], floor, 0.0, 0.3).unwrap(),
+    ];
+    let mut scheme = MoreauJean::new(bodies, contacts, 1e-3f32).unwrap();
+    let mut q = vec![0.0f32, 1.1, 0.0, 1.0, 0.1, 0.0];
+    let mut v = vec![0.0f32; 6];
+    let s = scheme.run(0.0, &mut q, &mut v, 3.0, &mut ()).unwrap();
+    assert!(s.max_residual <= 1.2e-4, "{s:?}");
+    assert!(v.iter().all(|x| x.abs() < 1e-4), "{v:?}");
+    assert!(
+        (q[1] - 0.1).abs() < 1e-3 && (q[4] - 0.1).abs() < 1e-3,
+        "{q:?}"
+    );
+}
+
+#[test]
+fn public_types_are_send_sync_clone() {
+    fn check<T: Send + Sync + Clone>() {}
+    check::<MoreauJean<f64, PlanarBodies<f64>, Vec<PlanarContact<f64>>>>();
+    check::<Lemke<f64>>();
+    check::<Pgs<f32>>();
+    check::<Nsgs<f64>>();
+    check::<Solver<f64>>();
+    check::<TimeStepError>();
+    check::<LcpError>();
+    check::<ImpactLog<f64>>();
+    check::<nonsmooth::timestep::StroboscopicSection>();
+    check::<nonsmooth::timestep::ContactRecord<f64>>();
+}

@@ -137,6 +137,11 @@ pub struct LcpReport {
     pub residual: f64,
 }
 
+/// The default residual tolerance: `10⁻¹⁰`, or `1000 ε` if larger (`1.2·10⁻⁴` for `f32`).
+fn default_tolerance<T: Real>() -> T {
+    lit::<T>(1e-10).max(lit::<T>(1000.0) * T::default_epsilon())
+}
+
 /// `max(1, ‖q‖∞)`, the residual's scale.
 fn scale<T: Real>(q: &[T]) -> T {
     q.iter().fold(T::one(), |a, &x| a.max(x.abs()))
@@ -243,11 +248,12 @@ impl<T: Real> Default for Lemke<T> {
 }
 
 impl<T: Real> Lemke<T> {
-    /// The solver with the default pivot limit `1000 + 50n` and residual tolerance `10⁻¹⁰`.
+    /// The solver with the default pivot limit `1000 + 50n` and residual tolerance `10⁻¹⁰`
+    /// (`1000 ε` if larger: `1.2·10⁻⁴` for `f32`).
     pub fn new() -> Self {
         Self {
             pivot_limit: None,
-            tolerance: lit(1e-10),
+            tolerance: default_tolerance(),
             tableau: Vec::new(),
             basis: Vec::new(),
             candidates: Vec::new(),
@@ -594,11 +600,12 @@ impl<T: Real> Default for Pgs<T> {
 }
 
 impl<T: Real> Pgs<T> {
-    /// At most 10 000 sweeps to a residual of `10⁻¹⁰`, no relaxation (`ω = 1`).
+    /// At most 10 000 sweeps to a residual of `10⁻¹⁰` (`1000 ε` if larger), no relaxation
+    /// (`ω = 1`).
     pub fn new() -> Self {
         Self {
             max_iterations: 10_000,
-            tolerance: lit(1e-10),
+            tolerance: default_tolerance(),
             omega: T::one(),
         }
     }
@@ -730,11 +737,11 @@ impl<T: Real> Default for Nsgs<T> {
 }
 
 impl<T: Real> Nsgs<T> {
-    /// At most 10 000 sweeps to a residual of `10⁻¹⁰`.
+    /// At most 10 000 sweeps to a residual of `10⁻¹⁰` (`1000 ε` if larger).
     pub fn new() -> Self {
         Self {
             max_iterations: 10_000,
-            tolerance: lit(1e-10),
+            tolerance: default_tolerance(),
         }
     }
 
