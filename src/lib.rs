@@ -13,9 +13,11 @@
 //! | models | `ẏ = f(t, y)`; N-DOF systems from elements, the 1-DOF oscillator | [`Dynamics`], [`model::Mechanical`], [`model::Oscillator`] |
 //! | catalogue | ready systems: the paper's cart, Duffing–Ueda, a 2-DOF impact oscillator | [`systems`] |
 //! | roots | Brent's method for equilibria and events | [`roots`] |
-//! | integrators | DOPRI5, DOP853, RK4, Rosenbrock 2(3) with dense output | [`integrate`] |
+//! | integrators | DOPRI5, DOP853, Rosenbrock 2(3) on one adaptive stepper, RK4, turning points; dense output | [`integrate`] |
 //! | events | crossings located on dense output, grazing pairs, resets, Zeno guard | [`event`] |
 //! | driver | system + stepper + events + observers | [`drive`] |
+//! | sliding | Filippov systems: crossing and sliding on switching surfaces, saltation, monodromy, orbits | [`filippov`] |
+//! | time-stepping | many rigid contacts at once: Moreau–Jean with Lemke, projected and nonsmooth Gauss–Seidel | [`timestep`] |
 //! | samplers | stroboscopic sections, impact sequences, period summaries | [`sample`] |
 //! | sweeps | up/down continuation, hysteresis, transitions, ramps | [`sweep`] |
 //! | chaos measures | top Lyapunov exponents (two-trajectory and QR), Tsallis entropy index | [`lyapunov`], [`entropy`] |
@@ -78,6 +80,7 @@ pub mod sweep;
 pub mod systems;
 #[cfg(feature = "testing")]
 pub mod testing;
+pub mod timestep;
 pub(crate) mod validate;
 
 pub use dynamics::{Dynamics, LaneByLane, LaneDynamics};

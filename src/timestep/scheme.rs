@@ -1,0 +1,724 @@
+//! The Moreau–Jean θ-scheme at velocity level.
+
+// The loops index several arrays of the same length together (state, forces, rows).
+#![allow(clippy::needless_range_loop)]
+
+use crate::Real;
+use crate::drive::Control;
+use crate::scalar::{lit, to_f64};
+use crate::validate::{ParameterError, positive};
+
+use super::error::TimeStepError;
+use super::lcp::{LcpReport, Lemke, Nsgs, Pgs};
+use super::observe::{ContactRecord, Energy, StepObserver, StepRecord, Summary};
+use super::system::{ContactSet, Jacobian, Lagrangian};
+
+/// The solver of each step's contact problem.
+#[derive(Debug, Clone)]
+#[non_exhaustive]
+pub enum Solver<T> {
+    /// Lemke's pivoting method (frictionless contacts; exact, for few contacts).
+    Lemke(Lemke<T>),
+    /// Projected Gauss–Seidel (frictionless contacts; many contacts).
+    Pgs(Pgs<T>),
+    /// Nonsmooth Gauss–Seidel (contacts with Coulomb friction).
+    Nsgs(Nsgs<T>),
+}
+
+impl<T: Real> Solver<T> {
+    fn name(&self) -> &'static str {
+        match self {
+            Solver::Lemke(_) => "Lemke",
+            Solver::Pgs(_) => "projected Gauss–Seidel",
+            Solver::Nsgs(_) => "nonsmooth Gauss–Seidel",
+        }
+    }
+}
+
+/// The Moreau–Jean time-stepping scheme for a [`Lagrangian`] system with a
+/// [`ContactSet`] (see the [module docs](super) for the equations).
+///
+/// Built with the step `h`; `θ = 1/2` and the activation weight `γ = 1/2` by default. The
+/// solver defaults to [`Solver::Nsgs`] if any contact has friction, else [`Solver::Lemke`].
+/// All workspaces are sized when the scheme is built: a step allocates nothing (the sparse
+/// rows of the active contacts grow to their largest size in the first steps and are reused).
+#[derive(Debug, Clone)]
+pub struct MoreauJean<T: Real, S, C> {
+    system: S,
+    contacts: C,
+    h: T,
+    theta: T,
+    gamma: T,
+    threshold: Option<T>,
+    solver: Solver<T>,
+    ws: Workspace<T>,
+}
+
+#[derive(Debug, Clone)]
+struct Workspace<T> {
+    n: usize,
+    m: usize,
+    diagonal: bool,
+    constant: bool,
+    factored: bool,
+    mass: Vec<T>,
+    chol: Vec<T>,
+    inv_diag: Vec<T>,
+    f0: Vec<T>,
+    f1: Vec<T>,
+    qpred: Vec<T>,
+    vfree: Vec<T>,
+    vnew: Vec<T>,
+    dense: Vec<T>,
+    last: Vec<[T; 2]>,
+    scratch_n: Vec<(usize, T)>,
+    scratch_t: Vec<(usize, T)>,
+    rows: Vec<(usize, T)>,
+    offsets: Vec<usize>,
+    active: Vec<usize>,
+    gaps: Vec<T>,
+    pre: Vec<[T; 2]>,
+    w: Vec<T>,
+    q: Vec<T>,
+    p: Vec<T>,
+    mu: Vec<T>,
+    records: Vec<ContactRecord<T>>,
+    work: T,
+}
+
+impl<T: Real> Workspace<T> {
+    fn new(n: usize, m: usize) -> Self {
+        let z = T::zero();
+        Self {
+            n,
+            m,
+            diagonal: false,
+            constant: true,
+            factored: false,
+            mass: vec![z; n * n],
+            chol: vec![z; n * n],
+            inv_diag: vec![z; n],
+            f0: vec![z; n],
+            f1: vec![z; n],
+            qpred: vec![z; n],
+            vfree: vec![z; n],
+            vnew: vec![z; n],
+            dense: Vec::new(),
+            last: vec![[z; 2]; m],
+            scratch_n: Vec::with_capacity(n.min(64)),
+            scratch_t: Vec::with_capacity(n.min(64)),
+            rows: Vec::with_capacity(12 * m),
+            offsets: Vec::with_capacity(2 * m + 1),
+            active: Vec::with_capacity(m),
+            gaps: Vec::with_capacity(m),
+            pre: Vec::with_capacity(m),
+            w: Vec::new(),
+            q: Vec::with_capacity(2 * m),
+            p: Vec::with_capacity(2 * m),
+            mu: Vec::with_capacity(m),
+            records: Vec::with_capacity(m),
+            work: z,
+        }
+    }
+}
+
+/// Sparse row `a` of the rows stored at `offsets`.
+#[inline(always)]
+fn row<'a, T>(rows: &'a [(usize, T)], offsets: &[usize], a: usize) -> &'a [(usize, T)] {
+    &rows[offsets[a]..offsets[a + 1]]
+}
+
+impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
+    /// The scheme with step `h` for `system` and `contacts`.
+    ///
+    /// # Errors
+    /// [`TimeStepError::Parameter`] unless `h` is finite and > 0 and every contact has
+    /// `0 ≤ e ≤ 1` and a finite `μ ≥ 0`; a contact's own check
+    /// ([`Contact::check`](super::Contact::check)).
+    pub fn new(system: S, contacts: C, h: T) -> Result<Self, TimeStepError> {
+        let h = positive("h", h)?;
+        let n = system.dofs();
+        if n == 0 {
+            return Err(TimeStepError::Dimension {
+                what: "number of coordinates",
+                got: 0,
+                expected: 1,
+            });
+        }
+        let m = contacts.len();
+        let mut frictional = false;
+        for i in 0..m {
+            contacts.check(i, n)?;
+            let e = contacts.restitution(i);
+            if !(e >= T::zero() && e <= T::one()) {
+                return Err(ParameterError::new("restitution", to_f64(e), "in [0, 1]").into());
+            }
+            let mu = crate::validate::non_negative("friction", contacts.friction(i))?;
+            frictional |= mu > T::zero();
+        }
+        let solver = if frictional {
+            Solver::Nsgs(Nsgs::new())
+        } else {
+            let mut l = Lemke::new();
+            l.reserve(m.min(1024));
+            Solver::Lemke(l)
+        };
+        let mut ws = Workspace::new(n, m);
+        ws.diagonal = system.diagonal_mass();
+        ws.constant = system.constant_mass();
+        Ok(Self {
+            system,
+            contacts,
+            h,
+            theta: lit(0.5),
+            gamma: lit(0.5),
+            threshold: None,
+            solver,
+            ws,
+        })
+    }
+
+    /// Sets `θ ∈ [1/2, 1]` of the velocity and force averages (1/2: trapezoidal, 1:
+    /// implicit Euler for the positions).
+    ///
+    /// # Errors
+    /// [`ParameterError`] unless `0.5 ≤ θ ≤ 1`.
+    pub fn with_theta(mut self, theta: T) -> Result<Self, ParameterError> {
+        if !(theta >= lit(0.5) && theta <= T::one()) {
+            return Err(ParameterError::new("theta", to_f64(theta), "in [0.5, 1]"));
+        }
+        self.theta = theta;
+        Ok(self)
+    }
+
+    /// Sets the activation weight `γ ∈ [0, 1]`: contact `i` enters the step's problem when
+    /// its predicted gap `g_i + γ h ġ_i ≤ δ` (see
+    /// [`with_activation_threshold`](Self::with_activation_threshold)).
+    ///
+    /// # Errors
+    /// [`ParameterError`] unless `0 ≤ γ ≤ 1`.
+    pub fn with_activation(mut self, gamma: T) -> Result<Self, ParameterError> {
+        if !(gamma >= T::zero() && gamma <= T::one()) {
+            return Err(ParameterError::new("gamma", to_f64(gamma), "in [0, 1]"));
+        }
+        self.gamma = gamma;
+        Ok(self)
+    }
+
+    /// Sets the activation threshold `δ ≥ 0` (a length, in the units of the gaps): contact
+    /// `i` enters the step's problem when `g_i + γ h ġ_i ≤ δ`. The default,
+    /// `16 ε max(1, ‖q‖∞)`, keeps a resting contact active when rounding leaves its gap a few
+    /// ulps above zero or its velocity a few ulps separating (a stack of balls would
+    /// otherwise lose a contact and let the balls above it fall for a step).
+    ///
+    /// # Errors
+    /// [`ParameterError`] unless `δ` is finite and ≥ 0.
+    pub fn with_activation_threshold(mut self, delta: T) -> Result<Self, ParameterError> {
+        self.threshold = Some(crate::validate::non_negative("delta", delta)?);
+        Ok(self)
+    }
+
+    /// Sets the contact solver.
+    ///
+    /// # Errors
+    /// [`TimeStepError::FrictionUnsupported`] for a frictionless solver when a contact has
+    /// friction.
+    pub fn with_solver(mut self, solver: Solver<T>) -> Result<Self, TimeStepError> {
+        if !matches!(solver, Solver::Nsgs(_)) {
+            for i in 0..self.contacts.len() {
+                let mu = self.contacts.friction(i);
+                if mu > T::zero() {
+                    return Err(TimeStepError::FrictionUnsupported {
+                        contact: i,
+                        mu: to_f64(mu),
+                        solver: solver.name(),
+                    });
+                }
+            }
+        }
+        self.solver = solver;
+        Ok(self)
+    }
+
+    /// The step.
+    pub fn step_size(&self) -> T {
+        self.h
+    }
+
+    /// The system.
+    pub fn system(&self) -> &S {
+        &self.system
+    }
+
+    /// The contacts.
+    pub fn contacts(&self) -> &C {
+        &self.contacts
+    }
+
+    /// Runs from `(t0, q, v)` to `t_end` on the grid `t_k = t0 + k·h` (the last step ends
+    /// at `t_end`, shorter if `t_end − t0` is not a multiple of `h`), updating `q` and `v`
+    /// in place and calling `observer` after every step.
+    ///
+    /// # Errors
+    /// [`TimeStepError::Dimension`] if `q` or `v` does not have `dofs()` entries;
+    /// [`TimeStepError::Parameter`] unless `t0 ≤ t_end` are finite;
+    /// [`TimeStepError::MassMatrix`]; [`TimeStepError::NonFinite`] for a non-finite force,
+    /// gap, Jacobian entry or state; [`TimeStepError::Contact`] if a step's contact problem
+    /// is not solved (with the step, its time and the residual reached). The state is that
+    /// of the last completed step after an error.
+    pub fn run<O: StepObserver<T>>(
+        &mut self,
+        t0: T,
+        q: &mut [T],
+        v: &mut [T],
+        t_end: T,
+        observer: &mut O,
+    ) -> Result<Summary, TimeStepError> {
+        let n = self.ws.n;
+        for (what, len) in [("length of q", q.len()), ("length of v", v.len())] {
+            if len != n {
+                return Err(TimeStepError::Dimension {
+                    what,
+                    got: len,
+                    expected: n,
+                });
+            }
+        }
+        crate::validate::finite("t0", t0)?;
+        crate::validate::finite("t_end", t_end)?;
+        if !(t_end >= t0) {
+            return Err(ParameterError::new("t_end", to_f64(t_end), "≥ t0").into());
+        }
+        for (what, x) in [("q", &*q), ("v", &*v)] {
+            if let Some(i) = x.iter().position(|a| !a.is_finite()) {
+                return Err(TimeStepError::NonFinite {
+                    step: 0,
+                    t: to_f64(t0),
+                    what,
+                    index: i,
+                    value: to_f64(x[i]),
+                });
+            }
+        }
+        // Number of steps: (t_end − t0)/h rounded up, unless within 1e-9 of an integer.
+        let ratio = to_f64((t_end - t0) / self.h);
+        let steps = if (ratio - ratio.round()).abs() <= 1e-9 * ratio.max(1.0) {
+            ratio.round()
+        } else {
+            ratio.ceil()
+        };
+        if !(steps < 1e15) {
+            return Err(ParameterError::new("h", to_f64(self.h), "giving < 1e15 steps").into());
+        }
+        let steps = steps as usize;
+        self.ws.factored = false;
+        observer.on_start(t0, q, v);
+        let mut summary = Summary {
+            steps: 0,
+            t: to_f64(t0),
+            stopped: false,
+            max_residual: 0.0,
+            solver_iterations: 0,
+            max_active: 0,
+        };
+        for k in 0..steps {
+            let ta = t0 + lit::<T>(k as f64) * self.h;
+            let tb = if k + 1 == steps {
+                t_end
+            } else {
+                t0 + lit::<T>((k + 1) as f64) * self.h
+            };
+            let report = self.step(k, ta, tb, q, v)?;
+            summary.steps += 1;
+            summary.t = to_f64(tb);
+            summary.max_residual = summary.max_residual.max(report.residual);
+            summary.solver_iterations += report.iterations;
+            summary.max_active = summary.max_active.max(self.ws.records.len());
+            let energy = self.energy(tb, q, v);
+            let record = StepRecord {
+                step: k,
+                t0: ta,
+                t1: tb,
+                q,
+                v,
+                energy,
+                contacts: &self.ws.records,
+                solver: report,
+            };
+            if observer.on_step(&record) == Control::Stop {
+                summary.stopped = true;
+                break;
+            }
+        }
+        observer.on_finish(&summary);
+        Ok(summary)
+    }
+
+    /// The energies at `(t, q, v)` and the impulses' work of the last step.
+    fn energy(&self, t: T, q: &[T], v: &[T]) -> Energy<T> {
+        let ws = &self.ws;
+        let n = ws.n;
+        let mut kin = T::zero();
+        if ws.diagonal {
+            for i in 0..n {
+                kin += ws.mass[i * n + i] * v[i] * v[i];
+            }
+        } else {
+            for i in 0..n {
+                let mut s = T::zero();
+                for j in 0..n {
+                    s += ws.mass[i * n + j] * v[j];
+                }
+                kin += v[i] * s;
+            }
+        }
+        let work = ws.work;
+        Energy {
+            kinetic: kin * lit(0.5),
+            potential: self.system.potential(t, q),
+            impulse_work: work,
+        }
+    }
+
+    fn nonfinite(step: usize, t: T, what: &'static str, x: &[T]) -> Result<(), TimeStepError> {
+        match x.iter().position(|a| !a.is_finite()) {
+            None => Ok(()),
+            Some(i) => Err(TimeStepError::NonFinite {
+                step,
+                t: to_f64(t),
+                what,
+                index: i,
+                value: to_f64(x[i]),
+            }),
+        }
+    }
+
+    /// Factorizes the mass matrix at `q` (Cholesky, or the inverse diagonal).
+    fn factor(&mut self, k: usize, t: T, q: &[T]) -> Result<(), TimeStepError> {
+        let ws = &mut self.ws;
+        let n = ws.n;
+        self.system.mass(q, &mut ws.mass);
+        Self::nonfinite(k, t, "mass", &ws.mass)?;
+        if ws.diagonal {
+            for i in 0..n {
+                let d = ws.mass[i * n + i];
+                if !(d > T::zero()) {
+                    return Err(TimeStepError::MassMatrix {
+                        t: to_f64(t),
+                        pivot: i,
+                        value: to_f64(d),
+                    });
+                }
+                ws.inv_diag[i] = T::one() / d;
+            }
+        } else {
+            let l = &mut ws.chol;
+            l.copy_from_slice(&ws.mass);
+            for j in 0..n {
+                let mut d = l[j * n + j];
+                for k2 in 0..j {
+                    d -= l[j * n + k2] * l[j * n + k2];
+                }
+                if !(d > T::zero()) {
+                    return Err(TimeStepError::MassMatrix {
+                        t: to_f64(t),
+                        pivot: j,
+                        value: to_f64(d),
+                    });
+                }
+                let d = d.sqrt();
+                l[j * n + j] = d;
+                for i in j + 1..n {
+                    let mut s = l[i * n + j];
+                    for k2 in 0..j {
+                        s -= l[i * n + k2] * l[j * n + k2];
+                    }
+                    l[i * n + j] = s / d;
+                }
+            }
+        }
+        ws.factored = true;
+        Ok(())
+    }
+
+    /// `x ← M⁻¹ x` with the factorization.
+    fn solve_mass(diagonal: bool, inv_diag: &[T], l: &[T], x: &mut [T]) {
+        let n = inv_diag.len();
+        if diagonal {
+            for i in 0..n {
+                x[i] *= inv_diag[i];
+            }
+            return;
+        }
+        for i in 0..n {
+            let mut s = x[i];
+            for k in 0..i {
+                s -= l[i * n + k] * x[k];
+            }
+            x[i] = s / l[i * n + i];
+        }
+        for i in (0..n).rev() {
+            let mut s = x[i];
+            for k in i + 1..n {
+                s -= l[k * n + i] * x[k];
+            }
+            x[i] = s / l[i * n + i];
+        }
+    }
+
+    /// One step `[ta, tb]`.
+    fn step(
+        &mut self,
+        k: usize,
+        ta: T,
+        tb: T,
+        q: &mut [T],
+        v: &mut [T],
+    ) -> Result<LcpReport, TimeStepError> {
+        let h = tb - ta;
+        let n = self.ws.n;
+        if !self.ws.factored || !self.ws.constant {
+            self.factor(k, ta, q)?;
+        }
+        let theta = self.theta;
+        // Free velocity: v_free = v + h M⁻¹ ((1−θ) f(ta, q, v) + θ f(tb, q + h v, v)).
+        {
+            let ws = &mut self.ws;
+            self.system.forces(ta, q, v, &mut ws.f0);
+            for i in 0..n {
+                ws.qpred[i] = q[i] + h * v[i];
+            }
+            self.system.forces(tb, &ws.qpred, v, &mut ws.f1);
+            Self::nonfinite(k, ta, "force", &ws.f0)?;
+            Self::nonfinite(k, tb, "force", &ws.f1)?;
+            for i in 0..n {
+                ws.vfree[i] = h * ((T::one() - theta) * ws.f0[i] + theta * ws.f1[i]);
+            }
+        }
+        {
+            let ws = &mut self.ws;
+            Self::solve_mass(ws.diagonal, &ws.inv_diag, &ws.chol, &mut ws.vfree);
+        }
+        for i in 0..n {
+            self.ws.vfree[i] += v[i];
+        }
+        // Active contacts: predicted gap g + γ h ġ ≤ δ.
+        let ws = &mut self.ws;
+        let threshold = match self.threshold {
+            Some(d) => d,
+            None => {
+                let scale = q.iter().fold(T::one(), |a, &x| a.max(x.abs()));
+                lit::<T>(16.0) * T::default_epsilon() * scale
+            }
+        };
+        ws.rows.clear();
+        ws.offsets.clear();
+        ws.offsets.push(0);
+        ws.active.clear();
+        ws.gaps.clear();
+        ws.pre.clear();
+        ws.records.clear();
+        for i in 0..ws.m {
+            ws.scratch_n.clear();
+            ws.scratch_t.clear();
+            let mut jac = Jacobian {
+                normal: &mut ws.scratch_n,
+                tangent: &mut ws.scratch_t,
+                dofs: n,
+                out_of_range: None,
+            };
+            let geo = self.contacts.evaluate(i, ta, q, &mut jac);
+            if let Some(dof) = jac.out_of_range {
+                return Err(TimeStepError::Dimension {
+                    what: "contact Jacobian index",
+                    got: dof,
+                    expected: n,
+                });
+            }
+            let drift = self.contacts.drift(i, ta, q);
+            let mut un = drift[0];
+            for &(j, x) in ws.scratch_n.iter() {
+                un += x * v[j];
+            }
+            let mut ut = drift[1];
+            for &(j, x) in ws.scratch_t.iter() {
+                ut += x * v[j];
+            }
+            let check = [geo.gap, un, ut];
+            if check.iter().any(|x| !x.is_finite()) {
+                return Err(TimeStepError::NonFinite {
+                    step: k,
+                    t: to_f64(ta),
+                    what: "contact gap or rows",
+                    index: i,
+                    value: to_f64(geo.gap + un + ut),
+                });
+            }
+            if geo.gap + self.gamma * h * un <= threshold {
+                ws.active.push(i);
+                ws.gaps.push(geo.gap);
+                ws.pre.push([un, ut]);
+                ws.rows.extend_from_slice(&ws.scratch_n);
+                ws.offsets.push(ws.rows.len());
+                ws.rows.extend_from_slice(&ws.scratch_t);
+                ws.offsets.push(ws.rows.len());
+            } else {
+                ws.last[i] = [T::zero(); 2];
+            }
+        }
+        let act = ws.active.len();
+        let frictional = matches!(self.solver, Solver::Nsgs(_));
+        let d = if frictional { 2 * act } else { act };
+        // The problem's rows α: frictional (n₁, t₁, n₂, t₂, …) or normal rows only.
+        let row_of = |a: usize| if frictional { a } else { 2 * a };
+        let mut report = LcpReport {
+            iterations: 0,
+            residual: 0.0,
+        };
+        if act > 0 {
+            if ws.w.len() < d * d {
+                ws.w.resize(d * d, T::zero());
+            }
+            ws.q.clear();
+            ws.p.clear();
+            ws.mu.clear();
+            if !ws.diagonal && ws.dense.len() < d * n {
+                ws.dense.resize(d * n, T::zero());
+            }
+            // G_β = M⁻¹ r_βᵀ (dense, general mass matrices only).
+            if !ws.diagonal {
+                for b in 0..d {
+                    let (lo, hi) = (ws.offsets[row_of(b)], ws.offsets[row_of(b) + 1]);
+                    let g = &mut ws.dense[b * n..(b + 1) * n];
+                    g.iter_mut().for_each(|x| *x = T::zero());
+                    for &(j, x) in &ws.rows[lo..hi] {
+                        g[j] += x;
+                    }
+                }
+                for b in 0..d {
+                    Self::solve_mass(
+                        false,
+                        &ws.inv_diag,
+                        &ws.chol,
+                        &mut ws.dense[b * n..(b + 1) * n],
+                    );
+                }
+            }
+            for a in 0..d {
+                let ra = row(&ws.rows, &ws.offsets, row_of(a));
+                for b in 0..d {
+                    let mut s = T::zero();
+                    if ws.diagonal {
+                        let rb = row(&ws.rows, &ws.offsets, row_of(b));
+                        for &(i, x) in ra {
+                            for &(j, y) in rb {
+                                if i == j {
+                                    s += x * y * ws.inv_diag[i];
+                                }
+                            }
+                        }
+                    } else {
+                        let g = &ws.dense[b * n..(b + 1) * n];
+                        for &(i, x) in ra {
+                            s += x * g[i];
+                        }
+                    }
+                    ws.w[a * d + b] = s;
+                }
+            }
+            for a in 0..d {
+                let c = if frictional { a / 2 } else { a };
+                let normal = !frictional || a % 2 == 0;
+                let i = ws.active[c];
+                let drift = self.contacts.drift(i, tb, q);
+                let mut s = if normal { drift[0] } else { drift[1] };
+                for &(j, x) in row(&ws.rows, &ws.offsets, row_of(a)) {
+                    s += x * ws.vfree[j];
+                }
+                if normal {
+                    s += self.contacts.restitution(i) * ws.pre[c][0];
+                }
+                ws.q.push(s);
+                ws.p.push(ws.last[i][if normal { 0 } else { 1 }]);
+            }
+            if frictional {
+                for c in 0..act {
+                    ws.mu.push(self.contacts.friction(ws.active[c]));
+                }
+            }
+            let w = &ws.w[..d * d];
+            let result = match &mut self.solver {
+                Solver::Lemke(s) => s.solve(w, &ws.q, &mut ws.p),
+                Solver::Pgs(s) => s.solve(w, &ws.q, &mut ws.p),
+                Solver::Nsgs(s) => s.solve(w, &ws.q, &ws.mu, &mut ws.p),
+            };
+            report = result.map_err(|source| TimeStepError::Contact {
+                step: k,
+                t: to_f64(ta),
+                source,
+            })?;
+        }
+        // v⁺ = v_free + M⁻¹ Σ p_α r_αᵀ.
+        ws.vnew.copy_from_slice(&ws.vfree);
+        for a in 0..d {
+            let pa = ws.p[a];
+            if pa == T::zero() {
+                continue;
+            }
+            if ws.diagonal {
+                for &(j, x) in row(&ws.rows, &ws.offsets, row_of(a)) {
+                    ws.vnew[j] += pa * x * ws.inv_diag[j];
+                }
+            } else {
+                for j in 0..n {
+                    ws.vnew[j] += pa * ws.dense[a * n + j];
+                }
+            }
+        }
+        Self::nonfinite(k, ta, "velocity", &ws.vnew)?;
+        // Records of the active contacts, and the warm start of the next step.
+        ws.work = T::zero();
+        for c in 0..act {
+            let i = ws.active[c];
+            let (pn, pt) = if frictional {
+                (ws.p[2 * c], ws.p[2 * c + 1])
+            } else {
+                (ws.p[c], T::zero())
+            };
+            ws.last[i] = [pn, pt];
+            let drift = self.contacts.drift(i, tb, q);
+            let (mut post, mut slip, mut free, mut free_slip) =
+                (drift[0], drift[1], drift[0], drift[1]);
+            for &(j, x) in row(&ws.rows, &ws.offsets, 2 * c) {
+                post += x * ws.vnew[j];
+                free += x * ws.vfree[j];
+            }
+            for &(j, x) in row(&ws.rows, &ws.offsets, 2 * c + 1) {
+                slip += x * ws.vnew[j];
+                free_slip += x * ws.vfree[j];
+            }
+            // ΔT = ½ pᵀ H (v⁺ + v_free): the drift terms cancel in the sums below.
+            ws.work += lit::<T>(0.5)
+                * (pn * (post + free - drift[0] - drift[0])
+                    + pt * (slip + free_slip - drift[1] - drift[1]));
+            ws.records.push(ContactRecord {
+                index: i,
+                gap: ws.gaps[c],
+                pre: ws.pre[c][0],
+                post,
+                free,
+                slip,
+                free_slip,
+                normal_impulse: pn,
+                tangent_impulse: pt,
+            });
+        }
+        // q⁺ = q + h ((1−θ) v + θ v⁺).
+        for i in 0..n {
+            q[i] += h * ((T::one() - theta) * v[i] + theta * ws.vnew[i]);
+        }
+        v.copy_from_slice(&ws.vnew);
+        Self::nonfinite(k, tb, "position", q)?;
+        Ok(report)
+    }
+}
