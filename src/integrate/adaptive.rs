@@ -47,13 +47,14 @@ pub trait Method<T: Real, const N: usize>:
     type Poly: Interpolant<T, N>;
 
     /// One accepted step: advances `parts.core` from its state towards `t_limit` (never past
-    /// it) and returns the step's dense output.
+    /// it) and writes the step's dense output into `dense` (untouched on an error).
     #[doc(hidden)]
     fn advance<S: Dynamics<T, N>>(
         parts: StepParts<'_, T, N>,
+        dense: &mut MethodDense<T, N, Self::Poly>,
         sys: &S,
         t_limit: T,
-    ) -> Result<MethodDense<T, N, Self::Poly>, IntegrateError>;
+    ) -> Result<(), IntegrateError>;
 }
 
 /// The interpolant of a method's step, evaluated with the step's ends. Sealed.
@@ -164,8 +165,7 @@ impl<T: Real, const N: usize, M: Method<T, N>> Stepper<T, N> for Adaptive<T, N, 
             ctrl: &mut self.ctrl,
             core: &mut self.core,
         };
-        self.dense = M::advance(parts, sys, t_limit)?;
-        Ok(())
+        M::advance(parts, &mut self.dense, sys, t_limit)
     }
 
     fn current(&self) -> (T, &SVector<T, N>) {

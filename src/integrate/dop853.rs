@@ -314,9 +314,10 @@ impl<T: Real, const N: usize> Method<T, N> for Dop853Method {
 
     fn advance<S: Dynamics<T, N>>(
         parts: StepParts<'_, T, N>,
+        dense: &mut Dop853Dense<T, N>,
         sys: &S,
         t_limit: T,
-    ) -> Result<Dop853Dense<T, N>, IntegrateError> {
+    ) -> Result<(), IntegrateError> {
         let StepParts { tol, ctrl, core } = parts;
         core.begin(sys, t_limit)?;
         let (t, y) = (core.t, core.y);
@@ -378,11 +379,11 @@ impl<T: Real, const N: usize> Method<T, N> for Dop853Method {
             }
             r[3 + m] = acc * hs;
         }
-        let dense = MethodDense {
+        *dense = MethodDense {
             ends: HermiteDense::new(t, a.t_new, y, y_new, k[0], f_new),
             poly: Dop853Interpolant { h: hs, r },
         };
         core.accept(&a);
-        Ok(dense)
+        Ok(())
     }
 }

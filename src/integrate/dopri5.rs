@@ -120,9 +120,10 @@ impl<T: Real, const N: usize> Method<T, N> for Dopri5Method {
 
     fn advance<S: Dynamics<T, N>>(
         parts: StepParts<'_, T, N>,
+        dense: &mut Dopri5Dense<T, N>,
         sys: &S,
         t_limit: T,
-    ) -> Result<Dopri5Dense<T, N>, IntegrateError> {
+    ) -> Result<(), IntegrateError> {
         let StepParts { tol, ctrl, core } = parts;
         core.begin(sys, t_limit)?;
         let (t, y, k1) = (core.t, core.y, core.f);
@@ -165,7 +166,7 @@ impl<T: Real, const N: usize> Method<T, N> for Dopri5Method {
         let ydiff = y_new - y;
         let bspl = k1 * hs - ydiff;
         let [d1, d3, d4, d5, d6, d7] = tableau::D.map(c);
-        let dense = MethodDense {
+        *dense = MethodDense {
             ends: HermiteDense::new(t, a.t_new, y, y_new, k1, k7),
             poly: Dopri5Interpolant {
                 h: hs,
@@ -176,6 +177,6 @@ impl<T: Real, const N: usize> Method<T, N> for Dopri5Method {
             },
         };
         core.accept(&a);
-        Ok(dense)
+        Ok(())
     }
 }

@@ -127,9 +127,10 @@ impl<T: Real, const N: usize> Method<T, N> for Rosenbrock23Method {
 
     fn advance<S: Dynamics<T, N>>(
         parts: StepParts<'_, T, N>,
+        dense: &mut Rosenbrock23Dense<T, N>,
         sys: &S,
         t_limit: T,
-    ) -> Result<Rosenbrock23Dense<T, N>, IntegrateError> {
+    ) -> Result<(), IntegrateError> {
         let StepParts { tol, ctrl, core } = parts;
         core.begin(sys, t_limit)?;
         let (t, y) = (core.t, core.y);
@@ -175,11 +176,11 @@ impl<T: Real, const N: usize> Method<T, N> for Rosenbrock23Method {
                 tol.error_norm(&errv, &y, &y_new)
             }))
         })?;
-        let dense = MethodDense {
+        *dense = MethodDense {
             ends: HermiteDense::new(t, a.t_new, y, a.y, f0, a.f),
             poly: Rosenbrock23Interpolant { h: a.hs, k1, k2 },
         };
         core.accept(&a);
-        Ok(dense)
+        Ok(())
     }
 }
