@@ -124,13 +124,14 @@ struct Linear {
 impl Contact<f64> for Linear {
     fn evaluate(&self, _t: f64, q: &[f64], jac: &mut Jacobian<'_, f64>) -> Geometry<f64> {
         let mut gap = self.offset;
-        for j in 0..3 {
-            if self.normal[j] != 0.0 {
-                jac.normal(j, self.normal[j]);
-                gap += self.normal[j] * q[j];
+        let rows = self.normal.iter().zip(&self.tangent).zip(q);
+        for (j, ((&n, &t), &x)) in rows.enumerate() {
+            if n != 0.0 {
+                jac.normal(j, n);
+                gap += n * x;
             }
-            if self.tangent[j] != 0.0 {
-                jac.tangent(j, self.tangent[j]);
+            if t != 0.0 {
+                jac.tangent(j, t);
             }
         }
         Geometry { gap }
@@ -244,6 +245,7 @@ fn period(beaks: &[f64], n: usize) -> (f64, f64) {
 
 /// States of `Woodpecker.ref` at t = 0.1 and 0.2 (rows 5001 and 10001 of the file):
 /// `(y, ẏ, φ_S, ω_S, φ_B, ω_B)`.
+#[allow(clippy::excessive_precision)] // transcribed digit for digit
 const REFERENCE_STATES: [[f64; 6]; 2] = [
     [
         -7.080097509441099e-03,
