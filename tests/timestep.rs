@@ -1012,6 +1012,8 @@ fn public_types_are_send_sync_clone() {
     check::<ImpactLog<f64>>();
     check::<nonsmooth::timestep::StroboscopicSection>();
     check::<nonsmooth::timestep::ContactRecord<f64>>();
+    check::<nonsmooth::timestep::LinearStep<f64, 6>>();
+    check::<nonsmooth::timestep::DriveObserver<f64, 6, nonsmooth::sample::Stroboscopic<f64, 6>>>();
 }
 
 /// A point mass on a vertical line under gravity (Siconos' bouncing ball: its vertical
@@ -1404,4 +1406,39 @@ fn drive_observers_watch_a_time_stepping_run() {
         .is_err()
     );
     assert!(DriveObserver::new(EventCount::default(), f64::NAN).is_err());
+}
+
+#[test]
+fn woodpecker_settles_on_its_limit_cycle() {
+    // Ten cycles from Siconos' initial state (h = 2e-5): every cycle, beak impact to beak
+    // impact, shows the reference's pattern (beak, g₃, g₂, g₃), and the mean period of the
+    // last five matches the reference file's one cycle (0.22710 − 0.08104 = 0.14606 s) to
+    // three steps. Impacts and the ends of sticking phases land on the grid, so single
+    // cycles jitter by up to about ten steps (see `examples/timestep_woodpecker.rs`, 40
+    // cycles: mean 0.146042 s, spread 1.8e-4 s).
+    let h = 2e-5;
+    let mut scheme = MoreauJean::new(Woodpecker, woodpecker_contacts(), h).unwrap();
+    let (mut q, mut v) = ([0.0, -0.1036, -0.2788], [-0.3411, 4.8572e-15, -7.4583]);
+    let mut jumps = Jumps::default();
+    scheme.run(0.0, &mut q, &mut v, 1.6, &mut jumps).unwrap();
+    let beaks: Vec<usize> = (0..jumps.impacts.len())
+        .filter(|&i| jumps.impacts[i].1 == 0)
+        .collect();
+    assert!(beaks.len() >= 11, "{} beak impacts", beaks.len());
+    for w in beaks.windows(2) {
+        let pattern: Vec<usize> = jumps.impacts[w[0]..w[1]].iter().map(|x| x.1).collect();
+        assert_eq!(
+            pattern,
+            [0, 2, 1, 2],
+            "cycle from step {}",
+            jumps.impacts[w[0]].0
+        );
+    }
+    let times: Vec<f64> = beaks
+        .iter()
+        .map(|&i| jumps.impacts[i].0 as f64 * h)
+        .collect();
+    let last5 = &times[times.len() - 6..];
+    let mean = (last5[5] - last5[0]) / 5.0;
+    assert!((mean - 0.14606).abs() <= 3.0 * h, "mean period {mean}");
 }
