@@ -36,8 +36,10 @@
 //!
 //! Measured (h = 2·10⁻⁵): period 0.14604 s over the last 20 of 40 cycles against the
 //! reference's 0.14606 s (its one full cycle, beak impact to beak impact at 0.08104 and
-//! 0.22710); the published papers' own period could not be confirmed here (the initial state
-//! above, Siconos', is the papers' periodic point as Siconos transcribes it).
+//! 0.22710). The published papers' own period could not be confirmed here: their text was not
+//! available, only the constants (Glocker's thesis, as transcribed by Siconos and others) and
+//! the initial state, which Siconos and the `cardillo` library both start their one-cycle
+//! runs from.
 //!
 //! `cargo run --release --example timestep_woodpecker`
 
