@@ -6,8 +6,8 @@
 use nonsmooth::drive::Control;
 use nonsmooth::timestep::lcp::{LcpError, Lemke, Nsgs, Pgs, frictional_contact_residual, residual};
 use nonsmooth::timestep::{
-    Contact, Geometry, ImpactLog, Jacobian, MoreauJean, PlanarBodies, PlanarContact, Plane,
-    RigidBody, Solver, StepObserver, StepRecord, TimeStepError,
+    Contact, Geometry, ImpactLog, Jacobian, Lagrangian, MoreauJean, PlanarBodies, PlanarContact,
+    Plane, RigidBody, Solver, StepObserver, StepRecord, TimeStepError,
 };
 
 /// A seeded xorshift generator (uniform in [0, 1)).
@@ -1012,4 +1012,434 @@ fn public_types_are_send_sync_clone() {
     check::<ImpactLog<f64>>();
     check::<nonsmooth::timestep::StroboscopicSection>();
     check::<nonsmooth::timestep::ContactRecord<f64>>();
+    check::<nonsmooth::timestep::LinearStep<f64, 6>>();
+    check::<nonsmooth::timestep::DriveObserver<f64, 6, nonsmooth::sample::Stroboscopic<f64, 6>>>();
+}
+
+/// A point mass on a vertical line under gravity (Siconos' bouncing ball: its vertical
+/// coordinate alone, the gap being the coordinate itself).
+struct Vertical {
+    m: f64,
+    g: f64,
+}
+
+impl Lagrangian<f64> for Vertical {
+    fn dofs(&self) -> usize {
+        1
+    }
+    fn mass(&self, _q: &[f64], m: &mut [f64]) {
+        m[0] = self.m;
+    }
+    fn diagonal_mass(&self) -> bool {
+        true
+    }
+    fn forces(&self, _t: f64, _q: &[f64], _v: &[f64], f: &mut [f64]) {
+        f[0] = -self.m * self.g;
+    }
+}
+
+/// A contact with constant rows: `g = normal·q + offset`, tangent velocity `tangent·q̇`.
+struct Linear<const N: usize> {
+    normal: [f64; N],
+    offset: f64,
+    tangent: [f64; N],
+    e: f64,
+    mu: f64,
+}
+
+impl<const N: usize> Contact<f64> for Linear<N> {
+    fn evaluate(&self, _t: f64, q: &[f64], jac: &mut Jacobian<'_, f64>) -> Geometry<f64> {
+        let mut gap = self.offset;
+        let rows = self.normal.iter().zip(&self.tangent).zip(q);
+        for (j, ((&n, &t), &x)) in rows.enumerate() {
+            if n != 0.0 {
+                jac.normal(j, n);
+                gap += n * x;
+            }
+            if t != 0.0 {
+                jac.tangent(j, t);
+            }
+        }
+        Geometry { gap }
+    }
+    fn restitution(&self) -> f64 {
+        self.e
+    }
+    fn friction(&self) -> f64 {
+        self.mu
+    }
+}
+
+/// Rows of Siconos' reference result `examples/mechanics/BouncingBall/BouncingBallTS.ref`
+/// (repository `siconos/siconos-tutorials`; `BouncingBallTS.cpp`: `MoreauJeanOSI`, θ = ½,
+/// h = 0.005, e = 0.9, m = 1, g = 9.81, q₀ = 1, v₀ = 0, an LCP per step): the row (= steps
+/// done), the position, the velocity and the step's impulse. Rows 91, 254, 401, 534 are the
+/// first four impact steps, 1715–2000 the ball at rest on the floor (its gap settled at
+/// −2.29e-5, the penetration left by the last impacts — no drift correction — and the
+/// impulse per step at m g h).
+#[allow(clippy::excessive_precision)] // transcribed digit for digit
+const SICONOS_BALL: [(usize, f64, f64, f64); 11] = [
+    (
+        91,
+        5.633874999998808e-03,
+        3.973050000000009e+00,
+        8.436600000000018e+00,
+    ),
+    (250, 6.412600000000038e-02, -3.825899999999999e+00, 0.0),
+    (
+        254,
+        4.640612499999924e-03,
+        3.575745000000000e+00,
+        7.597845000000000e+00,
+    ),
+    (
+        401,
+        1.635737500006920e-04,
+        3.226999499999999e+00,
+        6.861604499999997e+00,
+    ),
+    (500, 3.956807012500005e-01, -1.628950500000001e+00, 0.0),
+    (
+        534,
+        -7.446656374999743e-03,
+        2.922840450000001e+00,
+        6.219490950000001e+00,
+    ),
+    (1000, 1.513536802625140e-01, -7.522581257549901e-01, 0.0),
+    (1500, 7.675139496731129e-03, -4.064282005908780e-01, 0.0),
+    (
+        1715,
+        -2.288836712780184e-05,
+        1.661528943808221e-05,
+        4.908507672215473e-02,
+    ),
+    (
+        1750,
+        -2.288612618096358e-05,
+        -4.159065322417721e-07,
+        4.904912197508885e-02,
+    ),
+    (
+        2000,
+        -2.288618090550717e-05,
+        -2.775557561562891e-17,
+        4.904999999999019e-02,
+    ),
+];
+
+/// Records `(q, v, impulse)` after every step.
+#[derive(Default)]
+struct Trace(Vec<(f64, f64, f64)>);
+
+impl StepObserver<f64> for Trace {
+    fn on_step(&mut self, s: &StepRecord<'_, f64>) -> Control {
+        let p = s.contacts.iter().map(|c| c.normal_impulse).sum();
+        self.0.push((s.q[0], s.v[0], p));
+        Control::Continue
+    }
+}
+
+#[test]
+fn bouncing_ball_matches_siconos_reference_step_by_step() {
+    let ball = Vertical { m: 1.0, g: 9.81 };
+    let floor = vec![Linear {
+        normal: [1.0],
+        offset: 0.0,
+        tangent: [0.0],
+        e: 0.9,
+        mu: 0.0,
+    }];
+    let mut scheme = MoreauJean::new(ball, floor, 0.005).unwrap();
+    let (mut q, mut v) = ([1.0], [0.0]);
+    let mut trace = Trace::default();
+    let summary = scheme.run(0.0, &mut q, &mut v, 10.0, &mut trace).unwrap();
+    assert_eq!(summary.steps, 2000);
+    // Same grid, same forces (constant), same activation rule (predicted gap g + h ġ/2 ≤ 0)
+    // and an exact LCP solver on both sides: the states agree to rounding (measured worst
+    // difference 9e-17 of the scales; Siconos checks its own runs against the file at 1e-12).
+    let mut worst: f64 = 0.0;
+    for &(row, qr, vr, pr) in &SICONOS_BALL {
+        let (qm, vm, pm) = trace.0[row - 1];
+        for (a, b, scale) in [(qm, qr, 1.0), (vm, vr, 10.0), (pm, pr, 10.0)] {
+            worst = worst.max((a - b).abs() / scale);
+        }
+        // Impact steps and impulse-free steps are the same steps.
+        assert_eq!(pm > 0.0, pr > 0.0, "row {row}: impulse {pm} against {pr}");
+    }
+    eprintln!("Siconos ball: worst difference {worst:e}");
+    assert!(
+        worst <= 1e-12,
+        "worst difference {worst:e} (of 1 m, 10 m/s, 10 N s)"
+    );
+}
+
+/// Glocker's woodpecker toy (Ch. Glocker, PhD thesis, TU München 1995, pp. 162ff.; R. I.
+/// Leine, Ch. Glocker, D. H. van Campen, DETC 2001 / *J. Vib. Control* 9 (2003)) with the
+/// constants and initial state of Siconos' `examples/mechanics/Woodpecker`
+/// (`siconos/siconos-tutorials`): `q = (y, φ_S, φ_B)`, sleeve S and bird B; contacts beak
+/// (`e = 0.5`) and the sleeve's two edges (`e = 0`), `μ = 0.3`. See
+/// `examples/timestep_woodpecker.rs` for the limit cycle.
+struct Woodpecker;
+
+const WP: (f64, f64, f64, f64) = (3.0e-4, 5.0e-9, 4.5e-3, 7.0e-7); // m_S, J_S, m_B, J_B
+const WP_LS: f64 = 1.0e-2;
+const WP_LG: f64 = 1.5e-2;
+
+impl Lagrangian<f64> for Woodpecker {
+    fn dofs(&self) -> usize {
+        3
+    }
+    fn mass(&self, _q: &[f64], m: &mut [f64]) {
+        let (ms, js, mb, jb) = WP;
+        let (ls, lg) = (WP_LS, WP_LG);
+        m.copy_from_slice(&[
+            ms + mb,
+            mb * ls,
+            mb * lg,
+            mb * ls,
+            js + mb * ls * ls,
+            mb * ls * lg,
+            mb * lg,
+            mb * ls * lg,
+            jb + mb * lg * lg,
+        ]);
+    }
+    fn forces(&self, _t: f64, q: &[f64], _v: &[f64], f: &mut [f64]) {
+        let (ms, _, mb, _) = WP;
+        let spring = 5.6e-3 * (q[2] - q[1]);
+        f[0] = -(ms + mb) * 9.81;
+        f[1] = spring - mb * WP_LS * 9.81;
+        f[2] = -spring - mb * WP_LG * 9.81;
+    }
+}
+
+fn woodpecker_contacts() -> [Linear<3>; 3] {
+    let (r0, rs, hs, hb, lb) = (2.5e-3, 3.1e-3, 5.8e-3, 2.0e-2, 2.01e-2);
+    let sleeve = [1.0, rs, 0.0];
+    [
+        Linear {
+            normal: [0.0, 0.0, -hb],
+            offset: WP_LS + WP_LG - lb - r0,
+            tangent: [1.0, WP_LS, WP_LG - lb],
+            e: 0.5,
+            mu: 0.3,
+        },
+        Linear {
+            normal: [0.0, hs, 0.0],
+            offset: rs - r0,
+            tangent: sleeve,
+            e: 0.0,
+            mu: 0.3,
+        },
+        Linear {
+            normal: [0.0, -hs, 0.0],
+            offset: rs - r0,
+            tangent: sleeve,
+            e: 0.0,
+            mu: 0.3,
+        },
+    ]
+}
+
+/// Steps where the sleeve's angular velocity jumps by more than 3 rad/s or the bird's by more
+/// than 0.3 rad/s: `(step, contact with the largest impulse)`.
+/// Also keeps the state `(y, ẏ, φ_S, ω_S, φ_B, ω_B)` after `keep_at` steps.
+#[derive(Default)]
+struct Jumps {
+    last: [f64; 3],
+    impacts: Vec<(usize, usize)>,
+    keep_at: usize,
+    kept: Option<[f64; 6]>,
+}
+
+impl StepObserver<f64> for Jumps {
+    fn on_start(&mut self, _t0: f64, _q: &[f64], v: &[f64]) {
+        self.last.copy_from_slice(v);
+    }
+    fn on_step(&mut self, s: &StepRecord<'_, f64>) -> Control {
+        if (s.v[1] - self.last[1]).abs() > 3.0 || (s.v[2] - self.last[2]).abs() > 0.3 {
+            let c = s
+                .contacts
+                .iter()
+                .max_by(|a, b| a.normal_impulse.total_cmp(&b.normal_impulse))
+                .map_or(usize::MAX, |c| c.index);
+            self.impacts.push((s.step + 1, c));
+        }
+        if s.step + 1 == self.keep_at {
+            self.kept = Some([s.q[0], s.v[0], s.q[1], s.v[1], s.q[2], s.v[2]]);
+        }
+        self.last.copy_from_slice(s.v);
+        Control::Continue
+    }
+}
+
+#[test]
+fn woodpecker_impacts_match_siconos_reference() {
+    // Siconos' `Woodpecker.ref` (θ = ½, h = 2e-5, 0 ≤ t ≤ 0.3): the rows (= steps done) where
+    // ω_S or ω_B jump as above, and the contact that acts (0 beak, 1 and 2 the sleeve's
+    // edges g₂ = r_S − r_0 + h_S φ_S, g₃ = r_S − r_0 − h_S φ_S); the cycle from one beak
+    // impact to the next is beak, g₃, g₂, g₃ and lasts 0.14606 s in the file.
+    let reference = [
+        (3896, 2),
+        (4052, 0),
+        (4081, 2),
+        (5941, 1),
+        (11200, 2),
+        (11355, 0),
+        (11384, 2),
+        (13241, 1),
+    ];
+    let mut scheme = MoreauJean::new(Woodpecker, woodpecker_contacts(), 2e-5).unwrap();
+    let (mut q, mut v) = ([0.0, -0.1036, -0.2788], [-0.3411, 4.8572e-15, -7.4583]);
+    let mut jumps = Jumps {
+        keep_at: 14999,
+        ..Jumps::default()
+    };
+    scheme.run(0.0, &mut q, &mut v, 0.3, &mut jumps).unwrap();
+    assert_eq!(jumps.impacts.len(), reference.len(), "{:?}", jumps.impacts);
+    for (got, want) in jumps.impacts.iter().zip(&reference) {
+        assert_eq!(got.1, want.1, "contact of the impact at step {}", want.0);
+        // Measured: every impact on the reference's own step. Siconos treats the spring
+        // implicitly (linear time-invariant system), this scheme explicitly: one step of
+        // slack for that `O(h²)`-per-step difference.
+        assert!(
+            got.0.abs_diff(want.0) <= 1,
+            "step {} against {}",
+            got.0,
+            want.0
+        );
+    }
+    // Last row of the file (row 14999, t = 0.29998): `y, ẏ, φ_S, ω_S, φ_B, ω_B`, compared at
+    // 1e-3 of each coordinate's scale (the spring's implicit/explicit treatment again;
+    // measured: 3.7e-4 here, 4e-5 and 6e-5 at t = 0.1 and 0.2 in the example).
+    #[allow(clippy::excessive_precision)] // transcribed digit for digit
+    let last = [
+        -4.134818676833654e-02,
+        -2.601373307913771e-01,
+        -1.034684682717361e-01,
+        -2.220446049250313e-16,
+        -3.409339755504301e-01,
+        -8.327555353239312e+00,
+    ];
+    let scale = [1e-2, 0.3, 0.1, 10.0, 0.3, 10.0];
+    let kept = jumps.kept.unwrap();
+    let worst = (0..6).fold(0.0_f64, |a, i| a.max((kept[i] - last[i]).abs() / scale[i]));
+    eprintln!("woodpecker at t = 0.29998: {worst:e} of the scales");
+    assert!(worst < 1e-3, "{kept:?} against {last:?}: {worst:e}");
+}
+
+/// Counts the events a `drive::Observer` is shown, per contact.
+#[derive(Default)]
+struct EventCount(Vec<(usize, f64)>);
+
+impl nonsmooth::drive::Observer<f64, 6> for EventCount {
+    fn on_event(&mut self, e: &nonsmooth::drive::EventRecord<f64, 6>) -> Control {
+        self.0.push((e.index, e.t));
+        Control::Continue
+    }
+}
+
+#[test]
+fn drive_observers_watch_a_time_stepping_run() {
+    use nonsmooth::sample::Stroboscopic;
+    use nonsmooth::timestep::{DriveObserver, StroboscopicSection};
+    let ball = PlanarBodies::new(vec![RigidBody::disc(1.0, 0.1).unwrap()], 9.81).unwrap();
+    let floor =
+        vec![PlanarContact::disc_plane(0, 0.1, Plane::floor(0.0).unwrap(), 0.8, 0.0).unwrap()];
+    let mut scheme = MoreauJean::new(ball, floor, 1e-3).unwrap();
+    let (period, t_end) = (0.0937, 3.0);
+    let strobe = Stroboscopic::<f64, 6>::periodic(0.0, period, 0.0, 1000).unwrap();
+    let mut adapter = DriveObserver::new((strobe, EventCount::default()), 0.05).unwrap();
+    adapter.check(0.0, t_end).unwrap();
+    let mut own = (
+        StroboscopicSection::new(0.0, period).unwrap(),
+        ImpactLog::new(0.05).unwrap(),
+    );
+    let (mut q, mut v) = ([0.0, 1.1, 0.0], [0.3, 0.0, 0.0]);
+    scheme
+        .run(0.0, &mut q, &mut v, t_end, &mut (&mut adapter, &mut own))
+        .unwrap();
+    assert_eq!(adapter.mismatch(), None);
+    let (strobe, events) = adapter.observer();
+    let points = strobe.points();
+    // The sampler interpolates the adapter's linear dense output; the module's own section
+    // interpolates the same step ends linearly: the same samples to rounding.
+    assert_eq!(points.len(), own.0.samples.len());
+    assert_eq!(points.len(), (t_end / period) as usize + 1);
+    for (p, s) in points.iter().zip(&own.0.samples) {
+        assert!((p.t - s.t).abs() <= 1e-12, "{} against {}", p.t, s.t);
+        for i in 0..3 {
+            assert!((p.y[i] - s.q[i]).abs() <= 1e-12 * (1.0 + s.q[i].abs()));
+            assert!((p.y[3 + i] - s.v[i]).abs() <= 1e-12 * (1.0 + s.v[i].abs()));
+        }
+    }
+    // The ball moves sideways at 0.3 m/s: the section times carry x = 0.3 t exactly (no
+    // force along x), a check of the interpolation itself.
+    for p in points {
+        assert!(
+            (p.y[0] - 0.3 * p.t).abs() <= 1e-12,
+            "x({}) = {}",
+            p.t,
+            p.y[0]
+        );
+    }
+    // Impacts: the same steps as the impact log, at the steps' ends.
+    let log = &own.1.impacts;
+    assert!(log.len() >= 5, "{} impacts", log.len());
+    assert_eq!(events.0.len(), log.len());
+    for (e, i) in events.0.iter().zip(log) {
+        assert_eq!(e.0, i.contact);
+        assert_eq!(e.1, i.t1);
+    }
+    // A system of the wrong size is not observed: the run stops at its first step.
+    let strobe = Stroboscopic::<f64, 4>::periodic(0.0, period, 0.0, 10).unwrap();
+    let mut wrong = DriveObserver::new(strobe, 0.05).unwrap();
+    let (mut q, mut v) = ([0.0, 1.1, 0.0], [0.0; 3]);
+    let summary = scheme.run(0.0, &mut q, &mut v, 1.0, &mut wrong).unwrap();
+    assert!(summary.stopped && summary.steps == 1);
+    assert_eq!(wrong.mismatch(), Some(3));
+    assert!(wrong.observer().points().is_empty());
+    assert!(
+        DriveObserver::new(
+            Stroboscopic::<f64, 3>::periodic(0.0, 1.0, 0.0, 1).unwrap(),
+            0.0
+        )
+        .is_err()
+    );
+    assert!(DriveObserver::new(EventCount::default(), f64::NAN).is_err());
+}
+
+#[test]
+fn woodpecker_settles_on_its_limit_cycle() {
+    // Ten cycles from Siconos' initial state (h = 2e-5): every cycle, beak impact to beak
+    // impact, shows the reference's pattern (beak, g₃, g₂, g₃), and the mean period of the
+    // last five matches the reference file's one cycle (0.22710 − 0.08104 = 0.14606 s) to
+    // three steps. Impacts and the ends of sticking phases land on the grid, so single
+    // cycles jitter by up to about ten steps (see `examples/timestep_woodpecker.rs`, 40
+    // cycles: mean 0.146042 s, spread 1.8e-4 s).
+    let h = 2e-5;
+    let mut scheme = MoreauJean::new(Woodpecker, woodpecker_contacts(), h).unwrap();
+    let (mut q, mut v) = ([0.0, -0.1036, -0.2788], [-0.3411, 4.8572e-15, -7.4583]);
+    let mut jumps = Jumps::default();
+    scheme.run(0.0, &mut q, &mut v, 1.6, &mut jumps).unwrap();
+    let beaks: Vec<usize> = (0..jumps.impacts.len())
+        .filter(|&i| jumps.impacts[i].1 == 0)
+        .collect();
+    assert!(beaks.len() >= 11, "{} beak impacts", beaks.len());
+    for w in beaks.windows(2) {
+        let pattern: Vec<usize> = jumps.impacts[w[0]..w[1]].iter().map(|x| x.1).collect();
+        assert_eq!(
+            pattern,
+            [0, 2, 1, 2],
+            "cycle from step {}",
+            jumps.impacts[w[0]].0
+        );
+    }
+    let times: Vec<f64> = beaks
+        .iter()
+        .map(|&i| jumps.impacts[i].0 as f64 * h)
+        .collect();
+    let last5 = &times[times.len() - 6..];
+    let mean = (last5[5] - last5[0]) / 5.0;
+    assert!((mean - 0.14606).abs() <= 3.0 * h, "mean period {mean}");
 }

@@ -40,7 +40,9 @@
 //!   impulses), every active contact's [`ContactRecord`] (gap, velocities before and after,
 //!   impulses) and the solver's [`LcpReport`](lcp::LcpReport) (iterations, residual), to a
 //!   [`StepObserver`]; [`ImpactLog`] turns the impulses into impacts, [`StroboscopicSection`]
-//!   samples the state at `t₀ + i·T`;
+//!   samples the state at `t₀ + i·T`; [`DriveObserver`] lets any
+//!   [`drive::Observer`](crate::drive::Observer) (the [`sample`](crate::sample) samplers)
+//!   watch the run, each step with a [`LinearStep`] dense output, each impact an event;
 //! - a contact problem that is not solved to its tolerance stops the run with
 //!   [`TimeStepError::Contact`] naming the step, its time and the residual reached.
 //!
@@ -79,8 +81,8 @@ mod system;
 
 pub use error::TimeStepError;
 pub use observe::{
-    ContactRecord, Energy, Impact, ImpactLog, SectionSample, StepObserver, StepRecord,
-    StroboscopicSection, Summary,
+    ContactRecord, DriveObserver, Energy, Impact, ImpactLog, LinearStep, SectionSample,
+    StepObserver, StepRecord, StroboscopicSection, Summary,
 };
 pub use planar::{PlanarBodies, PlanarContact, Plane, RigidBody};
 pub use scheme::{MoreauJean, Solver};

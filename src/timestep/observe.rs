@@ -1,8 +1,12 @@
 //! What a time-stepping run reports: per-step records (state, energies, the active contacts
 //! with their impulses), observers of them, and an impact log built from the impulses.
 
+use nalgebra::SVector;
+
 use crate::Real;
-use crate::drive::Control;
+use crate::drive::{Control, EventRecord, Observer, Outcome, RunError, StepView, Termination};
+use crate::event::Direction;
+use crate::integrate::{DenseOutput, Stats};
 use crate::scalar::to_f64;
 
 use super::lcp::LcpReport;
@@ -305,5 +309,228 @@ impl<T: Real> StepObserver<T> for StroboscopicSection {
             *a = to_f64(b);
         }
         Control::Continue
+    }
+}
+
+/// The linear dense output of one time-stepping step, over the state `y = (q, v)` of
+/// `N = 2·dofs` entries: both halves interpolated linearly between the step's ends (the
+/// scheme's own first-order picture: its position update is a straight line in `t`, its
+/// velocity jumps inside the step).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LinearStep<T: Real, const N: usize> {
+    t0: T,
+    t1: T,
+    y0: SVector<T, N>,
+    y1: SVector<T, N>,
+    slope: SVector<T, N>,
+}
+
+impl<T: Real, const N: usize> DenseOutput<T, N> for LinearStep<T, N> {
+    fn span(&self) -> (T, T) {
+        (self.t0, self.t1)
+    }
+    fn endpoints(&self) -> (&SVector<T, N>, &SVector<T, N>) {
+        (&self.y0, &self.y1)
+    }
+    /// The chord's slope at both ends.
+    fn end_derivatives(&self) -> (&SVector<T, N>, &SVector<T, N>) {
+        (&self.slope, &self.slope)
+    }
+    fn interpolate_unchecked(&self, t: T, out: &mut SVector<T, N>) {
+        let s = t - self.t0;
+        for i in 0..N {
+            out[i] = self.y0[i] + s * self.slope[i];
+        }
+    }
+}
+
+/// Lets any [`drive::Observer`](crate::drive::Observer) — the samplers of
+/// [`sample`](crate::sample) among them — watch a time-stepping run: the state is
+/// `y = (q, v)` (`N = 2·dofs` entries), each step is an observer step with a
+/// [`LinearStep`] dense output, and each impact (a step whose contact
+/// [`is_impact`](ContactRecord::is_impact) at the given speed) is an event whose `index` is
+/// the contact's, reported after its step at the step's end `t1` with the state there (the
+/// impulse is already in it: the scheme has no pre-impact state at one instant; `y_after`
+/// is `None`, the direction [`Direction::Falling`](crate::event::Direction::Falling), the
+/// gap closing).
+///
+/// A run whose system does not have `N/2` coordinates is not forwarded: the adapter stops it
+/// at its first step and [`mismatch`](Self::mismatch) reports the number of coordinates seen.
+/// [`Observer::check`](crate::drive::Observer::check) and
+/// [`check_span`](crate::drive::Observer::check_span) are the caller's to call (as
+/// [`check`](Self::check) does) before the run.
+///
+/// # Examples
+/// ```
+/// use nonsmooth::sample::Stroboscopic;
+/// use nonsmooth::timestep::{DriveObserver, MoreauJean, PlanarBodies, PlanarContact, Plane, RigidBody};
+/// let ball = PlanarBodies::new(vec![RigidBody::disc(1.0, 0.1)?], 9.81)?;
+/// let floor = vec![PlanarContact::disc_plane(0, 0.1, Plane::floor(0.0)?, 0.5, 0.0)?];
+/// let mut scheme = MoreauJean::new(ball, floor, 1e-3)?;
+/// let strobe = Stroboscopic::<f64, 6>::periodic(0.0, 0.25, 0.0, 100)?;
+/// let mut adapter = DriveObserver::new(strobe, 1e-3)?;
+/// adapter.check(0.0, 1.0)?;
+/// let (mut q, mut v) = ([0.0, 1.1, 0.0], [0.0; 3]);
+/// scheme.run(0.0, &mut q, &mut v, 1.0, &mut adapter)?;
+/// assert_eq!(adapter.observer().points().len(), 5); // t = 0, 0.25, …, 1
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct DriveObserver<T: Real, const N: usize, O> {
+    observer: O,
+    speed: T,
+    last_t: T,
+    last: SVector<T, N>,
+    mismatch: Option<usize>,
+    steps: u64,
+    events: u64,
+}
+
+impl<T: Real, const N: usize, O: Observer<T, N>> DriveObserver<T, N, O> {
+    /// Wraps `observer`; contacts approaching faster than `speed ≥ 0` when struck are
+    /// reported as events.
+    ///
+    /// # Errors
+    /// [`ParameterError`](crate::ParameterError) unless `speed` is finite and ≥ 0, or if
+    /// `N` is odd (`N` must be `2·dofs`).
+    pub fn new(observer: O, speed: T) -> Result<Self, crate::ParameterError> {
+        if N % 2 != 0 {
+            return Err(crate::ParameterError::new(
+                "N",
+                N as f64,
+                "even: the state (q, v) has 2·dofs entries",
+            ));
+        }
+        Ok(Self {
+            observer,
+            speed: crate::validate::non_negative("speed", speed)?,
+            last_t: T::zero(),
+            last: SVector::zeros(),
+            mismatch: None,
+            steps: 0,
+            events: 0,
+        })
+    }
+
+    /// Runs the wrapped observer's [`check`](Observer::check) and
+    /// [`check_span`](Observer::check_span) for a run over `[t0, t_end]`.
+    ///
+    /// # Errors
+    /// The wrapped observer's.
+    pub fn check(&self, t0: T, t_end: T) -> Result<(), RunError> {
+        self.observer.check()?;
+        self.observer.check_span(t0, t_end)
+    }
+
+    /// The wrapped observer.
+    pub fn observer(&self) -> &O {
+        &self.observer
+    }
+
+    /// The wrapped observer, mutably.
+    pub fn observer_mut(&mut self) -> &mut O {
+        &mut self.observer
+    }
+
+    /// Unwraps the observer.
+    pub fn into_inner(self) -> O {
+        self.observer
+    }
+
+    /// The number of coordinates of the last run's system if it was not `N/2` (that run
+    /// was stopped at its first step, unobserved).
+    pub fn mismatch(&self) -> Option<usize> {
+        self.mismatch
+    }
+
+    fn stack(q: &[T], v: &[T], y: &mut SVector<T, N>) {
+        let n = N / 2;
+        for i in 0..n {
+            y[i] = q[i];
+            y[n + i] = v[i];
+        }
+    }
+}
+
+impl<T: Real, const N: usize, O: Observer<T, N>> StepObserver<T> for DriveObserver<T, N, O> {
+    fn on_start(&mut self, t0: T, q: &[T], v: &[T]) {
+        self.steps = 0;
+        self.events = 0;
+        self.mismatch = (2 * q.len() != N || 2 * v.len() != N).then_some(q.len());
+        if self.mismatch.is_some() {
+            return;
+        }
+        self.last_t = t0;
+        Self::stack(q, v, &mut self.last);
+        self.observer.on_start(t0, &self.last);
+    }
+
+    fn on_step(&mut self, s: &StepRecord<'_, T>) -> Control {
+        if self.mismatch.is_some() {
+            return Control::Stop;
+        }
+        let mut y1 = SVector::<T, N>::zeros();
+        Self::stack(s.q, s.v, &mut y1);
+        let span = s.t1 - s.t0;
+        let slope = if span > T::zero() {
+            (y1 - self.last) / span
+        } else {
+            SVector::zeros()
+        };
+        let dense = LinearStep {
+            t0: s.t0,
+            t1: s.t1,
+            y0: self.last,
+            y1,
+            slope,
+        };
+        let view = StepView {
+            t0: s.t0,
+            t1: s.t1,
+            y0: self.last,
+            y1,
+            dense: &dense,
+        };
+        let mut control = self.observer.on_step(&view);
+        for c in s.contacts {
+            if c.is_impact(self.speed) {
+                let event = EventRecord {
+                    index: c.index,
+                    t: s.t1,
+                    y: y1,
+                    y_after: None,
+                    direction: Direction::Falling,
+                };
+                self.events += 1;
+                if self.observer.on_event(&event) == Control::Stop {
+                    control = Control::Stop;
+                }
+            }
+        }
+        self.last_t = s.t1;
+        self.last = y1;
+        self.steps += 1;
+        control
+    }
+
+    fn on_finish(&mut self, summary: &Summary) {
+        if self.mismatch.is_some() {
+            return;
+        }
+        let outcome = Outcome {
+            t: self.last_t,
+            y: self.last,
+            termination: if summary.stopped {
+                Termination::ObserverStopped
+            } else {
+                Termination::ReachedEnd
+            },
+            stats: Stats {
+                accepted: self.steps,
+                events: self.events,
+                ..Stats::default()
+            },
+        };
+        self.observer.on_finish(&outcome);
     }
 }
