@@ -1180,3 +1180,172 @@ fn sliding_on_a_curved_surface_is_held_by_projection() {
     );
     assert!((run.x.norm_squared() - 1.0).abs() < 1e-13);
 }
+
+// ---------------------------------------------------------------------------------------
+// Lyapunov exponents through sliding, two estimators: the forced oscillator on a belt with a
+// falling (Stribeck-type) friction characteristic,
+// ẍ + x = a cos ωt − μ(v) sgn v, v = ẋ − v_b, μ(v) = 1 − δ + δ/(1 + γ|v|),
+// a Filippov system on H = ẋ − v_b (each side's friction a smooth function of v, extended
+// a little beyond its side). At δ = 0.5, γ = 3, v_b = 0.5, a = 1, ω = 0.5 it sticks and
+// slips chaotically (both estimators find a positive exponent, many standard errors above
+// zero); at ω = 0.6 it settles on a periodic stick–slip orbit.
+#[derive(Clone, Copy, Debug)]
+struct Stribeck {
+    a: f64,
+    w: f64,
+}
+
+const STRIBECK_VB: f64 = 0.5;
+const STRIBECK_DROP: f64 = 0.5;
+const STRIBECK_GAMMA: f64 = 3.0;
+
+impl Filippov<f64, 2, 1> for Stribeck {
+    fn surface(&self, _i: usize, _t: f64, x: &SVector<f64, 2>) -> f64 {
+        x[1] - STRIBECK_VB
+    }
+    fn gradient(&self, _i: usize, _t: f64, _x: &SVector<f64, 2>) -> SVector<f64, 2> {
+        SVector::from([0.0, 1.0])
+    }
+    fn field(&self, sides: &[Side; 1], t: f64, x: &SVector<f64, 2>, dx: &mut SVector<f64, 2>) {
+        let v = x[1] - STRIBECK_VB;
+        let s = sides[0].sign::<f64>();
+        let mu = 1.0 - STRIBECK_DROP + STRIBECK_DROP / (1.0 + STRIBECK_GAMMA * s * v);
+        *dx = SVector::from([x[1], -x[0] + self.a * (self.w * t).cos() - s * mu]);
+    }
+    fn field_jacobian(
+        &self,
+        sides: &[Side; 1],
+        _t: f64,
+        x: &SVector<f64, 2>,
+    ) -> Option<SMatrix<f64, 2, 2>> {
+        // ∂(−s μ)/∂v = δγ/(1 + γ s v)².
+        let v = x[1] - STRIBECK_VB;
+        let s = sides[0].sign::<f64>();
+        let q = 1.0 + STRIBECK_GAMMA * s * v;
+        Some(SMatrix::<f64, 2, 2>::new(
+            0.0,
+            1.0,
+            -1.0,
+            STRIBECK_DROP * STRIBECK_GAMMA / (q * q),
+        ))
+    }
+    fn time_scale(&self, _t: f64) -> Option<f64> {
+        Some(TAU / self.w / 16.0)
+    }
+}
+
+/// The QR estimate (`FilippovSimulation::exponents`) of the top exponent over `chunks`
+/// consecutive runs of `periods` forcing periods each (renormalized every period): the
+/// mean of the chunks and its standard error.
+fn qr_top_exponent(
+    system: Stribeck,
+    t0: f64,
+    x0: SVector<f64, 2>,
+    chunks: usize,
+    periods: usize,
+) -> (f64, f64) {
+    let period = TAU / system.w;
+    let tol6 = Tolerances::<f64, 6>::new(1e-10, 1e-12).unwrap();
+    let mut sim = FilippovSimulation::new(system, Dopri5::new(tol2()));
+    let mut x = x0;
+    let mut values = Vec::new();
+    for c in 0..chunks {
+        let t = t0 + (c * periods) as f64 * period;
+        let e = sim.exponents(t, x, period, periods, tol6).unwrap();
+        values.push(e.values[0]);
+        x = e.x;
+    }
+    let n = values.len() as f64;
+    let mean = values.iter().sum::<f64>() / n;
+    let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    (mean, (var / n).sqrt())
+}
+
+#[test]
+fn top_exponent_through_sliding_two_trajectory_and_qr_agree() {
+    use nonsmooth::lyapunov::{FilippovTwoTrajectory, Norm};
+    // Chaotic stick–slip: a transient of 100 periods, then both estimators from the same
+    // state over the same 400 periods.
+    let chaotic = Stribeck { a: 1.0, w: 0.5 };
+    let period = TAU / chaotic.w;
+    let mut sim = FilippovSimulation::new(chaotic, Dopri5::new(tol2()));
+    let start = sim
+        .run(0.0, SVector::from([0.1, 0.0]), 100.0 * period, &mut ())
+        .unwrap();
+    let sticks = sim
+        .run(start.t, start.x, start.t + 400.0 * period, &mut ())
+        .unwrap()
+        .transitions
+        .iter()
+        .filter(|tr| tr.kind == TransitionKind::SlidingEntry)
+        .count();
+    assert!(sticks > 100, "{sticks} sticks in 400 periods");
+    let mut two =
+        FilippovTwoTrajectory::new(chaotic, Dopri5::new(tol2()), 1e-7, Norm::Euclidean).unwrap();
+    two.start(start.t, start.x).unwrap();
+    let tt = two.estimate(period, 400).unwrap();
+    let (qr, qr_spread) = qr_top_exponent(chaotic, start.t, start.x, 10, 40);
+    let combined = (tt.spread.powi(2) + qr_spread.powi(2)).sqrt();
+    println!(
+        "chaotic stick–slip: two trajectories λ₁ = {:.5} ± {:.5}, QR λ₁ = {qr:.5} ± {qr_spread:.5} ({sticks} sticks in 400 periods), difference {:.2e} = {:.2} combined standard errors",
+        tt.exponent,
+        tt.spread,
+        (tt.exponent - qr).abs(),
+        (tt.exponent - qr).abs() / combined
+    );
+    // Chaos: both positive by many standard errors.
+    assert!(
+        tt.exponent > 5.0 * tt.spread,
+        "{} ± {}",
+        tt.exponent,
+        tt.spread
+    );
+    assert!(qr > 5.0 * qr_spread, "{qr} ± {qr_spread}");
+    // Agreement within the spreads (two combined standard errors).
+    assert!(
+        (tt.exponent - qr).abs() < 2.0 * combined,
+        "two trajectories {} ± {}, QR {qr} ± {qr_spread}",
+        tt.exponent,
+        tt.spread
+    );
+
+    // A periodic stick–slip orbit: its Floquet multipliers by shooting (one is 0: sticking
+    // collapses the velocity), the top exponent ln|μ₁|/T by both estimators.
+    let periodic = Stribeck { a: 1.0, w: 0.6 };
+    let period = TAU / periodic.w;
+    let mut sim = FilippovSimulation::new(periodic, Dopri5::new(tol2()));
+    let settled = sim
+        .run(0.0, SVector::from([0.1, 0.0]), 100.0 * period, &mut ())
+        .unwrap();
+    let tol6 = Tolerances::<f64, 6>::new(1e-12, 1e-14).unwrap();
+    let orbit = sim
+        .find_orbit(0.0, settled.x, period, false, tol6, 1e-11, 20)
+        .unwrap();
+    assert!(
+        orbit
+            .monodromy
+            .run
+            .transitions
+            .iter()
+            .any(|tr| tr.kind == TransitionKind::SlidingEntry)
+    );
+    let mus = orbit.monodromy.multipliers();
+    let floquet = mus[0].norm().ln() / period;
+    assert!(mus[1].norm() < 1e-9, "{mus:?}");
+    let mut two =
+        FilippovTwoTrajectory::new(periodic, Dopri5::new(tol2()), 1e-7, Norm::Euclidean).unwrap();
+    two.start(0.0, orbit.state).unwrap();
+    two.transient(period, 5).unwrap();
+    let tt = two.estimate(period, 40).unwrap();
+    let (qr, _) = qr_top_exponent(periodic, 0.0, orbit.state, 2, 20);
+    println!(
+        "periodic stick–slip: multipliers {mus:?}, Floquet λ₁ = {floquet:.8}, two trajectories {:.8} ± {:.1e}, QR {qr:.8}",
+        tt.exponent, tt.spread
+    );
+    assert!(
+        (tt.exponent - floquet).abs() < 1e-6,
+        "{} vs {floquet}",
+        tt.exponent
+    );
+    assert!((qr - floquet).abs() < 1e-6, "{qr} vs {floquet}");
+}

@@ -98,6 +98,7 @@
 //! (1985).
 
 mod diagram;
+mod filippov;
 pub mod hybrid;
 mod lanes;
 mod tangent;
@@ -106,6 +107,7 @@ mod two_trajectory;
 pub use diagram::{
     Diagram, DiagramDirection, DiagramPoint, DiagramSettings, IntervalRule, tle_diagram,
 };
+pub use filippov::FilippovTwoTrajectory;
 pub use hybrid::{HybridTangentSpace, HybridTwoTrajectory, Saltation};
 pub use lanes::tle_independent;
 #[cfg(feature = "parallel")]
@@ -266,6 +268,22 @@ pub enum LyapunovError {
     /// (its message).
     #[error("building the system failed: {0}")]
     Build(String),
+    /// A run of a Filippov system failed where only sliding motion can fail (two surfaces
+    /// met at once, a repelling surface, drift off the surface, …); its engine errors are
+    /// [`Run`](Self::Run).
+    #[error(transparent)]
+    Filippov(crate::filippov::FilippovError),
+}
+
+impl From<crate::filippov::FilippovError> for LyapunovError {
+    /// The engine's errors as [`Run`](LyapunovError::Run), the rest as
+    /// [`Filippov`](LyapunovError::Filippov).
+    fn from(e: crate::filippov::FilippovError) -> Self {
+        match e {
+            crate::filippov::FilippovError::Run(e) => LyapunovError::Run(e),
+            e => LyapunovError::Filippov(e),
+        }
+    }
 }
 
 /// `Result` with [`LyapunovError`].
