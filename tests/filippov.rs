@@ -982,7 +982,7 @@ fn f32_relay_slides_on_its_surface() {
 }
 
 /// The belt oscillator at forcing `f0`, `ω = 2`, `u = 0.5`, `F_k = 1`.
-fn belt(f0: f64) -> impl Filippov<f64, 2, 1> {
+fn belt(f0: f64) -> impl Filippov<f64, 2, 1> + Clone {
     const W: f64 = 2.0;
     Switched::new(
         |x: &SVector<f64, 2>| x[1] - 0.5,
@@ -1348,4 +1348,119 @@ fn top_exponent_through_sliding_two_trajectory_and_qr_agree() {
         tt.exponent
     );
     assert!((qr - floquet).abs() < 1e-6, "{qr} vs {floquet}");
+}
+
+/// The number of crossings and of sliding entries over one period `π` of the belt
+/// oscillator at `f0` after `settle` periods from `x0`.
+fn belt_period_kinds(f0: f64, x0: SVector<f64, 2>, settle: f64) -> (usize, usize) {
+    let mut sim = FilippovSimulation::new(belt(f0), Dopri5::new(tol2()));
+    let warm = sim.run(0.0, x0, settle * PI, &mut ()).unwrap();
+    let run = sim.run(warm.t, warm.x, warm.t + PI, &mut ()).unwrap();
+    let count = |k: TransitionKind| run.transitions.iter().filter(|tr| tr.kind == k).count();
+    (
+        count(TransitionKind::Crossing),
+        count(TransitionKind::SlidingEntry),
+    )
+}
+
+/// Bisection on `p` of a change of the simulated transition counts between `lo` and `hi`
+/// (an independent location: plain simulation, no shooting, no test function).
+fn bisect_by_simulation(mut lo: f64, mut hi: f64, x0: SVector<f64, 2>, width: f64) -> (f64, f64) {
+    let at_lo = belt_period_kinds(lo, x0, 80.0);
+    assert_ne!(
+        at_lo,
+        belt_period_kinds(hi, x0, 80.0),
+        "no change in [{lo}, {hi}]"
+    );
+    while hi - lo > width {
+        let mid = 0.5 * (lo + hi);
+        if belt_period_kinds(mid, x0, 80.0) == at_lo {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    (lo, hi)
+}
+
+#[test]
+fn sliding_bifurcations_on_a_branch_of_the_belt_oscillator() {
+    use nonsmooth::orbit::sliding::{SlidingBifurcationKind, SlidingContinuation, follow_sliding};
+    // The belt oscillator's orbit of the forcing period π (ω = 2) followed in F₀ from the
+    // pure-slip orbit at F₀ = 0.6 up to F₀ = 2.2.
+    let build = |f0: f64| Ok(FilippovSimulation::new(belt(f0), Dopri5::new(tol2())));
+    let tol6 = Tolerances::<f64, 6>::new(1e-12, 1e-14).unwrap();
+    let settings = SlidingContinuation::new(0.5, 2.2, 0.05, 0)
+        .unwrap()
+        .with_locate_tolerance(1e-12)
+        .unwrap();
+    let p0 = 0.6;
+    let branch = follow_sliding(
+        build,
+        |_| PI,
+        0.0,
+        p0,
+        SVector::from([1.0 + p0 / (1.0 - 4.0), 0.0]),
+        tol6,
+        &settings,
+    )
+    .unwrap();
+    assert_eq!(branch.end, nonsmooth::orbit::BranchEnd::ParameterRange);
+    for b in &branch.bifurcations {
+        println!(
+            "{:?} at F₀ = {:.12} (test function {:.2e}, bracket width {:.1e})",
+            b.kind,
+            b.p,
+            b.value,
+            b.bracket.1 - b.bracket.0
+        );
+    }
+    let kinds: Vec<SlidingBifurcationKind> = branch.bifurcations.iter().map(|b| b.kind).collect();
+    assert_eq!(
+        kinds,
+        [
+            SlidingBifurcationKind::GrazingSliding,
+            SlidingBifurcationKind::CrossingSliding,
+            SlidingBifurcationKind::CrossingSliding
+        ]
+    );
+    // Grazing-sliding: the slipping orbit's top velocity F₀ω/|1 − ω²| reaches u at
+    // F₀* = u|1 − ω²|/ω = 0.75.
+    let gs = &branch.bifurcations[0];
+    assert!((gs.p - 0.75).abs() < 1e-9, "grazing-sliding at {}", gs.p);
+    // Before it no point slides; after it every point does (until the crossing-sliding
+    // at the end of the branch).
+    for q in &branch.points {
+        assert_eq!(
+            q.tests.sliding_segments > 0,
+            q.p > gs.p && q.p < 2.03,
+            "{q:?}"
+        );
+    }
+    // Confirmed by simulation on both sides: the sliding segment appears past it.
+    let (below, slid_below) = belt_approach(gs.p * (1.0 - 1e-6));
+    let (_, slid_above) = belt_approach(gs.p * (1.0 + 1e-6));
+    assert!(!slid_below && below > 0.0, "below: {below}");
+    assert!(slid_above, "no sliding above the grazing-sliding");
+    // Crossing-sliding: where the orbit arrives at ẋ = u from below, the far field's rate
+    // −x + F₀ cos 2t − F_k passes through 0; below, the arrival is a sliding entry; above, a
+    // crossing into ẋ > u, followed by a short excursion and a sliding entry from above.
+    // Checked against a bisection of the simulated transition counts (no shooting, no test
+    // function) and, on both sides, by simulation.
+    for cs in &branch.bifurcations[1..] {
+        let (lo, hi) = bisect_by_simulation(cs.p - 0.01, cs.p + 0.01, cs.state, 1e-9);
+        println!(
+            "crossing-sliding at F₀ = {:.12}; simulation brackets it in [{lo:.12}, {hi:.12}]",
+            cs.p
+        );
+        assert!(
+            cs.p > lo - 1e-9 && cs.p < hi + 1e-9,
+            "{} outside [{lo}, {hi}]",
+            cs.p
+        );
+        assert_ne!(
+            belt_period_kinds(cs.p * (1.0 - 1e-6), cs.state, 80.0),
+            belt_period_kinds(cs.p * (1.0 + 1e-6), cs.state, 80.0)
+        );
+    }
 }

@@ -70,6 +70,7 @@ use crate::lyapunov::{LyapunovError, Norm, Saltation, Variational};
 use crate::scalar::{lit, to_f64};
 
 pub mod continuation;
+pub mod sliding;
 
 pub use continuation::{
     Bifurcation, BifurcationKind, Branch, BranchEnd, BranchPoint, ContinuationSettings, Grazing,
@@ -121,6 +122,22 @@ pub enum OrbitError {
     /// (its message).
     #[error("building the problem failed: {0}")]
     Build(String),
+    /// A run or shooting of a Filippov system failed where only sliding motion can fail
+    /// (two surfaces met at once, a repelling surface, no convergence of the shooting, …);
+    /// its engine errors are [`Run`](Self::Run).
+    #[error(transparent)]
+    Filippov(crate::filippov::FilippovError),
+}
+
+impl From<crate::filippov::FilippovError> for OrbitError {
+    /// The engine's errors as [`Run`](OrbitError::Run), the rest as
+    /// [`Filippov`](OrbitError::Filippov).
+    fn from(e: crate::filippov::FilippovError) -> Self {
+        match e {
+            crate::filippov::FilippovError::Run(e) => OrbitError::Run(e),
+            e => OrbitError::Filippov(e),
+        }
+    }
 }
 
 /// `Result` with [`OrbitError`].
