@@ -1464,3 +1464,79 @@ fn sliding_bifurcations_on_a_branch_of_the_belt_oscillator() {
         );
     }
 }
+
+// ---------------------------------------------------------------------------------------
+// Samplers and sweeps through sliding.
+
+#[test]
+fn sweeps_record_stroboscopic_points_and_sliding_through_filippov_runs() {
+    use nonsmooth::sample::Regime;
+    use nonsmooth::sweep::{SweepConfig, sweep_filippov};
+    // The belt oscillator on both sides of its grazing-sliding (F₀* = 0.75), each value
+    // from (0.8, 0): at F₀ = 0.6 that is the pure-slip orbit, with the stroboscopic point
+    // x(0) = F_k + F₀/(1 − ω²) = 1 − F₀/3, ẋ = 0 (undamped: it stays, it is not attracted);
+    // at F₀ = 0.9 and 1.2 the run settles on the orbit with one stick per period
+    // (multipliers 0.91 and 0.75, after 200 periods within 3e-9).
+    let config = SweepConfig::new(vec![0.6, 0.9, 1.2])
+        .unwrap()
+        .continuation(false)
+        .transients(200, 200)
+        .record(10)
+        .unwrap();
+    let x0 = SVector::from([0.8, 0.0]);
+    let build = |f0: f64| Ok(FilippovSimulation::new(belt(f0), Dopri5::new(tol2())));
+    let points = sweep_filippov(&config, build, |_| PI, x0).unwrap();
+    assert_eq!(points.len(), 3);
+    for q in &points {
+        assert_eq!(q.poincare.len(), 11, "{q:?}");
+        assert_eq!(q.regime, Regime::Periodic(1), "{q:?}");
+        if q.param < 0.75 {
+            assert_eq!((q.sliding_entries, q.sliding_fraction), (0, 0.0));
+            let worst = q
+                .poincare
+                .iter()
+                .map(|y| (y[0] - (1.0 - q.param / 3.0)).abs().max(y[1].abs()))
+                .fold(0.0, f64::max);
+            assert!(worst < 1e-9, "F₀ = {}: {worst:e}", q.param);
+        } else {
+            assert_eq!(q.sliding_entries, 10, "{q:?}");
+            assert!(q.sliding_fraction > 0.0 && q.sliding_fraction < 1.0);
+        }
+        // The sampler's points are the states of the run at t = kπ: checked against a plain
+        // run to t = 205π.
+        let mut sim = FilippovSimulation::new(belt(q.param), Dopri5::new(tol2()));
+        let at = sim.run(0.0, x0, 205.0 * PI, &mut ()).unwrap().x;
+        assert!(
+            (at - q.poincare[5]).amax() < 1e-9,
+            "{at:?} vs {:?}",
+            q.poincare[5]
+        );
+    }
+    // The sliding fraction grows with the forcing.
+    assert!(points[2].sliding_fraction > points[1].sliding_fraction);
+    println!(
+        "sweep: sliding fractions {:?}",
+        points
+            .iter()
+            .map(|q| q.sliding_fraction)
+            .collect::<Vec<_>>()
+    );
+    // The chaotic and the periodic stick–slip of the Stribeck oscillator, told apart by
+    // the stroboscopic points.
+    let config = SweepConfig::new(vec![0.5, 0.6])
+        .unwrap()
+        .continuation(false)
+        .transients(100, 100)
+        .record(60)
+        .unwrap();
+    let build = |w: f64| {
+        Ok(FilippovSimulation::new(
+            Stribeck { a: 1.0, w },
+            Dopri5::new(tol2()),
+        ))
+    };
+    let points = sweep_filippov(&config, build, |w| TAU / w, SVector::from([0.1, 0.0])).unwrap();
+    assert_eq!(points[0].regime, Regime::NotPeriodic);
+    assert_eq!(points[1].regime, Regime::Periodic(1));
+    assert!(points.iter().all(|q| q.sliding_entries >= 60), "{points:?}");
+}
