@@ -1512,6 +1512,22 @@ fn sweeps_record_stroboscopic_points_and_sliding_through_filippov_runs() {
             q.poincare[5]
         );
     }
+    // Per-period records through Plain: the extrema of x over each period of the pure-slip
+    // orbit x = 1 − 0.2 cos 2t are 0.8 and 1.2 (located on the dense output between steps).
+    let mut summary = nonsmooth::filippov::Plain(
+        nonsmooth::sample::PeriodSummary::periodic(0.0, PI, 7, 0, 1, 10.0, 0.0, 16).unwrap(),
+    );
+    FilippovSimulation::new(belt(0.6), Dopri5::new(tol2()))
+        .run(0.0, x0, 5.0 * PI, &mut summary)
+        .unwrap();
+    let periods = summary.0.periods();
+    assert_eq!(periods.len(), 5);
+    for r in periods {
+        assert!(
+            (r.x_min - 0.8).abs() < 1e-9 && (r.x_max - 1.2).abs() < 1e-9 && r.impacts == 0,
+            "{r:?}"
+        );
+    }
     // The sliding fraction grows with the forcing.
     assert!(points[2].sliding_fraction > points[1].sliding_fraction);
     println!(

@@ -1,23 +1,7 @@
 //! The two-trajectory (Benettin) estimate of the top exponent of a Filippov system, through
 //! crossings, sliding and exits.
 //!
-//! A Filippov flow is continuous in the state (the field jumps across a switching surface,
-//! the state does not), so the separation of two trajectories is a continuous function of
-//! time whatever modes they are in: unlike a system with resets
-//! ([`HybridTwoTrajectory`](super::HybridTwoTrajectory)) it can be measured at the grid times
-//! `t_k = t₀ + kτ` even when one trajectory slides and the other has not reached the
-//! surface yet. Each trajectory is an event-driven [`FilippovSimulation`] run of its own
-//! (crossings, sliding entries and exits at its own times); every `τ` the separation is
-//! pulled back to `d0` along its direction:
-//! $$d_k = \|\tilde x(t_k) - x(t_k)\|_w,\qquad
-//!   \tilde x(t_k) \leftarrow x(t_k) + \frac{d_0}{d_k}\bigl(\tilde x(t_k) - x(t_k)\bigr),\qquad
-//!   \lambda_1 \approx \frac{1}{n\tau}\sum_{k=1}^{n}\ln\frac{d_k}{d_0}.$$
-//! Sliding contracts the direction normal to the surface (to zero in one instant: the
-//! saltation matrix of a sliding entry is singular); the separation then lies in the
-//! surface, and what is measured is the growth along it. No Jacobian and no saltation
-//! matrix is formed: this is the check of the tangent-space estimate
-//! [`FilippovSimulation::exponents`] (variational equations of each mode and saltation
-//! matrices at each transition), by a method that shares nothing with it but the runs.
+//! The method is documented on [`FilippovTwoTrajectory`].
 
 use nalgebra::SVector;
 
@@ -32,10 +16,30 @@ use crate::integrate::{Stats, Stepper};
 use crate::scalar::{lit, to_f64};
 
 /// The two-trajectory (Benettin) estimator of the top Lyapunov exponent of a Filippov
-/// system (see the [module docs](self)): two [`FilippovSimulation`]s of the same system,
-/// used in three stages like [`TwoTrajectory`](super::TwoTrajectory) —
-/// [`start`](Self::start), [`transient`](Self::transient), [`estimate`](Self::estimate).
+/// system: two [`FilippovSimulation`]s of the same system, used in three stages like
+/// [`TwoTrajectory`](super::TwoTrajectory) — [`start`](Self::start),
+/// [`transient`](Self::transient), [`estimate`](Self::estimate).
 ///
+/// # Method
+/// A Filippov flow is continuous in the state (the field jumps across a switching surface,
+/// the state does not), so the separation of two trajectories is a continuous function of
+/// time whatever modes they are in: unlike a system with resets
+/// ([`HybridTwoTrajectory`](super::HybridTwoTrajectory)) it can be measured at the grid times
+/// `t_k = t₀ + kτ` even when one trajectory slides and the other has not reached the
+/// surface yet. Each trajectory is an event-driven [`FilippovSimulation`] run of its own
+/// (crossings, sliding entries and exits at its own times); every `τ` the separation is
+/// pulled back to `d0` along its direction:
+/// $$d_k = \|\tilde x(t_k) - x(t_k)\|_w,\qquad
+///   \tilde x(t_k) \leftarrow x(t_k) + \frac{d_0}{d_k}\bigl(\tilde x(t_k) - x(t_k)\bigr),\qquad
+///   \lambda_1 \approx \frac{1}{n\tau}\sum_{k=1}^{n}\ln\frac{d_k}{d_0}.$$
+/// Sliding contracts the direction normal to the surface (to zero in one instant: the
+/// saltation matrix of a sliding entry is singular); the separation then lies in the
+/// surface, and what is measured is the growth along it. No Jacobian and no saltation
+/// matrix is formed: this is the check of the tangent-space estimate
+/// [`FilippovSimulation::exponents`] (variational equations of each mode and saltation
+/// matrices at each transition), by a method that shares nothing with it but the runs.
+///
+/// # Example
 /// ```
 /// use nalgebra::SVector;
 /// use nonsmooth::filippov::Switched;

@@ -31,6 +31,15 @@
 //! that does not depend on the length of the run. It needs
 //! [`Dynamics::jacobian`].
 //!
+//! **Through sliding** ([`FilippovTwoTrajectory`]). For a Filippov system (a field
+//! discontinuous across switching surfaces, with sliding on them) the two trajectories are
+//! two event-driven runs of [`FilippovSimulation`](crate::filippov::FilippovSimulation);
+//! the state is continuous, so the separation is measured at the grid times whatever the
+//! modes. It checks the tangent-space estimate
+//! [`FilippovSimulation::exponents`](crate::filippov::FilippovSimulation::exponents)
+//! (saltation matrices at crossings and sliding entries, the sliding field's Jacobian
+//! while sliding).
+//!
 //! # The norm
 //! Both methods measure separations in a weighted Euclidean [`Norm`]
 //! $$\|\delta\|_w = \Bigl(\sum_i (\delta_i/w_i)^2\Bigr)^{1/2},$$

@@ -26,6 +26,11 @@
 //! `|μ|^{1/m}`, and solves for all segment starts `yᵢ` at once:
 //! `φᵢ(yᵢ) − y₍ᵢ₊₁₎ mod m = 0`, Jacobian blocks `Φᵢ` and `−I`, `Φ = Φ_{m−1}⋯Φ₀`.
 //!
+//! Orbits of forced Filippov systems (crossings and sliding) are followed by
+//! [`sliding::follow_sliding`], shooting through
+//! [`FilippovSimulation::find_orbit`](crate::filippov::FilippovSimulation::find_orbit),
+//! with the sliding bifurcations located on the branch as zeros of their test functions.
+//!
 //! # Example
 //! A forced linear oscillator `ẍ + 2ζẋ + x = cos ωt`: its periodic orbit is the steady state,
 //! its multipliers `e^{(−ζ ± i√(1−ζ²))T}`.
