@@ -1140,6 +1140,11 @@ fn public_types_are_send_sync_clone() {
     check::<nonsmooth::filippov::SlidingOrbit<f64, 3, 1>>();
     check::<nonsmooth::filippov::Exponents<f64, 3>>();
     check::<FilippovSimulation<f64, Corner, Dopri5<f64, 2>>>();
+    check::<nonsmooth::lyapunov::FilippovTwoTrajectory<f64, 2, Corner, Dopri5<f64, 2>>>();
+    check::<nonsmooth::orbit::sliding::SlidingBranch<2>>();
+    check::<nonsmooth::orbit::sliding::SlidingContinuation>();
+    check::<nonsmooth::orbit::sliding::SlidingTests>();
+    check::<nonsmooth::sweep::SlidingSweepPoint<2>>();
 }
 
 #[test]
@@ -1395,6 +1400,26 @@ fn sliding_bifurcations_on_a_branch_of_the_belt_oscillator() {
         .with_locate_tolerance(1e-12)
         .unwrap();
     let p0 = 0.6;
+    // Settings are checked: an empty range, a zero step, a surface the system lacks.
+    assert!(SlidingContinuation::new(1.0, 1.0, 0.1, 0).is_err());
+    assert!(SlidingContinuation::new(0.0, 1.0, 0.0, 0).is_err());
+    assert!(SlidingContinuation::new(0.0, 1.0, f64::NAN, 0).is_err());
+    assert!(settings.with_locate_tolerance(0.0).is_err());
+    let wrong = SlidingContinuation::new(0.5, 2.2, 0.05, 1).unwrap();
+    match follow_sliding(
+        build,
+        |_| PI,
+        0.0,
+        p0,
+        SVector::from([0.8, 0.0]),
+        tol6,
+        &wrong,
+    ) {
+        Err(nonsmooth::orbit::OrbitError::InvalidSetting { what, value, .. }) => {
+            assert!(what.contains("surface") && value == 1.0, "{what}");
+        }
+        other => panic!("expected an invalid surface, got {other:?}"),
+    }
     let branch = follow_sliding(
         build,
         |_| PI,

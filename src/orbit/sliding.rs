@@ -62,12 +62,14 @@ pub struct SlidingContinuation {
     locate_tolerance: f64,
     xtol: f64,
     max_iterations: usize,
+    max_points: usize,
 }
 
 impl SlidingContinuation {
     /// Follow the branch over the grid `p₀ + kΔp` (`step = Δp`, either sign) while `p` stays
-    /// in `[lo, hi]`, testing surface `surface`; sign changes located to `10⁻⁹·max(1, |lo|,
-    /// |hi|)` in `p`; shooting to `xtol = 10⁻¹¹` in at most 30 Newton iterations.
+    /// in `[lo, hi]` (at most 10⁴ points), testing surface `surface`; sign changes located
+    /// to `10⁻⁹·max(1, |lo|, |hi|)` in `p`; shooting to `xtol = 10⁻¹¹` in at most 30 Newton
+    /// iterations.
     ///
     /// # Errors
     /// [`OrbitError::InvalidSetting`] unless `lo < hi` are finite and `step` is finite and
@@ -91,7 +93,24 @@ impl SlidingContinuation {
             locate_tolerance: 1e-9 * lo.abs().max(hi.abs()).max(1.0),
             xtol: 1e-11,
             max_iterations: 30,
+            max_points: 10_000,
         })
+    }
+
+    /// The most points of a branch (default 10⁴).
+    ///
+    /// # Errors
+    /// [`OrbitError::InvalidSetting`] if `points < 2`.
+    pub fn with_max_points(mut self, points: usize) -> Result<Self> {
+        if points < 2 {
+            return Err(invalid(
+                "the number of branch points",
+                ">= 2",
+                points as f64,
+            ));
+        }
+        self.max_points = points;
+        Ok(self)
     }
 
     /// The tolerance in `p` to which a sliding bifurcation is located.
@@ -462,9 +481,10 @@ fn is_zero(value: f64, fa: Option<f64>, fb: Option<f64>) -> bool {
 /// [module docs](self)).
 ///
 /// # Errors
-/// The errors of the first orbit (builder, shooting: [`OrbitError::Filippov`],
-/// [`OrbitError::Run`]). A shooting that fails at a later grid point ends the branch
-/// ([`BranchEnd::StepTooSmall`]).
+/// [`OrbitError::InvalidSetting`] for a tested surface `≥ S`; the errors of the first orbit
+/// (builder, shooting: [`OrbitError::Filippov`], [`OrbitError::Run`]). A shooting that
+/// fails at a later grid point ends the branch ([`BranchEnd::StepTooSmall`]), as does the
+/// point cap ([`BranchEnd::MaxPoints`]).
 pub fn follow_sliding<Sys, St, B, P, const N: usize, const S: usize, const M: usize>(
     build: B,
     period: P,
@@ -480,6 +500,13 @@ where
     Sys: Filippov<f64, N, S> + Clone,
     St: Stepper<f64, N>,
 {
+    if settings.surface >= S {
+        return Err(invalid(
+            "the tested surface",
+            "< S (the number of surfaces)",
+            settings.surface as f64,
+        ));
+    }
     let problem = Problem {
         build: &build,
         period: &period,
@@ -491,6 +518,9 @@ where
     let mut bifurcations = Vec::new();
     let mut k = 1usize;
     let end = loop {
+        if points.len() >= settings.max_points {
+            break BranchEnd::MaxPoints;
+        }
         let p = p0 + settings.step * k as f64;
         if p < settings.lo || p > settings.hi {
             break BranchEnd::ParameterRange;
