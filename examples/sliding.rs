@@ -5,12 +5,17 @@
 //! - the dry-friction oscillator on a belt over the forcing amplitude: the bifurcation
 //!   diagram (largest velocity, fraction of time stuck) with the grazing-sliding point
 //!   located by a secant on its test function (the closest approach to the belt speed) and
-//!   marked.
+//!   marked;
+//! - the belt oscillator's periodic orbit followed in the forcing amplitude by shooting
+//!   (`orbit::sliding::follow_sliding`), with its sliding bifurcations (grazing-sliding,
+//!   crossing-sliding) located on the branch as zeros of their test functions.
 //!
-//! `cargo run --release --example sliding -- [--out DIR]`
+//! `cargo run --release [--features plot] --example sliding -- [--out DIR]`
 //!
-//! Writes `relay_orbit.csv`, `belt_diagram.csv` and `belt_bifurcation.csv` into
-//! `out/sliding`. Prints the checks; exits non-zero if one fails.
+//! Writes `relay_orbit.csv`, `belt_diagram.csv`, `belt_bifurcation.csv` and
+//! `belt_branch.csv` into `out/sliding`, and with feature `plot` `sliding.png` (the relay's
+//! sliding orbit, the belt's bifurcation diagram with the sliding bifurcations marked, the
+//! branch). Prints the checks; exits non-zero if one fails.
 
 use std::f64::consts::PI;
 use std::path::PathBuf;
@@ -22,6 +27,7 @@ use nonsmooth::filippov::{
     TransitionKind,
 };
 use nonsmooth::integrate::{DenseOutput, Dopri5, Tolerances};
+use nonsmooth::orbit::sliding::{SlidingBifurcationKind, SlidingContinuation, follow_sliding};
 use nonsmooth::output::csv::write_table_path;
 
 /// The relay feedback system `ẋ = A x − b sgn(x₁)` (ζ = 0.05, ω = 25, σ = 1).
@@ -76,7 +82,7 @@ impl SlidingObserver<f64, 3, 1> for Samples {
 }
 
 /// The belt oscillator `ẍ + x = F₀ cos 2t − sgn(ẋ − 0.5)`.
-fn belt(f0: f64) -> impl Filippov<f64, 2, 1> {
+fn belt(f0: f64) -> impl Filippov<f64, 2, 1> + Clone {
     Switched::new(
         |x: &SVector<f64, 2>| x[1] - 0.5,
         |_x: &SVector<f64, 2>| SVector::from([0.0, 1.0]),
@@ -285,6 +291,93 @@ fn run() -> Result<(), String> {
         ]],
     )
     .map_err(|e| e.to_string())?;
+
+    // The belt oscillator's orbit of period π followed in F₀ by shooting, with the sliding
+    // bifurcations located on the branch.
+    let tol2 = Tolerances::<f64, 2>::new(1e-12, 1e-14).map_err(|e| e.to_string())?;
+    let build = |f0: f64| Ok(FilippovSimulation::new(belt(f0), Dopri5::new(tol2)));
+    let tol6 = Tolerances::<f64, 6>::new(1e-12, 1e-14).map_err(|e| e.to_string())?;
+    let settings = SlidingContinuation::new(0.5, 2.2, 0.05, 0)
+        .and_then(|s| s.with_locate_tolerance(1e-12))
+        .map_err(|e| e.to_string())?;
+    let branch = follow_sliding(
+        build,
+        |_| PI,
+        0.0,
+        0.6,
+        SVector::from([1.0 - 0.6 / 3.0, 0.0]),
+        tol6,
+        &settings,
+    )
+    .map_err(|e| e.to_string())?;
+    for bif in &branch.bifurcations {
+        println!("belt branch: {:?} at F₀ = {:.12}", bif.kind, bif.p);
+    }
+    let graze = branch
+        .bifurcations
+        .iter()
+        .find(|bif| bif.kind == SlidingBifurcationKind::GrazingSliding)
+        .ok_or("no grazing-sliding on the branch")?;
+    if (graze.p - closed).abs() > 1e-9 {
+        failures.push(format!(
+            "grazing-sliding on the branch at {}, closed form {closed}",
+            graze.p
+        ));
+    }
+    write_table_path(
+        out.join("belt_branch.csv"),
+        &["f0", "x0", "v0", "sliding_time", "mu1"],
+        branch.points.iter().map(|q| {
+            [
+                q.p,
+                q.state[0],
+                q.state[1],
+                q.tests.sliding_time,
+                q.multipliers[0].norm(),
+            ]
+        }),
+    )
+    .map_err(|e| e.to_string())?;
+
+    #[cfg(feature = "plot")]
+    {
+        use nonsmooth::output::plot::{Layout, Panel, Rgb, Series, render};
+        let (slide, region): (Vec<&[f64; 5]>, Vec<&[f64; 5]>) =
+            samples.rows.iter().partition(|r| r[4] > 0.5);
+        let orbit = Panel::new("x₁", "x₂")
+            .title("relay feedback: sliding orbit (sliding red)")
+            .with(Series::dots(region.iter().map(|r| (r[1], r[2]))).color(Rgb::BLUE))
+            .with(Series::dots(slide.iter().map(|r| (r[1], r[2]))).color(Rgb::RED));
+        let mut diagram = Panel::new("F₀", "largest ẋ")
+            .title("belt oscillator: grazing-sliding (red), crossing-sliding (orange)")
+            .with(Series::dots(rows.iter().map(|r| (r[0], r[1]))).color(Rgb::BLACK))
+            .hline(0.5, Rgb::GRAY)
+            .vline(b, Rgb::RED);
+        let mut along = Panel::new("F₀", "x at t = 0")
+            .title("the branch by shooting, time stuck per period (gray)")
+            .with(Series::line(branch.points.iter().map(|q| (q.p, q.state[0]))).color(Rgb::BLUE))
+            .with(
+                Series::dots(branch.points.iter().map(|q| (q.p, q.tests.sliding_time)))
+                    .color(Rgb::GRAY),
+            );
+        for bif in &branch.bifurcations {
+            let color = match bif.kind {
+                SlidingBifurcationKind::GrazingSliding => Rgb::RED,
+                _ => Rgb::ORANGE,
+            };
+            along = along.vline(bif.p, color);
+            if bif.p <= rows.last().map_or(0.0, |r| r[0]) {
+                diagram = diagram.vline(bif.p, color);
+            }
+        }
+        render(
+            out.join("sliding.png"),
+            &[orbit, diagram, along],
+            &Layout::grid(3, 700, 560).title("sliding (Filippov systems)"),
+        )
+        .map_err(|e| e.to_string())?;
+    }
+
     println!("wrote {}", out.display());
     if failures.is_empty() {
         println!("all checks passed");

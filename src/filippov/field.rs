@@ -303,10 +303,13 @@ impl<T: Real, const N: usize, const S: usize, Sys: Filippov<T, N, S>> EventSet<T
             return T::one();
         }
         let h = self.sys.surface(i, t, y);
-        // Within rounding of the surface: on it (the side then comes from the rate, not
-        // from the sign of the rounding error of a projected state).
+        // Within rounding of the surface: on the mode's own side (not on the side of the
+        // rounding error of a projected state). A tiny value of the mode's sign rather
+        // than zero, so that a state that leaves the surface into its region and comes
+        // back within one step (a crossing close to a tangency of the far field) is
+        // located where it returns through the band, not at the start of the mode.
         if h.abs() <= band::<T>() * scale(&self.sys.gradient(i, t, y), y) {
-            T::zero()
+            self.mode.sides[i].sign::<T>() * T::default_epsilon() * T::default_epsilon()
         } else {
             h
         }

@@ -86,6 +86,12 @@
 //! oscillator on a belt); with `F_s > F_k` (a static limit above the kinetic force) the
 //! law is not a Filippov convexification and `StickSlip` is the model.
 //!
+//! # Relay loads
+//! [`RelayLoad`] builds the Filippov system of a [`Mechanical`](crate::model::Mechanical)
+//! model with a relay load `u = −U·sgn(σ)` along a direction `b` of the generalized forces,
+//! switched by a linear function `σ = s_q·q + s_v·q̇` of the state; with a linear model it
+//! is [`LinearRelay`] (checked in the tests to round-off).
+//!
 //! # Time dependence
 //! Fields and surfaces may depend on `t`. While the state slides (or sticks), it can stay
 //! nearly constant while the forcing changes, so a system with forcing declares its
@@ -127,6 +133,7 @@ mod approach;
 mod error;
 mod field;
 mod friction;
+mod load;
 mod relay;
 mod run;
 mod system;
@@ -135,6 +142,7 @@ mod tangent;
 pub use approach::Approach;
 pub use error::FilippovError;
 pub use friction::DryFriction;
+pub use load::RelayLoad;
 pub use relay::LinearRelay;
 pub use run::{
     FilippovRun, FilippovSimulation, Plain, Settings, SlidingObserver, Transition, TransitionKind,

@@ -31,6 +31,15 @@
 //! that does not depend on the length of the run. It needs
 //! [`Dynamics::jacobian`].
 //!
+//! **Through sliding** ([`FilippovTwoTrajectory`]). For a Filippov system (a field
+//! discontinuous across switching surfaces, with sliding on them) the two trajectories are
+//! two event-driven runs of [`FilippovSimulation`](crate::filippov::FilippovSimulation);
+//! the state is continuous, so the separation is measured at the grid times whatever the
+//! modes. It checks the tangent-space estimate
+//! [`FilippovSimulation::exponents`](crate::filippov::FilippovSimulation::exponents)
+//! (saltation matrices at crossings and sliding entries, the sliding field's Jacobian
+//! while sliding).
+//!
 //! # The norm
 //! Both methods measure separations in a weighted Euclidean [`Norm`]
 //! $$\|\delta\|_w = \Bigl(\sum_i (\delta_i/w_i)^2\Bigr)^{1/2},$$
@@ -98,6 +107,7 @@
 //! (1985).
 
 mod diagram;
+mod filippov;
 pub mod hybrid;
 mod lanes;
 mod tangent;
@@ -106,6 +116,7 @@ mod two_trajectory;
 pub use diagram::{
     Diagram, DiagramDirection, DiagramPoint, DiagramSettings, IntervalRule, tle_diagram,
 };
+pub use filippov::FilippovTwoTrajectory;
 pub use hybrid::{HybridTangentSpace, HybridTwoTrajectory, Saltation};
 pub use lanes::tle_independent;
 #[cfg(feature = "parallel")]
@@ -266,6 +277,22 @@ pub enum LyapunovError {
     /// (its message).
     #[error("building the system failed: {0}")]
     Build(String),
+    /// A run of a Filippov system failed where only sliding motion can fail (two surfaces
+    /// met at once, a repelling surface, drift off the surface, …); its engine errors are
+    /// [`Run`](Self::Run).
+    #[error(transparent)]
+    Filippov(crate::filippov::FilippovError),
+}
+
+impl From<crate::filippov::FilippovError> for LyapunovError {
+    /// The engine's errors as [`Run`](LyapunovError::Run), the rest as
+    /// [`Filippov`](LyapunovError::Filippov).
+    fn from(e: crate::filippov::FilippovError) -> Self {
+        match e {
+            crate::filippov::FilippovError::Run(e) => LyapunovError::Run(e),
+            e => LyapunovError::Filippov(e),
+        }
+    }
 }
 
 /// `Result` with [`LyapunovError`].

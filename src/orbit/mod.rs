@@ -26,6 +26,11 @@
 //! `|μ|^{1/m}`, and solves for all segment starts `yᵢ` at once:
 //! `φᵢ(yᵢ) − y₍ᵢ₊₁₎ mod m = 0`, Jacobian blocks `Φᵢ` and `−I`, `Φ = Φ_{m−1}⋯Φ₀`.
 //!
+//! Orbits of forced Filippov systems (crossings and sliding) are followed by
+//! [`sliding::follow_sliding`], shooting through
+//! [`FilippovSimulation::find_orbit`](crate::filippov::FilippovSimulation::find_orbit),
+//! with the sliding bifurcations located on the branch as zeros of their test functions.
+//!
 //! # Example
 //! A forced linear oscillator `ẍ + 2ζẋ + x = cos ωt`: its periodic orbit is the steady state,
 //! its multipliers `e^{(−ζ ± i√(1−ζ²))T}`.
@@ -70,6 +75,7 @@ use crate::lyapunov::{LyapunovError, Norm, Saltation, Variational};
 use crate::scalar::{lit, to_f64};
 
 pub mod continuation;
+pub mod sliding;
 
 pub use continuation::{
     Bifurcation, BifurcationKind, Branch, BranchEnd, BranchPoint, ContinuationSettings, Grazing,
@@ -121,6 +127,22 @@ pub enum OrbitError {
     /// (its message).
     #[error("building the problem failed: {0}")]
     Build(String),
+    /// A run or shooting of a Filippov system failed where only sliding motion can fail
+    /// (two surfaces met at once, a repelling surface, no convergence of the shooting, …);
+    /// its engine errors are [`Run`](Self::Run).
+    #[error(transparent)]
+    Filippov(crate::filippov::FilippovError),
+}
+
+impl From<crate::filippov::FilippovError> for OrbitError {
+    /// The engine's errors as [`Run`](OrbitError::Run), the rest as
+    /// [`Filippov`](OrbitError::Filippov).
+    fn from(e: crate::filippov::FilippovError) -> Self {
+        match e {
+            crate::filippov::FilippovError::Run(e) => OrbitError::Run(e),
+            e => OrbitError::Filippov(e),
+        }
+    }
 }
 
 /// `Result` with [`OrbitError`].

@@ -17,10 +17,16 @@
 //! [`hysteresis`] compares the two branches and reports where they differ (coexisting
 //! attractors); [`transitions`] lists the parameter steps where the number of impacts per
 //! period or the period changes (grazing and period-doubling points).
+//!
+//! [`sweep_filippov`] sweeps a forced Filippov system (crossings and sliding, see
+//! [`filippov`](crate::filippov)): stroboscopic points, regime and the time spent sliding
+//! per value.
 
+mod filippov;
 mod lanes;
 mod ramp;
 
+pub use filippov::{SlidingSweepPoint, sweep_filippov};
 #[cfg(feature = "parallel")]
 pub use lanes::sweep_independent_parallel;
 pub use lanes::{IndependentSweep, LaneStart, sweep_independent, sweep_starts};
@@ -143,9 +149,23 @@ pub enum RunFailure {
     /// A run through modes was started inconsistently or left its constraint.
     #[error(transparent)]
     Mode(#[from] crate::drive::ModeError),
+    /// A Filippov run failed where only sliding motion can fail (two surfaces met at
+    /// once, a repelling surface, …).
+    #[error(transparent)]
+    Filippov(crate::filippov::FilippovError),
     /// Any other error, by its message.
     #[error("{0}")]
     Other(String),
+}
+
+impl From<crate::filippov::FilippovError> for RunFailure {
+    /// The engine's errors as themselves, the rest as [`Filippov`](RunFailure::Filippov).
+    fn from(e: crate::filippov::FilippovError) -> Self {
+        match e {
+            crate::filippov::FilippovError::Run(e) => e.into(),
+            e => Self::Filippov(e),
+        }
+    }
 }
 
 impl From<RunError> for RunFailure {
