@@ -126,11 +126,7 @@ where
     /// # Errors
     /// [`LyapunovError::InvalidDirection`] if it is zero or not finite.
     pub fn with_direction(mut self, direction: SVector<T, N>) -> Result<Self> {
-        let n = self.norm.norm(&direction);
-        if !(n.is_finite() && n > T::zero() && direction.iter().all(|v| v.is_finite())) {
-            return Err(LyapunovError::InvalidDirection);
-        }
-        self.direction = direction / n;
+        self.direction = super::unit_direction(&self.norm, direction)?;
         Ok(self)
     }
 

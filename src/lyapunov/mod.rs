@@ -475,6 +475,21 @@ pub(crate) fn check_intervals(intervals: usize, minimum: usize) -> Result<(), Ly
 /// per interval, 1.6 GB at the limit).
 pub const MAX_INTERVALS: usize = 100_000_000;
 
+/// `direction` scaled to unit length in `norm`.
+///
+/// # Errors
+/// [`LyapunovError::InvalidDirection`] if it is zero or not finite.
+pub(crate) fn unit_direction<T: Real, const N: usize>(
+    norm: &Norm<T, N>,
+    direction: SVector<T, N>,
+) -> Result<SVector<T, N>, LyapunovError> {
+    let n = norm.norm(&direction);
+    if !(n.is_finite() && n > T::zero() && direction.iter().all(|v| v.is_finite())) {
+        return Err(LyapunovError::InvalidDirection);
+    }
+    Ok(direction / n)
+}
+
 pub(crate) fn check_blocks(blocks: usize) -> Result<usize, LyapunovError> {
     if blocks < 2 {
         Err(LyapunovError::InvalidBlocks { blocks })
