@@ -5,30 +5,17 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use nalgebra::{Matrix3, SVector, Vector3};
+use nalgebra::SVector;
 use nonsmooth::filippov::{FilippovSimulation, LinearRelay, Switched};
 use nonsmooth::integrate::{Dopri5, Tolerances};
+use nonsmooth::systems::RelayFeedback;
 
-/// The relay feedback system `ẋ = A x − b sgn(x₁)` (ζ = 0.05, ω = 25, σ = 1).
+/// The relay feedback system `ẋ = A x − b sgn(x₁)` of the catalogue (ζ = 0.05, ω = 25,
+/// σ = 1).
 fn relay() -> LinearRelay<f64, 3> {
-    let (z, w, s) = (0.05, 25.0, 1.0);
-    let a = Matrix3::new(
-        -(2.0 * z * w + 1.0),
-        1.0,
-        0.0,
-        -(2.0 * z * w + w * w),
-        0.0,
-        1.0,
-        -w * w,
-        0.0,
-        0.0,
-    );
-    LinearRelay::new(
-        a,
-        Vector3::new(1.0, -2.0 * s, 1.0),
-        Vector3::new(1.0, 0.0, 0.0),
-    )
-    .expect("finite relay matrices")
+    RelayFeedback::default()
+        .system()
+        .expect("finite relay matrices")
 }
 
 fn relay_runs(c: &mut Criterion) {

@@ -20,7 +20,7 @@
 use std::f64::consts::PI;
 use std::path::PathBuf;
 
-use nalgebra::{Matrix3, SVector, Vector3};
+use nalgebra::SVector;
 use nonsmooth::drive::{Control, StepView};
 use nonsmooth::filippov::{
     Approach, Filippov, FilippovSimulation, LinearRelay, Mode, SlidingObserver, Switched,
@@ -29,27 +29,14 @@ use nonsmooth::filippov::{
 use nonsmooth::integrate::{DenseOutput, Dopri5, Tolerances};
 use nonsmooth::orbit::sliding::{SlidingBifurcationKind, SlidingContinuation, follow_sliding};
 use nonsmooth::output::csv::write_table_path;
+use nonsmooth::systems::RelayFeedback;
 
-/// The relay feedback system `ẋ = A x − b sgn(x₁)` (ζ = 0.05, ω = 25, σ = 1).
+/// The relay feedback system `ẋ = A x − b sgn(x₁)` of the catalogue (ζ = 0.05, ω = 25,
+/// σ = 1).
 fn relay() -> LinearRelay<f64, 3> {
-    let (z, w, s) = (0.05, 25.0, 1.0);
-    let a = Matrix3::new(
-        -(2.0 * z * w + 1.0),
-        1.0,
-        0.0,
-        -(2.0 * z * w + w * w),
-        0.0,
-        1.0,
-        -w * w,
-        0.0,
-        0.0,
-    );
-    LinearRelay::new(
-        a,
-        Vector3::new(1.0, -2.0 * s, 1.0),
-        Vector3::new(1.0, 0.0, 0.0),
-    )
-    .expect("finite relay matrices")
+    RelayFeedback::default()
+        .system()
+        .expect("finite relay matrices")
 }
 
 /// Dense samples `(t, x, sliding)` after `t_from`, and the largest `|x₁|` while sliding.

@@ -13,6 +13,7 @@ use nonsmooth::filippov::{
 use nonsmooth::force::LinearSpring;
 use nonsmooth::integrate::{DenseOutput, Dopri5, Tolerances};
 use nonsmooth::model::{Coordinate, Element, Load, Mechanical};
+use nonsmooth::systems::RelayFeedback;
 use std::f64::consts::{PI, TAU};
 
 // ---------------------------------------------------------------------------------------
@@ -20,28 +21,14 @@ use std::f64::consts::{PI, TAU};
 // problem of Piiroinen & Kuznetsov (ACM TOMS 34(3), 2008, eq. (32)):
 // ẋ = A x + B u, u = −sgn(C x),
 // A = [[−(2ζω+1), 1, 0], [−(2ζω+ω²), 0, 1], [−ω², 0, 0]], B = (1, −2σ, 1)ᵀ, C = (1, 0, 0).
-const ZETA: f64 = 0.05;
-const OMEGA: f64 = 25.0;
-const SIGMA: f64 = 1.0;
-const X0: [f64; 3] = [0.0, -0.001, -0.02];
+const X0: [f64; 3] = RelayFeedback::X0;
 
 fn relay_a() -> Matrix3<f64> {
-    let (z, w) = (ZETA, OMEGA);
-    Matrix3::new(
-        -(2.0 * z * w + 1.0),
-        1.0,
-        0.0,
-        -(2.0 * z * w + w * w),
-        0.0,
-        1.0,
-        -w * w,
-        0.0,
-        0.0,
-    )
+    RelayFeedback::default().a()
 }
 
 fn relay_b() -> Vector3<f64> {
-    Vector3::new(1.0, -2.0 * SIGMA, 1.0)
+    RelayFeedback::default().b()
 }
 
 struct Relay {
