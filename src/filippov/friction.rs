@@ -109,13 +109,9 @@ where
 
     #[inline(always)]
     fn field(&self, sides: &[Side; 1], t: T, y: &SVector<T, M>, dy: &mut SVector<T, M>) {
-        let a = self.model.acceleration(t, y);
         // Friction opposes the slip: −F_k above the surface (slipping forward), +F_k below.
         let force = -sides[0].sign::<T>() * self.friction.kinetic();
-        for k in 0..N {
-            dy[k] = y[N + k];
-            dy[N + k] = a[k] + self.m_w[k] * force;
-        }
+        super::load::sided_field(self.model, &self.m_w, force, t, y, dy);
     }
 
     fn field_jacobian(

@@ -126,13 +126,8 @@ where
 
     #[inline(always)]
     fn field(&self, sides: &[Side; 1], t: T, y: &SVector<T, M>, dy: &mut SVector<T, M>) {
-        let a = self.model.acceleration(t, y);
         // u = −U sgn σ: +U below the surface, −U above.
-        let u = -sides[0].sign::<T>();
-        for k in 0..N {
-            dy[k] = y[N + k];
-            dy[N + k] = a[k] + self.m_b[k] * u;
-        }
+        sided_field(self.model, &self.m_b, -sides[0].sign::<T>(), t, y, dy);
     }
 
     fn field_jacobian(
@@ -147,5 +142,27 @@ where
 
     fn time_scale(&self, t: T) -> Option<T> {
         self.model.forcing_time_scale(t)
+    }
+}
+
+/// The field `q̇ = v`, `v̇ = a(t, y) + s·d` of `model` with a constant generalized force
+/// whose acceleration is `d` (`M⁻¹` applied), of sign `s` on the current side.
+#[inline(always)]
+pub(crate) fn sided_field<T, const N: usize, const M: usize, El, Ld>(
+    model: &Mechanical<T, N, El, Ld>,
+    d: &SVector<T, N>,
+    s: T,
+    t: T,
+    y: &SVector<T, M>,
+    dy: &mut SVector<T, M>,
+) where
+    T: Real,
+    El: Elements<T, N>,
+    Ld: Loads<T, N>,
+{
+    let a = model.acceleration(t, y);
+    for k in 0..N {
+        dy[k] = y[N + k];
+        dy[N + k] = a[k] + d[k] * s;
     }
 }
