@@ -2,7 +2,8 @@
 //! pole, a bird on a rotational spring, impacts of the sleeve's edges and of the beak on the
 //! pole, Coulomb friction at all three contacts.
 //!
-//! Model (Ch. Glocker, PhD thesis, TU München 1995, pp. 162ff.; R. I. Leine, Ch. Glocker,
+//! The model is the catalogue's [`systems::Woodpecker`](nonsmooth::systems::Woodpecker)
+//! (Ch. Glocker, PhD thesis, TU München 1995, pp. 162ff.; R. I. Leine, Ch. Glocker,
 //! D. H. van Campen, *Nonlinear dynamics of the woodpecker toy*, DETC 2001, and *J. Vib.
 //! Control* 9 (2003) 25–78): coordinates `q = (y, φ_S, φ_B)` — the sleeve's height, the
 //! sleeve's and the bird's angles — with the small-angle (linearized) mass matrix
@@ -44,30 +45,10 @@
 //! `cargo run --release --example timestep_woodpecker`
 
 use nonsmooth::drive::Control;
-use nonsmooth::timestep::{
-    Contact, Geometry, Jacobian, Lagrangian, MoreauJean, StepObserver, StepRecord,
-};
+use nonsmooth::systems::Woodpecker;
+use nonsmooth::timestep::{MoreauJean, StepObserver, StepRecord};
 
 type Res<T> = Result<T, Box<dyn std::error::Error>>;
-
-// Glocker's constants (S: sleeve, B: bird); Siconos names them M (sleeve) and S (bird).
-const M_S: f64 = 3.0e-4;
-const J_S: f64 = 5.0e-9;
-const M_B: f64 = 4.5e-3;
-const J_B: f64 = 7.0e-7;
-const R_0: f64 = 2.5e-3;
-const R_S: f64 = 3.1e-3;
-const H_S: f64 = 5.8e-3;
-const L_S: f64 = 1.0e-2;
-const L_G: f64 = 1.5e-2;
-const H_B: f64 = 2.0e-2;
-const L_B: f64 = 2.01e-2;
-const C_PHI: f64 = 5.6e-3;
-const G: f64 = 9.81;
-
-/// Siconos' initial state (a point near the limit cycle): `(y, φ_S, φ_B)` and velocities.
-const Q0: [f64; 3] = [0.0, -0.1036, -0.2788];
-const V0: [f64; 3] = [-0.3411, 4.8572e-15, -7.4583];
 
 /// The impacts of Siconos' `Woodpecker.ref` (θ = ½, h = 2·10⁻⁵): the end time of the step
 /// with the velocity jump and the contact (0: beak, 1 and 2: sleeve edges `g₂`, `g₃`),
@@ -82,94 +63,6 @@ const REFERENCE_IMPACTS: [(f64, usize); 8] = [
     (0.22768, 2),
     (0.26482, 1),
 ];
-
-/// The smooth part: constant mass matrix, gravity and the rotational spring.
-struct Woodpecker;
-
-impl Lagrangian<f64> for Woodpecker {
-    fn dofs(&self) -> usize {
-        3
-    }
-    fn mass(&self, _q: &[f64], m: &mut [f64]) {
-        m.copy_from_slice(&[
-            M_S + M_B,
-            M_B * L_S,
-            M_B * L_G,
-            M_B * L_S,
-            J_S + M_B * L_S * L_S,
-            M_B * L_S * L_G,
-            M_B * L_G,
-            M_B * L_S * L_G,
-            J_B + M_B * L_G * L_G,
-        ]);
-    }
-    fn forces(&self, _t: f64, q: &[f64], _v: &[f64], f: &mut [f64]) {
-        let spring = C_PHI * (q[2] - q[1]);
-        f[0] = -(M_S + M_B) * G;
-        f[1] = spring - M_B * L_S * G;
-        f[2] = -spring - M_B * L_G * G;
-    }
-    fn potential(&self, _t: f64, q: &[f64]) -> f64 {
-        let d = q[2] - q[1];
-        (M_S + M_B) * G * q[0] + M_B * G * (L_S * q[1] + L_G * q[2]) + 0.5 * C_PHI * d * d
-    }
-}
-
-/// A contact with constant rows: `g = normal·q + offset`, tangent velocity `tangent·q̇`.
-struct Linear {
-    normal: [f64; 3],
-    offset: f64,
-    tangent: [f64; 3],
-    e: f64,
-}
-
-impl Contact<f64> for Linear {
-    fn evaluate(&self, _t: f64, q: &[f64], jac: &mut Jacobian<'_, f64>) -> Geometry<f64> {
-        let mut gap = self.offset;
-        let rows = self.normal.iter().zip(&self.tangent).zip(q);
-        for (j, ((&n, &t), &x)) in rows.enumerate() {
-            if n != 0.0 {
-                jac.normal(j, n);
-                gap += n * x;
-            }
-            if t != 0.0 {
-                jac.tangent(j, t);
-            }
-        }
-        Geometry { gap }
-    }
-    fn restitution(&self) -> f64 {
-        self.e
-    }
-    fn friction(&self) -> f64 {
-        0.3
-    }
-}
-
-/// The beak (`g₁`) and the sleeve's edges (`g₂`, `g₃`).
-fn contacts() -> [Linear; 3] {
-    let sleeve = [1.0, R_S, 0.0];
-    [
-        Linear {
-            normal: [0.0, 0.0, -H_B],
-            offset: L_S + L_G - L_B - R_0,
-            tangent: [1.0, L_S, L_G - L_B],
-            e: 0.5,
-        },
-        Linear {
-            normal: [0.0, H_S, 0.0],
-            offset: R_S - R_0,
-            tangent: sleeve,
-            e: 0.0,
-        },
-        Linear {
-            normal: [0.0, -H_S, 0.0],
-            offset: R_S - R_0,
-            tangent: sleeve,
-            e: 0.0,
-        },
-    ]
-}
 
 /// The impacts as Siconos' file shows them — steps where the sleeve's angular velocity
 /// jumps by more than 3 rad/s or the bird's by more than 0.3 rad/s (end time of the step,
@@ -217,8 +110,8 @@ impl StepObserver<f64> for Jumps {
 
 /// Runs from Siconos' initial state to `t_end` with step `h`.
 fn run(h: f64, t_end: f64, at: &[usize]) -> Res<Jumps> {
-    let mut scheme = MoreauJean::new(Woodpecker, contacts(), h)?;
-    let (mut q, mut v) = (Q0, V0);
+    let mut scheme = MoreauJean::new(Woodpecker, Woodpecker::contacts()?, h)?;
+    let (mut q, mut v) = (Woodpecker::Q0, Woodpecker::V0);
     let mut jumps = Jumps::new(at);
     scheme.run(0.0, &mut q, &mut v, t_end, &mut jumps)?;
     Ok(jumps)

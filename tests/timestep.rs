@@ -4,10 +4,11 @@
 //! (ball on a vibrating table) and against conservation laws (Newton's cradle).
 
 use nonsmooth::drive::Control;
+use nonsmooth::systems::Woodpecker;
 use nonsmooth::timestep::lcp::{LcpError, Lemke, Nsgs, Pgs, frictional_contact_residual, residual};
 use nonsmooth::timestep::{
-    Contact, Geometry, ImpactLog, Jacobian, Lagrangian, MoreauJean, PlanarBodies, PlanarContact,
-    Plane, RigidBody, Solver, StepObserver, StepRecord, TimeStepError,
+    Contact, Geometry, ImpactLog, Jacobian, Lagrangian, LinearContact, MoreauJean, PlanarBodies,
+    PlanarContact, Plane, RigidBody, Solver, StepObserver, StepRecord, TimeStepError,
 };
 
 /// A seeded xorshift generator (uniform in [0, 1)).
@@ -1038,38 +1039,6 @@ impl Lagrangian<f64> for Vertical {
     }
 }
 
-/// A contact with constant rows: `g = normal·q + offset`, tangent velocity `tangent·q̇`.
-struct Linear<const N: usize> {
-    normal: [f64; N],
-    offset: f64,
-    tangent: [f64; N],
-    e: f64,
-    mu: f64,
-}
-
-impl<const N: usize> Contact<f64> for Linear<N> {
-    fn evaluate(&self, _t: f64, q: &[f64], jac: &mut Jacobian<'_, f64>) -> Geometry<f64> {
-        let mut gap = self.offset;
-        let rows = self.normal.iter().zip(&self.tangent).zip(q);
-        for (j, ((&n, &t), &x)) in rows.enumerate() {
-            if n != 0.0 {
-                jac.normal(j, n);
-                gap += n * x;
-            }
-            if t != 0.0 {
-                jac.tangent(j, t);
-            }
-        }
-        Geometry { gap }
-    }
-    fn restitution(&self) -> f64 {
-        self.e
-    }
-    fn friction(&self) -> f64 {
-        self.mu
-    }
-}
-
 /// Rows of Siconos' reference result `examples/mechanics/BouncingBall/BouncingBallTS.ref`
 /// (repository `siconos/siconos-tutorials`; `BouncingBallTS.cpp`: `MoreauJeanOSI`, θ = ½,
 /// h = 0.005, e = 0.9, m = 1, g = 9.81, q₀ = 1, v₀ = 0, an LCP per step): the row (= steps
@@ -1142,13 +1111,7 @@ impl StepObserver<f64> for Trace {
 #[test]
 fn bouncing_ball_matches_siconos_reference_step_by_step() {
     let ball = Vertical { m: 1.0, g: 9.81 };
-    let floor = vec![Linear {
-        normal: [1.0],
-        offset: 0.0,
-        tangent: [0.0],
-        e: 0.9,
-        mu: 0.0,
-    }];
+    let floor = vec![LinearContact::new([1.0], 0.0, [0.0], 0.9, 0.0).unwrap()];
     let mut scheme = MoreauJean::new(ball, floor, 0.005).unwrap();
     let (mut q, mut v) = ([1.0], [0.0]);
     let mut trace = Trace::default();
@@ -1171,74 +1134,6 @@ fn bouncing_ball_matches_siconos_reference_step_by_step() {
         worst <= 1e-12,
         "worst difference {worst:e} (of 1 m, 10 m/s, 10 N s)"
     );
-}
-
-/// Glocker's woodpecker toy (Ch. Glocker, PhD thesis, TU München 1995, pp. 162ff.; R. I.
-/// Leine, Ch. Glocker, D. H. van Campen, DETC 2001 / *J. Vib. Control* 9 (2003)) with the
-/// constants and initial state of Siconos' `examples/mechanics/Woodpecker`
-/// (`siconos/siconos-tutorials`): `q = (y, φ_S, φ_B)`, sleeve S and bird B; contacts beak
-/// (`e = 0.5`) and the sleeve's two edges (`e = 0`), `μ = 0.3`. See
-/// `examples/timestep_woodpecker.rs` for the limit cycle.
-struct Woodpecker;
-
-const WP: (f64, f64, f64, f64) = (3.0e-4, 5.0e-9, 4.5e-3, 7.0e-7); // m_S, J_S, m_B, J_B
-const WP_LS: f64 = 1.0e-2;
-const WP_LG: f64 = 1.5e-2;
-
-impl Lagrangian<f64> for Woodpecker {
-    fn dofs(&self) -> usize {
-        3
-    }
-    fn mass(&self, _q: &[f64], m: &mut [f64]) {
-        let (ms, js, mb, jb) = WP;
-        let (ls, lg) = (WP_LS, WP_LG);
-        m.copy_from_slice(&[
-            ms + mb,
-            mb * ls,
-            mb * lg,
-            mb * ls,
-            js + mb * ls * ls,
-            mb * ls * lg,
-            mb * lg,
-            mb * ls * lg,
-            jb + mb * lg * lg,
-        ]);
-    }
-    fn forces(&self, _t: f64, q: &[f64], _v: &[f64], f: &mut [f64]) {
-        let (ms, _, mb, _) = WP;
-        let spring = 5.6e-3 * (q[2] - q[1]);
-        f[0] = -(ms + mb) * 9.81;
-        f[1] = spring - mb * WP_LS * 9.81;
-        f[2] = -spring - mb * WP_LG * 9.81;
-    }
-}
-
-fn woodpecker_contacts() -> [Linear<3>; 3] {
-    let (r0, rs, hs, hb, lb) = (2.5e-3, 3.1e-3, 5.8e-3, 2.0e-2, 2.01e-2);
-    let sleeve = [1.0, rs, 0.0];
-    [
-        Linear {
-            normal: [0.0, 0.0, -hb],
-            offset: WP_LS + WP_LG - lb - r0,
-            tangent: [1.0, WP_LS, WP_LG - lb],
-            e: 0.5,
-            mu: 0.3,
-        },
-        Linear {
-            normal: [0.0, hs, 0.0],
-            offset: rs - r0,
-            tangent: sleeve,
-            e: 0.0,
-            mu: 0.3,
-        },
-        Linear {
-            normal: [0.0, -hs, 0.0],
-            offset: rs - r0,
-            tangent: sleeve,
-            e: 0.0,
-            mu: 0.3,
-        },
-    ]
 }
 
 /// Steps where the sleeve's angular velocity jumps by more than 3 rad/s or the bird's by more
@@ -1289,8 +1184,8 @@ fn woodpecker_impacts_match_siconos_reference() {
         (11384, 2),
         (13241, 1),
     ];
-    let mut scheme = MoreauJean::new(Woodpecker, woodpecker_contacts(), 2e-5).unwrap();
-    let (mut q, mut v) = ([0.0, -0.1036, -0.2788], [-0.3411, 4.8572e-15, -7.4583]);
+    let mut scheme = MoreauJean::new(Woodpecker, Woodpecker::contacts().unwrap(), 2e-5).unwrap();
+    let (mut q, mut v) = (Woodpecker::Q0, Woodpecker::V0);
     let mut jumps = Jumps {
         keep_at: 14999,
         ..Jumps::default()
@@ -1418,8 +1313,8 @@ fn woodpecker_settles_on_its_limit_cycle() {
     // cycles jitter by up to about ten steps (see `examples/timestep_woodpecker.rs`, 40
     // cycles: mean 0.146042 s, spread 1.8e-4 s).
     let h = 2e-5;
-    let mut scheme = MoreauJean::new(Woodpecker, woodpecker_contacts(), h).unwrap();
-    let (mut q, mut v) = ([0.0, -0.1036, -0.2788], [-0.3411, 4.8572e-15, -7.4583]);
+    let mut scheme = MoreauJean::new(Woodpecker, Woodpecker::contacts().unwrap(), h).unwrap();
+    let (mut q, mut v) = (Woodpecker::Q0, Woodpecker::V0);
     let mut jumps = Jumps::default();
     scheme.run(0.0, &mut q, &mut v, 1.6, &mut jumps).unwrap();
     let beaks: Vec<usize> = (0..jumps.impacts.len())

@@ -7,10 +7,12 @@
 //! | ball on a vibrating table | `ÿ = −g` above `s = A sin ωt`, Newton restitution `e` (rigid) | [`bouncing_ball`] |
 //! | Duffing–Ueda oscillator | `ẍ + kẋ + x³ = B cos ωt` | [`duffing_ueda`] |
 //! | 2-DOF impact oscillator | primary mass, coupled secondary mass hitting a Hertz stop | [`two_dof`] |
+//! | woodpecker toy | sleeve and bird on a pole, three frictional impact contacts (time-stepping) | [`woodpecker`] |
 //! | relay feedback system | `ẋ = A x − b sgn(x₁)`, a third-order plant sliding on `x₁ = 0` (Filippov) | [`relay`] |
 //!
 //! Every entry is an ordinary [`Oscillator`](crate::model::Oscillator),
-//! [`Mechanical`](crate::model::Mechanical) model or [`filippov`](crate::filippov) system:
+//! [`Mechanical`](crate::model::Mechanical) model, [`filippov`](crate::filippov) system or
+//! [`timestep`](crate::timestep) `Lagrangian`:
 //! nothing in the engine knows about any of them.
 
 pub mod bouncing_ball;
@@ -18,8 +20,10 @@ pub mod duffing_ueda;
 pub mod paper;
 pub mod relay;
 pub mod two_dof;
+pub mod woodpecker;
 
 pub use bouncing_ball::BouncingBallTable;
 pub use duffing_ueda::DuffingUeda;
 pub use relay::RelayFeedback;
 pub use two_dof::TwoDofImpact;
+pub use woodpecker::Woodpecker;

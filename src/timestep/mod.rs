@@ -86,4 +86,4 @@ pub use observe::{
 };
 pub use planar::{PlanarBodies, PlanarContact, Plane, RigidBody};
 pub use scheme::{MoreauJean, Solver};
-pub use system::{Contact, ContactSet, Geometry, Jacobian, Lagrangian};
+pub use system::{Contact, ContactSet, Geometry, Jacobian, Lagrangian, LinearContact};

@@ -2,6 +2,8 @@
 
 use crate::Real;
 use crate::model::{Elements, Loads, Mechanical};
+use crate::scalar::to_f64;
+use crate::validate::ParameterError;
 
 use super::error::TimeStepError;
 
@@ -168,6 +170,93 @@ pub trait Contact<T: Real> {
     /// # Errors
     /// [`TimeStepError::Dimension`] for an index out of range.
     fn check(&self, _dofs: usize) -> Result<(), TimeStepError> {
+        Ok(())
+    }
+}
+
+/// A contact with constant rows over the first `K` coordinates: the gap
+/// `g = normal·q + offset`, the tangential velocity `tangent·q̇` (a point on a fixed plane
+/// in coordinates where both are linear, or a linearized contact such as the woodpecker's).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LinearContact<T, const K: usize> {
+    normal: [T; K],
+    offset: T,
+    tangent: [T; K],
+    restitution: T,
+    friction: T,
+}
+
+impl<T: Real, const K: usize> LinearContact<T, K> {
+    /// The contact `g = normal·q + offset` with tangent row `tangent`, Newton's coefficient
+    /// `restitution` and Coulomb's `friction`.
+    ///
+    /// # Errors
+    /// [`ParameterError`](crate::ParameterError) naming a non-finite row entry or offset,
+    /// a restitution outside `[0, 1]` or a negative friction coefficient.
+    pub fn new(
+        normal: [T; K],
+        offset: T,
+        tangent: [T; K],
+        restitution: T,
+        friction: T,
+    ) -> Result<Self, TimeStepError> {
+        use crate::validate::finite;
+        for &n in &normal {
+            finite("normal", n)?;
+        }
+        for &t in &tangent {
+            finite("tangent", t)?;
+        }
+        finite("offset", offset)?;
+        if !(restitution >= T::zero() && restitution <= T::one()) {
+            return Err(
+                ParameterError::new("restitution", to_f64(restitution), "in [0, 1]").into(),
+            );
+        }
+        if !(friction >= T::zero() && friction.is_finite()) {
+            return Err(
+                ParameterError::new("friction", to_f64(friction), "finite and >= 0").into(),
+            );
+        }
+        Ok(Self {
+            normal,
+            offset,
+            tangent,
+            restitution,
+            friction,
+        })
+    }
+}
+
+impl<T: Real, const K: usize> Contact<T> for LinearContact<T, K> {
+    fn evaluate(&self, _t: T, q: &[T], jac: &mut Jacobian<'_, T>) -> Geometry<T> {
+        let mut gap = self.offset;
+        let rows = self.normal.iter().zip(&self.tangent).zip(q);
+        for (j, ((&n, &t), &x)) in rows.enumerate() {
+            if n != T::zero() {
+                jac.normal(j, n);
+                gap += n * x;
+            }
+            if t != T::zero() {
+                jac.tangent(j, t);
+            }
+        }
+        Geometry { gap }
+    }
+    fn restitution(&self) -> T {
+        self.restitution
+    }
+    fn friction(&self) -> T {
+        self.friction
+    }
+    fn check(&self, dofs: usize) -> Result<(), TimeStepError> {
+        if K > dofs {
+            return Err(TimeStepError::Dimension {
+                what: "linear contact rows",
+                got: K,
+                expected: dofs,
+            });
+        }
         Ok(())
     }
 }
