@@ -1,7 +1,7 @@
 //! One right-hand-side evaluation of the paper's oscillator, in free flight and in contact
 //! (also against the scalar right-hand side written out, the cost of the oscillator being a
 //! layer over the 1-DOF `Mechanical` system, as a ratio in one run);
-//! and the forcing's `sin` (`nonsmooth::fastmath` against `libm`, as a ratio in one run).
+//! and the forcing's `sin` (`nonsmooth::util::sin` against `libm`, as a ratio in one run).
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use nalgebra::Vector2;
@@ -65,7 +65,7 @@ fn sine(c: &mut Criterion) {
     g.bench_function("fastmath", |b| {
         b.iter(|| {
             xs.iter()
-                .map(|&x| nonsmooth::fastmath::sin(black_box(x)))
+                .map(|&x| nonsmooth::util::sin(black_box(x)))
                 .sum::<f64>()
         })
     });

@@ -4,8 +4,8 @@
 //! Run with `cargo run --example approximations`.
 
 use nonsmooth::analysis::{AmplitudePhase, LinearizedResponse, TurningPoint};
-use nonsmooth::roots::brent;
 use nonsmooth::systems::paper::PAPER;
+use nonsmooth::util::brent;
 
 fn row(name: &str, paper: Option<f64>, ours: f64) {
     match paper {

@@ -17,6 +17,7 @@
 
 use std::path::PathBuf;
 
+use nonsmooth::analysis::observed_order;
 use nonsmooth::drive::Control;
 use nonsmooth::output::csv::{Cell, write_table_path};
 use nonsmooth::timestep::lcp::{Lemke, Pgs, residual};
@@ -38,16 +39,6 @@ impl Checks {
         println!("  [{}] {name}", if ok { "ok" } else { "FAILED" });
         self.0.push((name, ok));
     }
-}
-
-fn slope(hs: &[f64], errs: &[f64]) -> f64 {
-    let xs: Vec<f64> = hs.iter().map(|h| h.ln()).collect();
-    let ys: Vec<f64> = errs.iter().map(|e| e.ln()).collect();
-    let n = xs.len() as f64;
-    let (mx, my) = (xs.iter().sum::<f64>() / n, ys.iter().sum::<f64>() / n);
-    let sxy: f64 = xs.iter().zip(&ys).map(|(x, y)| (x - mx) * (y - my)).sum();
-    let sxx: f64 = xs.iter().map(|x| (x - mx) * (x - mx)).sum();
-    sxy / sxx
 }
 
 /// 1. Lemke's method on problems with known solutions.
@@ -316,7 +307,7 @@ fn ball_section(c: &mut Checks, out: &std::path::Path) -> Res<()> {
         ],
         rows.iter().map(|r| r.map(Cell::Number)),
     )?;
-    let (pt, pr) = (slope(&hs, &et), slope(&hs, &er));
+    let (pt, pr) = (observed_order(&hs, &et)?, observed_order(&hs, &er)?);
     println!("fitted orders: impact times {pt:.3}, rest time {pr:.3}");
     c.check(
         "impact times converge at first order",

@@ -1,10 +1,10 @@
 //! The ball on a vibrating table (`systems::BouncingBallTable`, e = 0.5) by both engines:
 //! the event-driven driver (located impacts, chattering ended by its sticking mode) and
-//! Moreau–Jean time-stepping (the same `Mechanical` model with the table as a user
-//! contact), at Γ = 1.2 and Γ = 2. Prints the regimes, the release and impact phases of
-//! both, their differences against the step, and the cost of each; writes
-//! `table_impacts.csv` (time, phase, engine, step) into `out/timestep`. Exits non-zero if
-//! the release phase or the first impact after a release differs by more than the
+//! Moreau–Jean time-stepping (the same `Mechanical` model with the table as a contact,
+//! `BouncingBallTable::contact`), at Γ = 1.2 and Γ = 2. Prints the regimes, the release
+//! and impact phases of both, their differences against the step, and the cost of each;
+//! writes `table_impacts.csv` (time, phase, engine, step) into `out/timestep`. Exits
+//! non-zero if the release phase or the first impact after a release differs by more than the
 //! resolution of the step grid (h and 2h).
 //!
 //! `cargo run --release --example timestep_table -- [--out DIR]`
@@ -16,33 +16,9 @@ use nonsmooth::drive::{Control, EventRecord, Observer, run_with_sticking};
 use nonsmooth::integrate::{Dopri5, Tolerances};
 use nonsmooth::output::csv::{Cell, write_table_path};
 use nonsmooth::systems::BouncingBallTable;
-use nonsmooth::timestep::{
-    Contact, Geometry, ImpactLog, Jacobian, MoreauJean, StepObserver, StepRecord,
-};
+use nonsmooth::timestep::{ImpactLog, MoreauJean, RidingLog};
 
 type Res<T> = Result<T, Box<dyn std::error::Error>>;
-
-/// The table `s(t) = A sin ωt` as a contact of the ball's one coordinate.
-struct Table {
-    amplitude: f64,
-    omega: f64,
-    e: f64,
-}
-
-impl Contact<f64> for Table {
-    fn evaluate(&self, t: f64, q: &[f64], jac: &mut Jacobian<'_, f64>) -> Geometry<f64> {
-        jac.normal(0, 1.0);
-        Geometry {
-            gap: q[0] - self.amplitude * (self.omega * t).sin(),
-        }
-    }
-    fn drift(&self, t: f64, _q: &[f64]) -> [f64; 2] {
-        [-self.amplitude * self.omega * (self.omega * t).cos(), 0.0]
-    }
-    fn restitution(&self) -> f64 {
-        self.e
-    }
-}
 
 struct EdImpacts(Vec<f64>);
 
@@ -50,31 +26,6 @@ impl Observer<f64, 2> for EdImpacts {
     fn on_event(&mut self, e: &EventRecord<f64, 2>) -> Control {
         if e.y_after.is_some() {
             self.0.push(e.t);
-        }
-        Control::Continue
-    }
-}
-
-/// Riding episodes `(start, end)` of the time-stepping.
-struct Riding {
-    speed: f64,
-    open: Option<f64>,
-    episodes: Vec<(f64, f64)>,
-}
-
-impl StepObserver<f64> for Riding {
-    fn on_step(&mut self, s: &StepRecord<'_, f64>) -> Control {
-        let riding = s
-            .contacts
-            .iter()
-            .any(|c| c.normal_impulse > 0.0 && !c.is_impact(self.speed));
-        match (riding, self.open) {
-            (true, None) => self.open = Some(s.t0),
-            (false, Some(t)) => {
-                self.episodes.push((t, s.t0));
-                self.open = None;
-            }
-            _ => {}
         }
         Control::Continue
     }
@@ -144,21 +95,10 @@ fn main() -> Res<()> {
             .collect();
         for h in [1e-3, 2.5e-4, 1e-4] {
             let clock = Instant::now();
-            let table = Table {
-                amplitude: p.amplitude,
-                omega: p.omega,
-                e: p.e,
-            };
+            let table = p.contact()?;
             let mut scheme = MoreauJean::new(p.model::<f64>()?, vec![table], h)?;
             let (mut q, mut v) = (vec![0.0], vec![v0]);
-            let mut obs = (
-                ImpactLog::new(p.g * h)?,
-                Riding {
-                    speed: p.g * h,
-                    open: None,
-                    episodes: Vec::new(),
-                },
-            );
+            let mut obs = (ImpactLog::new(p.g * h)?, RidingLog::new(p.g * h)?);
             scheme.run(0.0, &mut q, &mut v, t_end, &mut obs)?;
             let ts_ms = clock.elapsed().as_secs_f64() * 1e3;
             let ts: Vec<f64> = obs.0.impacts.iter().map(|i| i.t0).collect();

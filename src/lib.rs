@@ -12,7 +12,7 @@
 //! | excitation | harmonic, unbalanced rotor, ramped rotor | [`excite`] |
 //! | models | `ẏ = f(t, y)`; N-DOF systems from elements, the 1-DOF oscillator | [`Dynamics`], [`model::Mechanical`], [`model::Oscillator`] |
 //! | catalogue | ready systems: the paper's cart, Duffing–Ueda, a 2-DOF impact oscillator | [`systems`] |
-//! | roots | Brent's method for equilibria and events | [`roots`] |
+//! | utilities | Brent's root bracketing, golden-section search, the fast `sin`/`cos` of the forcing | [`util`] |
 //! | integrators | DOPRI5, DOP853, Rosenbrock 2(3) on one adaptive stepper, RK4, turning points; dense output | [`integrate`] |
 //! | events | crossings located on dense output, grazing pairs, resets, Zeno guard | [`event`] |
 //! | driver | system + stepper + events + observers | [`drive`] |
@@ -57,21 +57,21 @@ pub mod entropy;
 pub mod error;
 pub mod event;
 pub mod excite;
-pub mod fastmath;
+mod fastmath;
 pub mod filippov;
 pub mod force;
 pub mod identify;
 pub mod integrate;
 pub mod lanes;
-pub mod linalg;
+mod linalg;
 pub mod lyapunov;
 pub mod model;
 pub mod orbit;
 pub mod output;
 pub mod prelude;
-pub mod roots;
+mod roots;
 pub mod sample;
-pub mod scalar;
+mod scalar;
 mod serde_check;
 pub mod signal;
 #[cfg(feature = "cli")]
@@ -81,6 +81,7 @@ pub mod systems;
 #[cfg(feature = "testing")]
 pub mod testing;
 pub mod timestep;
+pub mod util;
 pub(crate) mod validate;
 
 pub use dynamics::{Dynamics, LaneByLane, LaneDynamics};

@@ -25,27 +25,10 @@ pub fn to_f64<T: Real>(x: T) -> f64 {
     x.to_subset().unwrap_or(f64::NAN)
 }
 
-/// `true` if `x` is neither NaN nor infinite.
-#[inline(always)]
-pub fn is_finite<T: Real>(x: T) -> bool {
-    x.is_finite()
-}
-
 /// Machine epsilon of `T`.
 #[inline(always)]
 pub fn epsilon<T: Real>() -> T {
     T::default_epsilon()
-}
-
-/// `sgn(x)·|x|^p` computed as `exp(p·ln|x|)` (one transcendental pair, zero at `x = 0`).
-#[inline(always)]
-pub fn signed_pow<T: Real>(x: T, p: T) -> T {
-    if x == T::zero() {
-        T::zero()
-    } else {
-        let m = (p * x.abs().ln()).exp();
-        if x > T::zero() { m } else { -m }
-    }
 }
 
 /// A power exponent with fast paths for the common values 1, 3/2 and 2.
@@ -147,14 +130,5 @@ mod tests {
             }
         }
         assert_eq!(Exponent::new(1.5_f64).pow(-1.0), 0.0);
-    }
-
-    #[test]
-    fn signed_pow_is_odd() {
-        assert_eq!(signed_pow(0.0_f64, 0.3), 0.0);
-        let a = signed_pow(2.0e-3_f64, 0.18667);
-        assert!((a - 2.0e-3_f64.powf(0.18667)).abs() < 1e-14);
-        assert_eq!(signed_pow(-2.0e-3_f64, 0.18667), -a);
-        assert!((signed_pow(0.5_f32, 0.5) - 0.5_f32.sqrt()).abs() < 1e-6);
     }
 }

@@ -479,7 +479,7 @@ fn lane_sin_is_the_scalar_kernel_to_the_bit() {
         let v = F64x4::load(c);
         let s = math::sin(v);
         for (i, &x) in c.iter().enumerate() {
-            let want = nonsmooth::fastmath::sin_f64(x);
+            let want = nonsmooth::util::sin_f64(x);
             let got = s.lane(i);
             assert!(
                 got.to_bits() == want.to_bits() || (got.is_nan() && want.is_nan()),

@@ -3,12 +3,13 @@
 //! closed forms (bouncing ball, Housner's rocking block), against the event-driven engine
 //! (ball on a vibrating table) and against conservation laws (Newton's cradle).
 
+use nonsmooth::analysis::observed_order;
 use nonsmooth::drive::Control;
-use nonsmooth::systems::Woodpecker;
+use nonsmooth::systems::{BouncingBallTable, Woodpecker};
 use nonsmooth::timestep::lcp::{LcpError, Lemke, Nsgs, Pgs, frictional_contact_residual, residual};
 use nonsmooth::timestep::{
     Contact, Geometry, ImpactLog, Jacobian, Lagrangian, LinearContact, MoreauJean, PlanarBodies,
-    PlanarContact, Plane, RigidBody, Solver, StepObserver, StepRecord, TimeStepError,
+    PlanarContact, Plane, RidingLog, RigidBody, Solver, StepObserver, StepRecord, TimeStepError,
 };
 
 /// A seeded xorshift generator (uniform in [0, 1)).
@@ -317,7 +318,12 @@ fn drop_ball(
     e: f64,
     h: f64,
     t_end: f64,
-) -> (Vec<nonsmooth::timestep::Impact>, f64, Vec<f64>, Vec<f64>) {
+) -> (
+    Vec<nonsmooth::timestep::StepImpact>,
+    f64,
+    Vec<f64>,
+    Vec<f64>,
+) {
     let ball = PlanarBodies::new(vec![RigidBody::disc(1.0, 0.1).unwrap()], 9.81).unwrap();
     let floor =
         vec![PlanarContact::disc_plane(0, 0.1, Plane::floor(0.0).unwrap(), e, 0.0).unwrap()];
@@ -341,17 +347,6 @@ impl StepObserver<f64> for LastFree {
         }
         Control::Continue
     }
-}
-
-/// Least-squares slope of log(err) against log(h).
-fn slope(hs: &[f64], errs: &[f64]) -> f64 {
-    let xs: Vec<f64> = hs.iter().map(|h| h.ln()).collect();
-    let ys: Vec<f64> = errs.iter().map(|e| e.ln()).collect();
-    let n = xs.len() as f64;
-    let (mx, my) = (xs.iter().sum::<f64>() / n, ys.iter().sum::<f64>() / n);
-    let sxy: f64 = xs.iter().zip(&ys).map(|(x, y)| (x - mx) * (y - my)).sum();
-    let sxx: f64 = xs.iter().map(|x| (x - mx) * (x - mx)).sum();
-    sxy / sxx
 }
 
 #[test]
@@ -389,7 +384,10 @@ fn bouncing_ball_passes_the_accumulation_point_and_converges_at_first_order() {
         time_err.push(err);
         rest_err.push((rest - t_inf).abs());
     }
-    let (p_times, p_rest) = (slope(&hs, &time_err), slope(&hs, &rest_err));
+    let (p_times, p_rest) = (
+        observed_order(&hs, &time_err).unwrap(),
+        observed_order(&hs, &rest_err).unwrap(),
+    );
     println!("orders: impact times {p_times:.3}, rest time {p_rest:.3}");
     // Impact times: first order (measured 0.945 over h = 4e-3 … 1.25e-4).
     assert!((p_times - 1.0).abs() < 0.15, "impact-time order {p_times}");
@@ -591,28 +589,6 @@ fn rocking_block_follows_housners_law() {
     assert!(ratio_err < 2e-3 && amp_err < 3e-2, "h = 2.5e-4: {worst:?}");
 }
 
-/// The vibrating table `s(t) = A sin ωt` as a user contact on a one-DOF system.
-struct TableGap {
-    amplitude: f64,
-    omega: f64,
-    e: f64,
-}
-
-impl Contact<f64> for TableGap {
-    fn evaluate(&self, t: f64, q: &[f64], jac: &mut Jacobian<'_, f64>) -> Geometry<f64> {
-        jac.normal(0, 1.0);
-        Geometry {
-            gap: q[0] - self.amplitude * (self.omega * t).sin(),
-        }
-    }
-    fn drift(&self, t: f64, _q: &[f64]) -> [f64; 2] {
-        [-self.amplitude * self.omega * (self.omega * t).cos(), 0.0]
-    }
-    fn restitution(&self) -> f64 {
-        self.e
-    }
-}
-
 /// Impact times of the event-driven engine (with its sticking mode).
 struct EdImpacts(Vec<f64>);
 
@@ -620,32 +596,6 @@ impl nonsmooth::drive::Observer<f64, 2> for EdImpacts {
     fn on_event(&mut self, e: &nonsmooth::drive::EventRecord<f64, 2>) -> Control {
         if e.y_after.is_some() {
             self.0.push(e.t);
-        }
-        Control::Continue
-    }
-}
-
-/// Episodes riding the table `(start, end)`: consecutive steps with an active contact
-/// carrying an impulse without being struck.
-struct Riding {
-    speed: f64,
-    open: Option<f64>,
-    episodes: Vec<(f64, f64)>,
-}
-
-impl StepObserver<f64> for Riding {
-    fn on_step(&mut self, s: &StepRecord<'_, f64>) -> Control {
-        let riding = s
-            .contacts
-            .iter()
-            .any(|c| c.normal_impulse > 0.0 && !c.is_impact(self.speed));
-        match (riding, self.open) {
-            (true, None) => self.open = Some(s.t0),
-            (false, Some(t)) => {
-                self.episodes.push((t, s.t0));
-                self.open = None;
-            }
-            _ => {}
         }
         Control::Continue
     }
@@ -691,7 +641,6 @@ fn ball_on_a_vibrating_table_agrees_with_the_event_driven_engine() {
     // each impact, so the number of periods to the next capture is not reproduced by the
     // time-stepping (8 at h = 1e-3, 13 at h = 2.5e-4 in this window), while every release
     // and the impacts that follow it converge at first order.
-    use nonsmooth::systems::BouncingBallTable;
     let hs = [1e-3, 2.5e-4, 1e-4];
     for gamma in [1.2, 2.0] {
         let p = BouncingBallTable::with_gamma(gamma, 0.5).unwrap();
@@ -719,20 +668,12 @@ fn ball_on_a_vibrating_table_agrees_with_the_event_driven_engine() {
         );
         let mut after_release_errors = Vec::new();
         for &h in &hs {
-            let table = TableGap {
-                amplitude: p.amplitude,
-                omega: p.omega,
-                e: p.e,
-            };
+            let table = p.contact().unwrap();
             let mut scheme = MoreauJean::new(p.model::<f64>().unwrap(), vec![table], h).unwrap();
             let (mut q, mut v) = (vec![0.0], vec![v0]);
             let mut obs = (
                 ImpactLog::new(p.g * h).unwrap(),
-                Riding {
-                    speed: p.g * h,
-                    open: None,
-                    episodes: Vec::new(),
-                },
+                RidingLog::new(p.g * h).unwrap(),
             );
             scheme.run(0.0, &mut q, &mut v, t_end, &mut obs).unwrap();
             let ts: Vec<f64> = obs.0.impacts.iter().map(|i| i.t0).collect();
@@ -937,21 +878,10 @@ fn a_dense_mass_matrix_gives_the_same_motion() {
 fn stroboscopic_section_samples_the_grid() {
     // A ball resting on a vibrating table (Γ = 0.5 < 1: it never leaves): sampled once per
     // period it sits on the table at the section phase, s(t) = A sin(ωt) with ωt = 2πi + 0.3.
-    let (amplitude, omega) = (
-        0.5 * 9.81 / (std::f64::consts::TAU).powi(2),
-        std::f64::consts::TAU,
-    );
-    let ball = nonsmooth::model::Mechanical::with_masses([1.0])
-        .unwrap()
-        .with_loads(
-            nonsmooth::model::Load::on_dof(0, nonsmooth::excite::Constant::new(-9.81).unwrap())
-                .unwrap(),
-        );
-    let table = TableGap {
-        amplitude,
-        omega,
-        e: 0.0,
-    };
+    let p = BouncingBallTable::with_gamma(0.5, 0.0).unwrap();
+    let (amplitude, omega) = (p.amplitude, p.omega);
+    let ball = p.model::<f64>().unwrap();
+    let table = p.contact().unwrap();
     let h = 1e-4;
     let mut scheme = MoreauJean::new(ball, vec![table], h).unwrap();
     let (mut q, mut v) = (vec![0.0], vec![amplitude * omega]);

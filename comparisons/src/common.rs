@@ -175,7 +175,7 @@ impl Paper {
         let total = 0.0 + spring + visc + fric + contact;
         // The crate's `sin` (fdlibm kernels, ≤ 1 ulp against libm): the peers evaluate the
         // same function, so the right-hand sides agree to the bit (`rhs_agreement`).
-        (self.amp * nonsmooth::fastmath::sin_f64(self.omega * t) - total) * self.inv_m
+        (self.amp * nonsmooth::util::sin_f64(self.omega * t) - total) * self.inv_m
     }
 
     /// `(∂ẍ/∂x, ∂ẍ/∂v)` (analytic, as `nonsmooth`'s `Oscillator::jacobian`).

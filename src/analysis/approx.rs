@@ -454,9 +454,9 @@ impl<T: Real> AmplitudePhaseSolution<T> {
         }
     }
 
-    /// The paper's `(A, α)` with `x = X0 + A sin(ωt − α)`: `(a, ψ)` for the upper point,
-    /// `(−a, ψ − π)` for the lower one.
-    pub fn paper_form(&self) -> (T, T) {
+    /// The signed form `(A, α)` with `x = X0 + A sin(ωt − α)` and the sign of `A` naming
+    /// the turning point: `(a, ψ)` for the upper point, `(−a, ψ − π)` for the lower one.
+    pub fn signed_amplitude_lag(&self) -> (T, T) {
         match self.turning_point {
             TurningPoint::Upper => (self.amplitude, self.lag),
             TurningPoint::Lower => (-self.amplitude, self.lag - T::pi()),

@@ -27,6 +27,7 @@
 
 mod approx;
 mod fit;
+mod order;
 mod spectrum;
 mod steady;
 
@@ -35,6 +36,7 @@ pub use approx::{
     TurningPoint,
 };
 pub use fit::{HarmonicFit, fit_harmonics};
+pub use order::observed_order;
 pub use spectrum::{
     AmplitudeSpectrum, DOMINANCE_THRESHOLD, HarmonicComponent, PERIOD_TOLERANCE, SPACING_TOLERANCE,
     SpectrumAnalyzer,
@@ -132,6 +134,13 @@ pub enum AnalysisError {
     /// A parameter of an approximation is invalid.
     #[error(transparent)]
     Parameter(#[from] ParameterError),
+    /// Convergence data that has no observed order: fewer than two points, slices of
+    /// different lengths, a step or error that is not finite and > 0, or a single step size.
+    #[error("no observed order from these data: {reason}")]
+    ConvergenceData {
+        /// What is wrong, naming the index and value.
+        reason: String,
+    },
     /// The restoring force has no zero in the given interval.
     #[error("no static equilibrium in [{lo}, {hi}]: the restoring force does not change sign")]
     NoEquilibrium {

@@ -25,6 +25,7 @@
 
 use nalgebra::SVector;
 
+mod constraint;
 mod error;
 pub mod modes;
 mod scan;

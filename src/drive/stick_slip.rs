@@ -50,6 +50,7 @@
 
 use nalgebra::SVector;
 
+use super::constraint::ScalarConstraint;
 use super::error::Result;
 use super::modes::{ModeError, ModeSystem, Segment, rate_along_flow};
 use super::{Observer, Simulation, Termination};
@@ -153,21 +154,12 @@ impl SlipMode {
 /// `max(1, |u|, |w·q̇|)` (the stick mode damps what is left).
 pub const STICK_RATE_TOLERANCE: f64 = 1e-8;
 
-/// The mass-metric quantities of the friction direction.
-#[derive(Debug, Clone, Copy)]
-struct Metric<T: Real, const N: usize> {
-    /// `M⁻¹w`.
-    m_w: SVector<T, N>,
-    /// `wᵀM⁻¹w`.
-    w_m_w: T,
-}
-
 /// The right-hand side of one mode: slip with a friction force `force`, or stick.
 #[derive(Debug)]
 struct ModeRhs<'a, T: Real, const N: usize, const M: usize, El, Ld, U> {
     model: &'a Mechanical<T, N, El, Ld>,
     friction: &'a Coulomb<T, N, U>,
-    metric: Metric<T, N>,
+    constraint: ScalarConstraint<T, N>,
     /// `Some(F)`: slipping with friction force `F`; `None`: stuck.
     slip_force: Option<T>,
     alpha: T,
@@ -194,7 +186,7 @@ where
         let w = self.friction.coordinate.weights();
         let drift = self.friction.slip_velocity(t, y);
         let target = self.friction.surface_velocity.force_rate(t) - self.alpha * drift;
-        (a, (target - w.dot(&a)) / self.metric.w_m_w)
+        (a, self.constraint.multiplier(w, &a, target))
     }
 }
 
@@ -223,10 +215,7 @@ where
             Some(f) => (self.model.acceleration(t, y), f),
             None => self.multiplier(t, y),
         };
-        for k in 0..N {
-            dy[k] = y[N + k];
-            dy[N + k] = a[k] + force * self.metric.m_w[k];
-        }
+        self.constraint.rhs(y, &a, force, dy);
     }
 }
 
@@ -275,7 +264,7 @@ where
 pub struct StickSlip<'a, T: Real, const N: usize, const M: usize, El, Ld, U, F> {
     model: &'a Mechanical<T, N, El, Ld>,
     friction: Coulomb<T, N, U>,
-    metric: Metric<T, N>,
+    constraint: ScalarConstraint<T, N>,
     alpha: T,
     stepper: F,
 }
@@ -297,11 +286,11 @@ where
         friction: Coulomb<T, N, U>,
         stepper: F,
     ) -> Self {
-        let (m_w, w_m_w) = model.mobility(friction.coordinate.weights());
+        let constraint = ScalarConstraint::new(model, friction.coordinate.weights());
         Self {
             model,
             friction,
-            metric: Metric { m_w, w_m_w },
+            constraint,
             alpha: T::one(),
             stepper,
         }
@@ -320,7 +309,7 @@ where
         ModeRhs {
             model: self.model,
             friction: &self.friction,
-            metric: self.metric,
+            constraint: self.constraint,
             slip_force,
             alpha: self.alpha,
         }
@@ -430,9 +419,7 @@ where
     /// Sets `v_r = 0` exactly, changing the velocities along `M⁻¹w` only.
     fn project(&self, t: T, y: &mut SVector<T, M>) {
         let v = self.friction.slip_velocity(t, y);
-        for k in 0..N {
-            y[N + k] -= v * self.metric.m_w[k] / self.metric.w_m_w;
-        }
+        self.constraint.shift_velocities(y, -v);
     }
 }
 

@@ -24,6 +24,7 @@
 
 use nalgebra::SVector;
 
+use super::constraint::ScalarConstraint;
 use super::error::Result;
 use super::modes::{ModeError, ModeSystem, Segment, rate_along_flow, run_modes};
 use super::{Observer, Outcome, Simulation, Termination};
@@ -39,10 +40,8 @@ use crate::{Dynamics, Real};
 pub struct Constrained<'a, T: Real, const N: usize, const M: usize, El, Ld, S> {
     model: &'a Mechanical<T, N, El, Ld>,
     gap: &'a Gap<T, N, S>,
-    /// `M⁻¹w`.
-    m_w: SVector<T, N>,
-    /// `wᵀM⁻¹w`.
-    w_m_w: T,
+    /// The constraint along the gap's coordinate.
+    constraint: ScalarConstraint<T, N>,
     /// Baumgarte rate `α` (1/s).
     alpha: T,
 }
@@ -69,7 +68,7 @@ where
 {
     /// The constrained motion of `model` on `gap`.
     pub fn new(model: &'a Mechanical<T, N, El, Ld>, gap: &'a Gap<T, N, S>) -> Self {
-        let (m_w, w_m_w) = model.mobility(gap.coordinate().weights());
+        let constraint = ScalarConstraint::new(model, gap.coordinate().weights());
         // Drift of the constraint (integration error) decays at rate α: four surface
         // radians per radian, or 1/s for a fixed surface.
         let alpha = EventFunction::<T, M>::time_scale(gap, T::zero()).map_or(T::one(), |h| {
@@ -78,8 +77,7 @@ where
         Self {
             model,
             gap,
-            m_w,
-            w_m_w,
+            constraint,
             alpha,
         }
     }
@@ -106,7 +104,7 @@ where
         let two = lit::<T>(2.0);
         let target =
             self.gap.surface_acceleration(t) - two * self.alpha * ed - self.alpha * self.alpha * e;
-        let lambda = (target - w.dot(&a)) / self.w_m_w;
+        let lambda = self.constraint.multiplier(w, &a, target);
         (a, lambda)
     }
 
@@ -116,10 +114,8 @@ where
         let (q, qd) = y.as_slice().split_at(N);
         let c = self.gap.coordinate().value(q);
         let cd = self.gap.coordinate().rate(qd);
-        for k in 0..N {
-            y[k] += (s - c) * self.m_w[k] / self.w_m_w;
-            y[N + k] += (sd - cd) * self.m_w[k] / self.w_m_w;
-        }
+        self.constraint.shift_positions(y, s - c);
+        self.constraint.shift_velocities(y, sd - cd);
     }
 }
 
@@ -133,10 +129,7 @@ where
 {
     fn rhs(&self, t: T, y: &SVector<T, M>, dy: &mut SVector<T, M>) {
         let (a, lambda) = self.multiplier(t, y);
-        for k in 0..N {
-            dy[k] = y[N + k];
-            dy[N + k] = a[k] + lambda * self.m_w[k];
-        }
+        self.constraint.rhs(y, &a, lambda, dy);
     }
     fn time_scale(&self, t: T) -> Option<T> {
         Constrained::time_scale(self, t)

@@ -315,7 +315,7 @@ impl<T: Real> ForceLaw<T> for HertzContact<T> {
     }
 }
 
-/// An [`Exponent`] per lane: masks of its kind and its value.
+/// A contact exponent per lane: masks of its kind and its value.
 #[derive(Debug, Clone, Copy)]
 pub struct ExponentLanes<V> {
     one: V,

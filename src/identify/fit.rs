@@ -245,6 +245,33 @@ struct Vertex {
     f: f64,
 }
 
+/// The start simplex of one run around `best` (kept as vertex 0, not evaluated again) and
+/// its per-coordinate steps, the yardstick of the x tolerance.
+fn start_simplex<F, E>(
+    best: &Vertex,
+    ev: &mut Evaluator<'_, F>,
+    options: &NelderMeadOptions,
+) -> Result<(Vec<Vertex>, Vec<f64>), IdentifyError>
+where
+    F: FnMut(&ParamValues) -> Result<f64, E>,
+    E: std::fmt::Display,
+{
+    let space = ev.space;
+    let n = space.len();
+    let at = space.to_physical(&best.u)?;
+    let start = space.simplex(at.values(), options.relative_step, options.zero_step)?;
+    let steps: Vec<f64> = (0..n)
+        .map(|j| (start[j + 1][j] - start[0][j]).abs())
+        .collect();
+    let mut simplex: Vec<Vertex> = Vec::with_capacity(n + 1);
+    simplex.push(best.clone());
+    for u in start.into_iter().skip(1) {
+        let f = ev.eval(&u);
+        simplex.push(Vertex { u, f });
+    }
+    Ok((simplex, steps))
+}
+
 /// Minimizes `objective` over the named parameters of `space` with the Nelder–Mead simplex
 /// method, as the paper minimizes `F0` with MATLAB's `fminsearch`.
 ///
@@ -339,18 +366,7 @@ where
     loop {
         runs += 1;
         let best_before = best.f;
-        let at = space.to_physical(&best.u)?;
-        let start = space.simplex(at.values(), options.relative_step, options.zero_step)?;
-        // Per-coordinate start steps, the yardstick of the x tolerance.
-        let steps: Vec<f64> = (0..n)
-            .map(|j| (start[j + 1][j] - start[0][j]).abs())
-            .collect();
-        let mut simplex: Vec<Vertex> = Vec::with_capacity(n + 1);
-        simplex.push(best.clone());
-        for u in start.into_iter().skip(1) {
-            let f = ev.eval(&u);
-            simplex.push(Vertex { u, f });
-        }
+        let (mut simplex, steps) = start_simplex(&best, &mut ev, options)?;
         sort(&mut simplex);
         history.push(simplex[0].f);
         termination = loop {

@@ -24,8 +24,8 @@
 //! **Tangent space** ([`TangentSpace`]). `K ≤ N` tangent vectors are integrated with the
 //! state through the variational equations ([`Variational`], dimension `M = N + N·K`)
 //! $$\dot y = f(t, y),\qquad \dot\Phi = J(t, y)\,\Phi,\qquad J = \partial f/\partial y,$$
-//! and re-orthonormalized every `τ` by modified Gram–Schmidt
-//! ([`gram_schmidt`](crate::linalg::gram_schmidt)), `Φ(t_k) = Q_k R_k`, `Φ ← Q_k`:
+//! and re-orthonormalized every `τ` by modified Gram–Schmidt,
+//! `Φ(t_k) = Q_k R_k`, `Φ ← Q_k`:
 //! $$\lambda_j \approx \frac{1}{n\tau}\sum_{k=1}^{n}\ln (R_k)_{jj},\qquad j = 1..K .$$
 //! With `K = N` the sum of the spectrum is the time average of `tr J` (Liouville), a check
 //! that does not depend on the length of the run. It needs

@@ -228,6 +228,73 @@ pub struct TimeSeries {
     phase: Option<Vec<f64>>,
 }
 
+/// The columns of a CSV file a [`TimeSeries`] reads: index and name of each.
+struct Columns {
+    time: (usize, String),
+    position: (usize, String),
+    phase: Option<(usize, String)>,
+}
+
+impl Columns {
+    /// The columns `options` names, found in `header`.
+    fn find(header: &csv::StringRecord, options: &CsvOptions) -> Result<Self, SignalError> {
+        let find = |col: &Column| -> Option<(usize, String)> {
+            match col {
+                Column::Name(n) => header
+                    .iter()
+                    .position(|h| h == n.trim())
+                    .map(|i| (i, n.clone())),
+                Column::Index(i) => header.get(*i).map(|h| (*i, h.to_owned())),
+            }
+        };
+        let missing = |col: &Column| SignalError::MissingColumn {
+            column: col.to_string(),
+            available: header.iter().collect::<Vec<_>>().join(","),
+        };
+        Ok(Self {
+            time: find(&options.time).ok_or_else(|| missing(&options.time))?,
+            position: find(&options.position).ok_or_else(|| missing(&options.position))?,
+            phase: match &options.phase {
+                PhaseColumn::None => None,
+                PhaseColumn::IfPresent(c) => find(c),
+                PhaseColumn::Required(c) => Some(find(c).ok_or_else(|| missing(c))?),
+            },
+        })
+    }
+}
+
+/// Field `idx` (column `name`) of a record on `line`, times `scale`: present, a number,
+/// finite after scaling.
+fn parse_field(
+    record: &csv::StringRecord,
+    idx: usize,
+    name: &str,
+    scale: f64,
+    line: u64,
+) -> Result<f64, SignalError> {
+    let text = record.get(idx).unwrap_or("");
+    if text.is_empty() {
+        return Err(SignalError::MissingField {
+            line,
+            column: format!("`{name}`"),
+        });
+    }
+    let v: f64 = text.parse().map_err(|_| SignalError::ParseField {
+        line,
+        column: format!("`{name}`"),
+        text: text.to_owned(),
+    })?;
+    let v = v * scale;
+    if !v.is_finite() {
+        return Err(SignalError::NonFinite {
+            location: Location::Line(line),
+            what: format!("column `{name}`"),
+            value: v,
+        });
+    }
+    Ok(v)
+}
+
 impl TimeSeries {
     /// Header of the time column written by [`write_csv`](Self::write_csv).
     pub const TIME_HEADER: &'static str = "t_s";
@@ -401,30 +468,11 @@ impl TimeSeries {
         if header.is_empty() {
             return Err(SignalError::EmptyInput { what: "header" });
         }
-        let find = |col: &Column| -> Option<(usize, String)> {
-            match col {
-                Column::Name(n) => header
-                    .iter()
-                    .position(|h| h == n.trim())
-                    .map(|i| (i, n.clone())),
-                Column::Index(i) => header.get(*i).map(|h| (*i, h.to_owned())),
-            }
-        };
-        let missing = |col: &Column| SignalError::MissingColumn {
-            column: col.to_string(),
-            available: header.iter().collect::<Vec<_>>().join(","),
-        };
-        let (it, t_name) = find(&options.time).ok_or_else(|| missing(&options.time))?;
-        let (ix, x_name) = find(&options.position).ok_or_else(|| missing(&options.position))?;
-        let phase_col = match &options.phase {
-            PhaseColumn::None => None,
-            PhaseColumn::IfPresent(c) => find(c),
-            PhaseColumn::Required(c) => Some(find(c).ok_or_else(|| missing(c))?),
-        };
+        let columns = Columns::find(&header, options)?;
 
         let mut t = Vec::new();
         let mut x = Vec::new();
-        let mut phase = phase_col.as_ref().map(|_| Vec::new());
+        let mut phase = columns.phase.as_ref().map(|_| Vec::new());
         let mut record = csv::StringRecord::new();
         loop {
             match rdr.read_record(&mut record) {
@@ -442,31 +490,10 @@ impl TimeSeries {
                     expected: header.len(),
                 });
             }
-            let field = |idx: usize, name: &str, scale: f64| -> Result<f64, SignalError> {
-                let text = record.get(idx).unwrap_or("");
-                if text.is_empty() {
-                    return Err(SignalError::MissingField {
-                        line,
-                        column: format!("`{name}`"),
-                    });
-                }
-                let v: f64 = text.parse().map_err(|_| SignalError::ParseField {
-                    line,
-                    column: format!("`{name}`"),
-                    text: text.to_owned(),
-                })?;
-                let v = v * scale;
-                if !v.is_finite() {
-                    return Err(SignalError::NonFinite {
-                        location: Location::Line(line),
-                        what: format!("column `{name}`"),
-                        value: v,
-                    });
-                }
-                Ok(v)
-            };
-            let ti = field(it, &t_name, options.time_scale)?;
-            let xi = field(ix, &x_name, options.position_scale)?;
+            let (it, t_name) = &columns.time;
+            let (ix, x_name) = &columns.position;
+            let ti = parse_field(&record, *it, t_name, options.time_scale, line)?;
+            let xi = parse_field(&record, *ix, x_name, options.position_scale, line)?;
             if let Some(&previous) = t.last() {
                 if ti <= previous {
                     return Err(SignalError::NonIncreasingTime {
@@ -476,8 +503,14 @@ impl TimeSeries {
                     });
                 }
             }
-            if let (Some((ip, p_name)), Some(ph)) = (&phase_col, phase.as_mut()) {
-                ph.push(field(*ip, p_name, options.phase_scale)?);
+            if let (Some((ip, p_name)), Some(ph)) = (&columns.phase, phase.as_mut()) {
+                ph.push(parse_field(
+                    &record,
+                    *ip,
+                    p_name,
+                    options.phase_scale,
+                    line,
+                )?);
             }
             t.push(ti);
             x.push(xi);

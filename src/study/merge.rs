@@ -206,30 +206,7 @@ impl Merged {
         if self.is_basin() {
             let root = BitMapBackend::new(path, (1000, 700)).into_drawing_area();
             root.fill(&WHITE).map_err(|e| err(&e))?;
-            let mut legend = Vec::new();
-            for a in &self.attractors {
-                let what = if a.period > 0 {
-                    format!(
-                        "P{}, {} imp.",
-                        a.period,
-                        (a.impacts_per_period * a.period as f64).round()
-                    )
-                } else {
-                    format!("not periodic, {:.2} imp./T", a.impacts_per_period)
-                };
-                legend.push((
-                    format!("{}: {what} ({:.0} %)", a.label, 100.0 * a.fraction),
-                    palette(a.label),
-                ));
-            }
-            if self.labels.iter().any(Option::is_none) {
-                legend.push(("failed".into(), BLACK));
-            }
-            let colours: Vec<RGBColor> = self
-                .labels
-                .iter()
-                .map(|l| l.map_or(BLACK, palette))
-                .collect();
+            let (colours, legend) = self.basin_colours();
             let title = format!("{}: basins of attraction ({n} points)", spec.name);
             self.panel(&root, &title, &colours, &legend)
                 .map_err(|e| err(&e))?;
@@ -238,7 +215,53 @@ impl Merged {
         let root = BitMapBackend::new(path, (1800, 700)).into_drawing_area();
         root.fill(&WHITE).map_err(|e| err(&e))?;
         let (left, right) = root.split_horizontally(900);
-        // Period panel.
+        let (colours, legend) = self.period_colours();
+        self.panel(
+            &left,
+            &format!("{}: period ({n} points)", spec.name),
+            &colours,
+            &legend,
+        )
+        .map_err(|e| err(&e))?;
+        let (colours, legend) = self.impact_colours();
+        self.panel(&right, "impacts per forcing period", &colours, &legend)
+            .map_err(|e| err(&e))?;
+        root.present().map_err(|e| err(&e))
+    }
+
+    /// A basin picture's colours (by point: the attractor's label, black where the point
+    /// failed) and its legend.
+    fn basin_colours(&self) -> (Vec<RGBColor>, Vec<(String, RGBColor)>) {
+        let mut legend = Vec::new();
+        for a in &self.attractors {
+            let what = if a.period > 0 {
+                format!(
+                    "P{}, {} imp.",
+                    a.period,
+                    (a.impacts_per_period * a.period as f64).round()
+                )
+            } else {
+                format!("not periodic, {:.2} imp./T", a.impacts_per_period)
+            };
+            legend.push((
+                format!("{}: {what} ({:.0} %)", a.label, 100.0 * a.fraction),
+                palette(a.label),
+            ));
+        }
+        if self.labels.iter().any(Option::is_none) {
+            legend.push(("failed".into(), BLACK));
+        }
+        let colours: Vec<RGBColor> = self
+            .labels
+            .iter()
+            .map(|l| l.map_or(BLACK, palette))
+            .collect();
+        (colours, legend)
+    }
+
+    /// The period panel's colours (P1 … P8, longer, not periodic, chaotic, failed) and
+    /// its legend.
+    fn period_colours(&self) -> (Vec<RGBColor>, Vec<(String, RGBColor)>) {
         let grey = RGBColor(150, 150, 150);
         let chaos = RGBColor(20, 20, 20);
         let period_class = |r: &PointRecord| -> (usize, String, RGBColor) {
@@ -261,14 +284,12 @@ impl Merged {
         legend.dedup_by_key(|c| c.0);
         let legend: Vec<(String, RGBColor)> = legend.into_iter().map(|c| (c.1, c.2)).collect();
         let colours: Vec<RGBColor> = classes.iter().map(|c| c.2).collect();
-        self.panel(
-            &left,
-            &format!("{}: period ({n} points)", spec.name),
-            &colours,
-            &legend,
-        )
-        .map_err(|e| err(&e))?;
-        // Impacts per period panel.
+        (colours, legend)
+    }
+
+    /// The impacts-per-period panel's colours (a ramp up to the largest finite value) and
+    /// its legend.
+    fn impact_colours(&self) -> (Vec<RGBColor>, Vec<(String, RGBColor)>) {
         let max = self
             .records
             .iter()
@@ -294,9 +315,7 @@ impl Merged {
                 (format!("{v:.2}"), ramp(v / max))
             })
             .collect();
-        self.panel(&right, "impacts per forcing period", &colours, &legend)
-            .map_err(|e| err(&e))?;
-        root.present().map_err(|e| err(&e))
+        (colours, legend)
     }
 
     /// One panel: the grid cells in `colours` (by point), a legend at the right.
@@ -314,38 +333,8 @@ impl Merged {
             Some(y) => (y.points, y.parameter.clone(), (y.start, y.end)),
             None => (1, String::new(), (0.0, 1.0)),
         };
-        let (xlab, ylab) = (gx.parameter.clone(), ylab);
-        // The chart's range: the axis values widened by half a cell. plotters computes its
-        // tick marks in a loop that never ends on a range that is not finite or whose
-        // width overflows; such an axis (one across most of the f64 range) is drawn over
-        // its grid index instead.
-        let range = |a: f64, b: f64, n: usize| -> Option<(f64, f64, f64)> {
-            let d = if n > 1 {
-                let m = (n - 1) as f64;
-                let d = (b - a) / m;
-                if d.is_finite() { d } else { b / m - a / m }
-            } else {
-                1.0
-            };
-            let (lo, hi) = (a - 0.5 * d, b + 0.5 * d);
-            let ok = [d, lo, hi, hi - lo].iter().all(|v| v.is_finite()) && hi > lo;
-            ok.then_some((lo, hi, d))
-        };
-        let by_index = |n: usize| ((-0.5, n as f64 - 0.5, 1.0), true);
-        let ((xl, xh, dx), x_index) =
-            range(gx.start, gx.end, gx.points).map_or_else(|| by_index(gx.points), |r| (r, false));
-        let ((yl, yh, dy), y_index) =
-            range(y0, y1, ny).map_or_else(|| by_index(ny), |r| (r, false));
-        let xlab = if x_index {
-            format!("{xlab} (grid index)")
-        } else {
-            xlab
-        };
-        let ylab = if y_index {
-            format!("{ylab} (grid index)")
-        } else {
-            ylab
-        };
+        let ((xl, xh, dx), x_index, xlab) = chart_axis(gx.start, gx.end, gx.points, &gx.parameter);
+        let ((yl, yh, dy), y_index, ylab) = chart_axis(y0, y1, ny, &ylab);
         let place = |index: usize| -> (f64, f64) {
             let (ix, iy) = self.study.coordinates(index);
             let (x, y) = self.study.values(index);
@@ -390,6 +379,30 @@ impl Merged {
                 .map_err(|x| e(&x))?;
         }
         Ok(())
+    }
+}
+
+/// A chart axis over `n` grid values from `a` to `b`: its range widened by half a cell and
+/// the cell width, or, where that range is not finite or its width overflows (plotters
+/// computes its tick marks in a loop that never ends on such a range; an axis across most
+/// of the f64 range), the grid index instead, said in the label.
+fn chart_axis(a: f64, b: f64, n: usize, label: &str) -> ((f64, f64, f64), bool, String) {
+    let d = if n > 1 {
+        let m = (n - 1) as f64;
+        let d = (b - a) / m;
+        if d.is_finite() { d } else { b / m - a / m }
+    } else {
+        1.0
+    };
+    let (lo, hi) = (a - 0.5 * d, b + 0.5 * d);
+    if [d, lo, hi, hi - lo].iter().all(|v| v.is_finite()) && hi > lo {
+        ((lo, hi, d), false, label.to_owned())
+    } else {
+        (
+            (-0.5, n as f64 - 0.5, 1.0),
+            true,
+            format!("{label} (grid index)"),
+        )
     }
 }
 

@@ -147,55 +147,15 @@ pub fn sbatch_script(
     spec_path: &Path,
     settings: &PlanSettings,
 ) -> Result<String, StudyError> {
+    let ScriptValues {
+        name,
+        time,
+        partition,
+        out,
+        program,
+        spec,
+    } = ScriptValues::checked(study, spec_path, settings)?;
     let n = settings.shards;
-    if n == 0 || n > study.points() {
-        return Err(StudyError::Shard(format!(
-            "--shards {n}: need 1 <= N <= {} (the number of points)",
-            study.points()
-        )));
-    }
-    if settings.cpus == 0 {
-        return Err(bad("--cpus", "must be >= 1".into()));
-    }
-    let name = token(
-        "name",
-        &study.spec().name,
-        is_name_char,
-        "letters, digits, '_', '-', '.'",
-    )?;
-    let time = token(
-        "--time",
-        &settings.time,
-        is_time_char,
-        "digits, ':' and '-' (a Slurm time, e.g. 01:00:00)",
-    )?;
-    let partition = settings
-        .partition
-        .as_deref()
-        .map(|p| {
-            token(
-                "--partition",
-                p,
-                is_partition_char,
-                "letters, digits, '_', '.', ',', '-' (partition names)",
-            )
-        })
-        .transpose()?;
-    let out = token(
-        "--out",
-        &settings.out,
-        is_path_char,
-        "letters, digits and '_', '-', '.', ',', '/', '+', '=', '@' (it is written into \
-         #SBATCH --output)",
-    )?;
-    let program = shell_value("program", &settings.program)?;
-    let spec = spec_path.to_str().ok_or_else(|| {
-        bad(
-            "spec path",
-            format!("{} is not valid UTF-8", spec_path.display()),
-        )
-    })?;
-    let spec = shell_value("spec path", spec)?;
     let mut s = String::new();
     s.push_str("#!/bin/bash\n");
     s.push_str(&format!("#SBATCH --job-name=nonsmooth-{name}\n"));
@@ -226,4 +186,81 @@ pub fn sbatch_script(
         quote(out)
     ));
     Ok(s)
+}
+
+/// Every value [`sbatch_script`] writes into the script, each checked against the
+/// characters its place allows.
+struct ScriptValues<'a> {
+    name: &'a str,
+    time: &'a str,
+    partition: Option<&'a str>,
+    out: &'a str,
+    program: &'a str,
+    spec: &'a str,
+}
+
+impl<'a> ScriptValues<'a> {
+    fn checked(
+        study: &'a Study,
+        spec_path: &'a Path,
+        settings: &'a PlanSettings,
+    ) -> Result<Self, StudyError> {
+        let n = settings.shards;
+        if n == 0 || n > study.points() {
+            return Err(StudyError::Shard(format!(
+                "--shards {n}: need 1 <= N <= {} (the number of points)",
+                study.points()
+            )));
+        }
+        if settings.cpus == 0 {
+            return Err(bad("--cpus", "must be >= 1".into()));
+        }
+        let name = token(
+            "name",
+            &study.spec().name,
+            is_name_char,
+            "letters, digits, '_', '-', '.'",
+        )?;
+        let time = token(
+            "--time",
+            &settings.time,
+            is_time_char,
+            "digits, ':' and '-' (a Slurm time, e.g. 01:00:00)",
+        )?;
+        let partition = settings
+            .partition
+            .as_deref()
+            .map(|p| {
+                token(
+                    "--partition",
+                    p,
+                    is_partition_char,
+                    "letters, digits, '_', '.', ',', '-' (partition names)",
+                )
+            })
+            .transpose()?;
+        let out = token(
+            "--out",
+            &settings.out,
+            is_path_char,
+            "letters, digits and '_', '-', '.', ',', '/', '+', '=', '@' (it is written into \
+             #SBATCH --output)",
+        )?;
+        let program = shell_value("program", &settings.program)?;
+        let spec = spec_path.to_str().ok_or_else(|| {
+            bad(
+                "spec path",
+                format!("{} is not valid UTF-8", spec_path.display()),
+            )
+        })?;
+        let spec = shell_value("spec path", spec)?;
+        Ok(Self {
+            name,
+            time,
+            partition,
+            out,
+            program,
+            spec,
+        })
+    }
 }

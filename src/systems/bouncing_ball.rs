@@ -20,6 +20,7 @@ use crate::event::{Gap, NewtonImpact};
 use crate::excite::{Constant, Harmonic};
 use crate::model::{Coordinate, Load, Mechanical};
 use crate::scalar::lit;
+use crate::timestep::{Contact, Geometry, Jacobian};
 use crate::validate::ParameterError;
 use crate::validate::positive;
 
@@ -133,5 +134,44 @@ impl BouncingBallTable {
     /// The table period `2π/ω`.
     pub fn period(&self) -> f64 {
         std::f64::consts::TAU / self.omega
+    }
+
+    /// The table as a contact of the ball's coordinate for Moreau–Jean time-stepping
+    /// ([`MoreauJean`](crate::timestep::MoreauJean) with [`model`](Self::model)): gap
+    /// `g = y − A sin ωt`, its explicit time derivative `−Aω cos ωt` as the drift, Newton's
+    /// restitution `e`, no friction.
+    ///
+    /// # Errors
+    /// [`ParameterError`] for invalid parameters.
+    pub fn contact(&self) -> Result<TableContact, ParameterError> {
+        self.validate()?;
+        Ok(TableContact {
+            amplitude: self.amplitude,
+            omega: self.omega,
+            e: self.e,
+        })
+    }
+}
+
+/// The vibrating table as a time-stepping contact ([`BouncingBallTable::contact`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TableContact {
+    amplitude: f64,
+    omega: f64,
+    e: f64,
+}
+
+impl Contact<f64> for TableContact {
+    fn evaluate(&self, t: f64, q: &[f64], jac: &mut Jacobian<'_, f64>) -> Geometry<f64> {
+        jac.normal(0, 1.0);
+        Geometry {
+            gap: q[0] - self.amplitude * (self.omega * t).sin(),
+        }
+    }
+    fn drift(&self, t: f64, _q: &[f64]) -> [f64; 2] {
+        [-self.amplitude * self.omega * (self.omega * t).cos(), 0.0]
+    }
+    fn restitution(&self) -> f64 {
+        self.e
     }
 }

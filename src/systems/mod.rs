@@ -22,7 +22,7 @@ pub mod relay;
 pub mod two_dof;
 pub mod woodpecker;
 
-pub use bouncing_ball::BouncingBallTable;
+pub use bouncing_ball::{BouncingBallTable, TableContact};
 pub use duffing_ueda::DuffingUeda;
 pub use relay::RelayFeedback;
 pub use two_dof::TwoDofImpact;

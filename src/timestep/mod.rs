@@ -81,8 +81,8 @@ mod system;
 
 pub use error::TimeStepError;
 pub use observe::{
-    ContactRecord, DriveObserver, Energy, Impact, ImpactLog, LinearStep, SectionSample,
-    StepObserver, StepRecord, StroboscopicSection, Summary,
+    ContactRecord, DriveObserver, Energy, ImpactLog, LinearStep, RidingLog, SectionSample,
+    StepImpact, StepObserver, StepRecord, StroboscopicSection, Summary,
 };
 pub use planar::{PlanarBodies, PlanarContact, Plane, RigidBody};
 pub use scheme::{MoreauJean, Solver};

@@ -164,7 +164,7 @@ impl<T: Real, A: StepObserver<T>, B: StepObserver<T>> StepObserver<T> for (A, B)
 
 /// An impact found from the impulses: contact `contact` struck during the step `[t0, t1]`.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Impact {
+pub struct StepImpact {
     /// The step's start.
     pub t0: f64,
     /// The step's end.
@@ -179,13 +179,13 @@ pub struct Impact {
     pub impulse: f64,
 }
 
-/// Records every [`Impact`] (a step in which a contact carries an impulse while approaching
+/// Records every [`StepImpact`] (a step in which a contact carries an impulse while approaching
 /// faster than `speed`, see [`ContactRecord::is_impact`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ImpactLog<T> {
     speed: T,
     /// The impacts in time order.
-    pub impacts: Vec<Impact>,
+    pub impacts: Vec<StepImpact>,
 }
 
 impl<T: Real> ImpactLog<T> {
@@ -205,7 +205,7 @@ impl<T: Real> StepObserver<T> for ImpactLog<T> {
     fn on_step(&mut self, s: &StepRecord<'_, T>) -> Control {
         for c in s.contacts {
             if c.is_impact(self.speed) {
-                self.impacts.push(Impact {
+                self.impacts.push(StepImpact {
                     t0: to_f64(s.t0),
                     t1: to_f64(s.t1),
                     contact: c.index,
@@ -214,6 +214,56 @@ impl<T: Real> StepObserver<T> for ImpactLog<T> {
                     impulse: to_f64(c.normal_impulse),
                 });
             }
+        }
+        Control::Continue
+    }
+}
+
+/// Records the episodes of sustained contact: runs of consecutive steps in which some contact
+/// carries an impulse without being struck (`normal_impulse > 0` and not
+/// [`ContactRecord::is_impact`] at `speed`): a body riding or resting on a surface.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RidingLog<T> {
+    speed: T,
+    open: Option<f64>,
+    /// The finished episodes `(start, end)`: the start of an episode's first step and the
+    /// start of the first step after it, in time order.
+    pub episodes: Vec<(f64, f64)>,
+}
+
+impl<T: Real> RidingLog<T> {
+    /// A log in which impulses of contacts approaching faster than `speed ≥ 0` are impacts,
+    /// slower ones sustained contact.
+    ///
+    /// # Errors
+    /// [`ParameterError`](crate::ParameterError) unless `speed` is finite and ≥ 0.
+    pub fn new(speed: T) -> Result<Self, crate::ParameterError> {
+        Ok(Self {
+            speed: crate::validate::non_negative("speed", speed)?,
+            open: None,
+            episodes: Vec::new(),
+        })
+    }
+
+    /// The start of an episode still going on at the last step seen, if any.
+    pub fn open(&self) -> Option<f64> {
+        self.open
+    }
+}
+
+impl<T: Real> StepObserver<T> for RidingLog<T> {
+    fn on_step(&mut self, s: &StepRecord<'_, T>) -> Control {
+        let riding = s
+            .contacts
+            .iter()
+            .any(|c| c.normal_impulse > T::zero() && !c.is_impact(self.speed));
+        match (riding, self.open) {
+            (true, None) => self.open = Some(to_f64(s.t0)),
+            (false, Some(t)) => {
+                self.episodes.push((t, to_f64(s.t0)));
+                self.open = None;
+            }
+            _ => {}
         }
         Control::Continue
     }

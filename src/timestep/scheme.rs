@@ -128,6 +128,13 @@ fn row<'a, T>(rows: &'a [(usize, T)], offsets: &[usize], a: usize) -> &'a [(usiz
     &rows[offsets[a]..offsets[a + 1]]
 }
 
+/// The stored row of the problem's row `a`: frictional problems use every row (normal,
+/// tangent, normal, …), frictionless ones the normal rows (every other stored row).
+#[inline]
+fn row_index(a: usize, frictional: bool) -> usize {
+    if frictional { a } else { 2 * a }
+}
+
 impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
     /// The scheme with step `h` for `system` and `contacts`.
     ///
@@ -466,7 +473,8 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
         }
     }
 
-    /// One step `[ta, tb]`.
+    /// One step `[ta, tb]`: the free velocity, the active contacts, their complementarity
+    /// problem, the impulses applied, the records, the position update.
     fn step(
         &mut self,
         k: usize,
@@ -476,33 +484,59 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
         v: &mut [T],
     ) -> Result<LcpReport, TimeStepError> {
         let h = tb - ta;
-        let n = self.ws.n;
         if !self.ws.factored || !self.ws.constant {
             self.factor(k, ta, q)?;
         }
+        self.free_velocity(k, ta, tb, q, v)?;
+        self.activate(k, ta, h, q, v)?;
+        let frictional = matches!(self.solver, Solver::Nsgs(_));
+        let report = self.solve_contacts(k, ta, tb, q, frictional)?;
+        self.apply_impulses(frictional);
+        Self::nonfinite(k, ta, "velocity", &self.ws.vnew)?;
+        self.record(tb, q, frictional);
+        // q⁺ = q + h ((1−θ) v + θ v⁺).
         let theta = self.theta;
-        // Free velocity: v_free = v + h M⁻¹ ((1−θ) f(ta, q, v) + θ f(tb, q + h v, v)).
-        {
-            let ws = &mut self.ws;
-            self.system.forces(ta, q, v, &mut ws.f0);
-            for i in 0..n {
-                ws.qpred[i] = q[i] + h * v[i];
-            }
-            self.system.forces(tb, &ws.qpred, v, &mut ws.f1);
-            Self::nonfinite(k, ta, "force", &ws.f0)?;
-            Self::nonfinite(k, tb, "force", &ws.f1)?;
-            for i in 0..n {
-                ws.vfree[i] = h * ((T::one() - theta) * ws.f0[i] + theta * ws.f1[i]);
-            }
+        for i in 0..self.ws.n {
+            q[i] += h * ((T::one() - theta) * v[i] + theta * self.ws.vnew[i]);
         }
-        {
-            let ws = &mut self.ws;
-            Self::solve_mass(ws.diagonal, &ws.inv_diag, &ws.chol, &mut ws.vfree);
-        }
+        v.copy_from_slice(&self.ws.vnew);
+        Self::nonfinite(k, tb, "position", q)?;
+        Ok(report)
+    }
+
+    /// The free velocity `v_free = v + h M⁻¹ ((1−θ) f(ta, q, v) + θ f(tb, q + h v, v))`.
+    fn free_velocity(
+        &mut self,
+        k: usize,
+        ta: T,
+        tb: T,
+        q: &[T],
+        v: &[T],
+    ) -> Result<(), TimeStepError> {
+        let (h, theta, n) = (tb - ta, self.theta, self.ws.n);
+        let ws = &mut self.ws;
+        self.system.forces(ta, q, v, &mut ws.f0);
         for i in 0..n {
-            self.ws.vfree[i] += v[i];
+            ws.qpred[i] = q[i] + h * v[i];
         }
-        // Active contacts: predicted gap g + γ h ġ ≤ δ.
+        self.system.forces(tb, &ws.qpred, v, &mut ws.f1);
+        Self::nonfinite(k, ta, "force", &ws.f0)?;
+        Self::nonfinite(k, tb, "force", &ws.f1)?;
+        for i in 0..n {
+            ws.vfree[i] = h * ((T::one() - theta) * ws.f0[i] + theta * ws.f1[i]);
+        }
+        Self::solve_mass(ws.diagonal, &ws.inv_diag, &ws.chol, &mut ws.vfree);
+        for i in 0..n {
+            ws.vfree[i] += v[i];
+        }
+        Ok(())
+    }
+
+    /// The active contacts, by the predicted gap `g + γ h ġ ≤ δ`: their indices, gaps,
+    /// pre-step rates and Jacobian rows (normal, tangent) into the workspace; an inactive
+    /// contact's warm start is cleared.
+    fn activate(&mut self, k: usize, ta: T, h: T, q: &[T], v: &[T]) -> Result<(), TimeStepError> {
+        let n = self.ws.n;
         let ws = &mut self.ws;
         let threshold = match self.threshold {
             Some(d) => d,
@@ -566,99 +600,126 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
                 ws.last[i] = [T::zero(); 2];
             }
         }
-        let act = ws.active.len();
-        let frictional = matches!(self.solver, Solver::Nsgs(_));
+        Ok(())
+    }
+
+    /// The complementarity problem of the active contacts, `w = W p + q`, solved into
+    /// `ws.p` (warm-started from the last step's impulses): rows `(n₁, t₁, n₂, t₂, …)` if
+    /// `frictional`, normal rows only otherwise.
+    fn solve_contacts(
+        &mut self,
+        k: usize,
+        ta: T,
+        tb: T,
+        q: &[T],
+        frictional: bool,
+    ) -> Result<LcpReport, TimeStepError> {
+        let act = self.ws.active.len();
         let d = if frictional { 2 * act } else { act };
-        // The problem's rows α: frictional (n₁, t₁, n₂, t₂, …) or normal rows only.
-        let row_of = |a: usize| if frictional { a } else { 2 * a };
-        let mut report = LcpReport {
-            iterations: 0,
-            residual: 0.0,
+        if act == 0 {
+            return Ok(LcpReport {
+                iterations: 0,
+                residual: 0.0,
+            });
+        }
+        self.delassus(d, frictional);
+        let ws = &mut self.ws;
+        ws.q.clear();
+        ws.p.clear();
+        ws.mu.clear();
+        for a in 0..d {
+            let c = if frictional { a / 2 } else { a };
+            let normal = !frictional || a % 2 == 0;
+            let i = ws.active[c];
+            let drift = self.contacts.drift(i, tb, q);
+            let mut s = if normal { drift[0] } else { drift[1] };
+            for &(j, x) in row(&ws.rows, &ws.offsets, row_index(a, frictional)) {
+                s += x * ws.vfree[j];
+            }
+            if normal {
+                s += self.contacts.restitution(i) * ws.pre[c][0];
+            }
+            ws.q.push(s);
+            ws.p.push(ws.last[i][if normal { 0 } else { 1 }]);
+        }
+        if frictional {
+            for c in 0..act {
+                ws.mu.push(self.contacts.friction(ws.active[c]));
+            }
+        }
+        let w = &ws.w[..d * d];
+        let result = match &mut self.solver {
+            Solver::Lemke(s) => s.solve(w, &ws.q, &mut ws.p),
+            Solver::Pgs(s) => s.solve(w, &ws.q, &mut ws.p),
+            Solver::Nsgs(s) => s.solve(w, &ws.q, &ws.mu, &mut ws.p),
         };
-        if act > 0 {
-            if ws.w.len() < d * d {
-                ws.w.resize(d * d, T::zero());
-            }
-            ws.q.clear();
-            ws.p.clear();
-            ws.mu.clear();
-            if !ws.diagonal && ws.dense.len() < d * n {
-                ws.dense.resize(d * n, T::zero());
-            }
-            // G_β = M⁻¹ r_βᵀ (dense, general mass matrices only).
-            if !ws.diagonal {
-                for b in 0..d {
-                    let (lo, hi) = (ws.offsets[row_of(b)], ws.offsets[row_of(b) + 1]);
-                    let g = &mut ws.dense[b * n..(b + 1) * n];
-                    g.iter_mut().for_each(|x| *x = T::zero());
-                    for &(j, x) in &ws.rows[lo..hi] {
-                        g[j] += x;
-                    }
+        result.map_err(|source| TimeStepError::Contact {
+            step: k,
+            t: to_f64(ta),
+            source,
+        })
+    }
+
+    /// The Delassus matrix `W = H M⁻¹ Hᵀ` of the `d` problem rows into `ws.w` (and, for a
+    /// general mass matrix, `G_β = M⁻¹ r_βᵀ` into `ws.dense`).
+    fn delassus(&mut self, d: usize, frictional: bool) {
+        let ws = &mut self.ws;
+        let n = ws.n;
+        if ws.w.len() < d * d {
+            ws.w.resize(d * d, T::zero());
+        }
+        if !ws.diagonal && ws.dense.len() < d * n {
+            ws.dense.resize(d * n, T::zero());
+        }
+        if !ws.diagonal {
+            for b in 0..d {
+                let rb = row_index(b, frictional);
+                let (lo, hi) = (ws.offsets[rb], ws.offsets[rb + 1]);
+                let g = &mut ws.dense[b * n..(b + 1) * n];
+                g.iter_mut().for_each(|x| *x = T::zero());
+                for &(j, x) in &ws.rows[lo..hi] {
+                    g[j] += x;
                 }
-                for b in 0..d {
-                    Self::solve_mass(
-                        false,
-                        &ws.inv_diag,
-                        &ws.chol,
-                        &mut ws.dense[b * n..(b + 1) * n],
-                    );
-                }
             }
-            for a in 0..d {
-                let ra = row(&ws.rows, &ws.offsets, row_of(a));
-                for b in 0..d {
-                    let mut s = T::zero();
-                    if ws.diagonal {
-                        let rb = row(&ws.rows, &ws.offsets, row_of(b));
-                        for &(i, x) in ra {
-                            for &(j, y) in rb {
-                                if i == j {
-                                    s += x * y * ws.inv_diag[i];
-                                }
+            for b in 0..d {
+                Self::solve_mass(
+                    false,
+                    &ws.inv_diag,
+                    &ws.chol,
+                    &mut ws.dense[b * n..(b + 1) * n],
+                );
+            }
+        }
+        for a in 0..d {
+            let ra = row(&ws.rows, &ws.offsets, row_index(a, frictional));
+            for b in 0..d {
+                let mut s = T::zero();
+                if ws.diagonal {
+                    let rb = row(&ws.rows, &ws.offsets, row_index(b, frictional));
+                    for &(i, x) in ra {
+                        for &(j, y) in rb {
+                            if i == j {
+                                s += x * y * ws.inv_diag[i];
                             }
                         }
-                    } else {
-                        let g = &ws.dense[b * n..(b + 1) * n];
-                        for &(i, x) in ra {
-                            s += x * g[i];
-                        }
                     }
-                    ws.w[a * d + b] = s;
+                } else {
+                    let g = &ws.dense[b * n..(b + 1) * n];
+                    for &(i, x) in ra {
+                        s += x * g[i];
+                    }
                 }
+                ws.w[a * d + b] = s;
             }
-            for a in 0..d {
-                let c = if frictional { a / 2 } else { a };
-                let normal = !frictional || a % 2 == 0;
-                let i = ws.active[c];
-                let drift = self.contacts.drift(i, tb, q);
-                let mut s = if normal { drift[0] } else { drift[1] };
-                for &(j, x) in row(&ws.rows, &ws.offsets, row_of(a)) {
-                    s += x * ws.vfree[j];
-                }
-                if normal {
-                    s += self.contacts.restitution(i) * ws.pre[c][0];
-                }
-                ws.q.push(s);
-                ws.p.push(ws.last[i][if normal { 0 } else { 1 }]);
-            }
-            if frictional {
-                for c in 0..act {
-                    ws.mu.push(self.contacts.friction(ws.active[c]));
-                }
-            }
-            let w = &ws.w[..d * d];
-            let result = match &mut self.solver {
-                Solver::Lemke(s) => s.solve(w, &ws.q, &mut ws.p),
-                Solver::Pgs(s) => s.solve(w, &ws.q, &mut ws.p),
-                Solver::Nsgs(s) => s.solve(w, &ws.q, &ws.mu, &mut ws.p),
-            };
-            report = result.map_err(|source| TimeStepError::Contact {
-                step: k,
-                t: to_f64(ta),
-                source,
-            })?;
         }
-        // v⁺ = v_free + M⁻¹ Σ p_α r_αᵀ.
+    }
+
+    /// `v⁺ = v_free + M⁻¹ Σ p_α r_αᵀ` into `ws.vnew`.
+    fn apply_impulses(&mut self, frictional: bool) {
+        let ws = &mut self.ws;
+        let n = ws.n;
+        let act = ws.active.len();
+        let d = if frictional { 2 * act } else { act };
         ws.vnew.copy_from_slice(&ws.vfree);
         for a in 0..d {
             let pa = ws.p[a];
@@ -666,7 +727,7 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
                 continue;
             }
             if ws.diagonal {
-                for &(j, x) in row(&ws.rows, &ws.offsets, row_of(a)) {
+                for &(j, x) in row(&ws.rows, &ws.offsets, row_index(a, frictional)) {
                     ws.vnew[j] += pa * x * ws.inv_diag[j];
                 }
             } else {
@@ -675,10 +736,14 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
                 }
             }
         }
-        Self::nonfinite(k, ta, "velocity", &ws.vnew)?;
-        // Records of the active contacts, and the warm start of the next step.
+    }
+
+    /// The records of the active contacts, the work of the impulses, and the warm start
+    /// of the next step.
+    fn record(&mut self, tb: T, q: &[T], frictional: bool) {
+        let ws = &mut self.ws;
         ws.work = T::zero();
-        for c in 0..act {
+        for c in 0..ws.active.len() {
             let i = ws.active[c];
             let (pn, pt) = if frictional {
                 (ws.p[2 * c], ws.p[2 * c + 1])
@@ -713,12 +778,5 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
                 tangent_impulse: pt,
             });
         }
-        // q⁺ = q + h ((1−θ) v + θ v⁺).
-        for i in 0..n {
-            q[i] += h * ((T::one() - theta) * v[i] + theta * ws.vnew[i]);
-        }
-        v.copy_from_slice(&ws.vnew);
-        Self::nonfinite(k, tb, "position", q)?;
-        Ok(report)
     }
 }
