@@ -56,6 +56,25 @@ pub enum TimeStepError {
         #[source]
         source: LcpError,
     },
+    /// The position projection did not bring every gap to `≥ −tolerance`.
+    #[error(
+        "step {step} (t = {t}): the position projection left contact {contact} at gap {gap:e} \
+         after {iterations} iterations (tolerance {tolerance:e})"
+    )]
+    Projection {
+        /// The step index.
+        step: usize,
+        /// The step's end time (where the positions are projected).
+        t: f64,
+        /// The most penetrated contact.
+        contact: usize,
+        /// Its gap.
+        gap: f64,
+        /// The projection's iterations.
+        iterations: usize,
+        /// The tolerance asked for.
+        tolerance: f64,
+    },
     /// A force, gap, Jacobian or the new state is not finite.
     #[error("step {step} (t = {t}): {what}[{index}] = {value} is not finite")]
     NonFinite {

@@ -31,8 +31,9 @@
 //!    $q_{k+1} = q_k + h\big((1-\theta)v_k + \theta v_{k+1}\big)$.
 //!
 //! The scheme is of order one; impacts land on the step grid (an impact time is known to
-//! `O(h)`), the gaps may become slightly negative (`O(h²)` per step, no drift correction),
-//! and accumulation points are passed in finitely many steps: once the impact velocity
+//! `O(h)`), the gaps may become slightly negative (`O(h²)` per step where a gap is
+//! nonlinear in `q`; [`MoreauJean::with_projection`] projects the positions back after every
+//! step), and accumulation points are passed in finitely many steps: once the impact velocity
 //! falls below about `g h`, the contact stays active and its impulse holds the body at rest.
 //!
 //! # What you get
