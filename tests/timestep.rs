@@ -1357,7 +1357,7 @@ fn position_projection_keeps_a_curved_contact_closed_and_converges_to_the_pendul
     let free = run(1e-3, None);
     let ball = nonsmooth::model::Mechanical::with_masses([1.0, 1.0]).unwrap();
     for bad in [0.0, -1e-9, f64::NAN, f64::INFINITY] {
-        let scheme = MoreauJean::new(ball.clone(), vec![Bowl { radius }], 1e-3).unwrap();
+        let scheme = MoreauJean::new(ball, vec![Bowl { radius }], 1e-3).unwrap();
         let err = scheme.with_projection(bad).unwrap_err().to_string();
         assert!(err.contains("projection tolerance"), "{err}");
     }
