@@ -9,6 +9,8 @@
 //! |---|---|---|---|---|
 //! | [`Dopri5`] | explicit, embedded 5(4), FSAL | 5 | 4th order (Hairer's continuous extension) | default |
 //! | [`Dop853`] | explicit, embedded 8(5,3) | 8 | 7th order | tight tolerances |
+//! | [`Tsit5`] | explicit, embedded 5(4), FSAL | 5 | 4th order (free) | alternative to DOPRI5 |
+//! | [`Vern6`] | explicit, embedded 6(5), FSAL | 6 | 6th order (3 extra stages) | tight tolerances on smooth flows |
 //! | [`Rk4`] | explicit, fixed step | 4 | cubic Hermite (3rd order) | reference, tests |
 //! | [`Rosenbrock23`] | linearly implicit, embedded 2(3), FSAL | 2 | quadratic (the method's own) | stiff phases |
 //!
@@ -25,18 +27,24 @@
 mod adaptive;
 mod dop853;
 pub(crate) mod dopri5;
+mod erk;
 mod rk4;
 mod rosenbrock;
+mod tsit5;
 pub mod turning;
+mod vern6;
 
 pub use adaptive::{Adaptive, Interpolant, Method, MethodDense};
 pub use dop853::{Dop853, Dop853Dense, Dop853Interpolant, Dop853Method};
 pub use dopri5::{Dopri5, Dopri5Dense, Dopri5Interpolant, Dopri5Method};
+pub use erk::{ExplicitTableau, PowerInterpolant};
 pub use rk4::{HermiteDense, Rk4};
 pub use rosenbrock::{
     Rosenbrock23, Rosenbrock23Dense, Rosenbrock23Interpolant, Rosenbrock23Method,
 };
+pub use tsit5::{Tsit5, Tsit5Dense, Tsit5Interpolant, Tsit5Method};
 pub use turning::{SegmentCounts, TurningDense, TurningPoints};
+pub use vern6::{Vern6, Vern6Dense, Vern6Interpolant, Vern6Method};
 
 use nalgebra::SVector;
 use thiserror::Error;
