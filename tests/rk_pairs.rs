@@ -98,7 +98,10 @@ fn residuals(tab: &ExplicitTableau, b: &[f64], b_abs: &[f64], theta: f64, max: u
     let ts = trees(max);
     let gamma = densities(&ts);
     let a = tab.matrix();
-    let abs: Vec<Vec<f64>> = a.iter().map(|r| r.iter().map(|x| x.abs()).collect()).collect();
+    let abs: Vec<Vec<f64>> = a
+        .iter()
+        .map(|r| r.iter().map(|x| x.abs()).collect())
+        .collect();
     let phi = stage_weights(&ts, &a);
     let phi_abs = stage_weights(&ts, &abs);
     let mut worst = vec![0.0f64; max];
@@ -314,7 +317,12 @@ fn resolved_order(hs: &[f64], errs: &[f64]) -> f64 {
         .filter(|(_, e)| **e > RESOLVED)
         .map(|(h, e)| (*h, *e))
         .unzip();
-    assert!(h.len() >= 3, "only {} resolved levels: {}", h.len(), sci(errs));
+    assert!(
+        h.len() >= 3,
+        "only {} resolved levels: {}",
+        h.len(),
+        sci(errs)
+    );
     convergence_order(&h, &e).unwrap()
 }
 
@@ -327,12 +335,15 @@ enum Expect {
     /// coefficients of Vern6, so the next terms dominate while the errors stand above
     /// rounding (measured: see the tests).
     AtLeast(f64),
+    /// Measured by another call (over other steps).
+    Elsewhere(f64),
 }
 
 fn check_order(name: &str, got: f64, want: Expect) {
     let ok = match want {
         Expect::Exact(p) => (got - p).abs() < 0.15,
         Expect::AtLeast(p) => got > p - 0.15 && got < p + 2.5,
+        Expect::Elsewhere(_) => true,
     };
     assert!(ok, "{name}: order {got:.3}, expected {want:?}");
 }
@@ -355,8 +366,14 @@ fn global_error_orders() {
     check_order("Tsit5 coupled", p, Expect::AtLeast(5.0));
     let ns = [4, 8, 16, 32, 64];
     for (name, p) in [
-        ("forced", observed_global_order::<Vern6Method, _>(&Forced, &ns)),
-        ("coupled", observed_global_order::<Vern6Method, _>(&Coupled, &ns)),
+        (
+            "forced",
+            observed_global_order::<Vern6Method, _>(&Forced, &ns),
+        ),
+        (
+            "coupled",
+            observed_global_order::<Vern6Method, _>(&Coupled, &ns),
+        ),
     ] {
         println!("Vern6 global order ({name}) {p:.3}");
         check_order(name, p, Expect::AtLeast(6.0));
@@ -455,13 +472,20 @@ fn local_orders<M: Method<f64, 2>, P: Problem>(
         sci(&estimate),
         sci(&dense)
     );
-    let p = resolved_order(hs, &local);
-    let pe = resolved_order(hs, &estimate);
-    let pd = resolved_order(hs, &dense);
-    println!("{name}: local order {p:.3}, estimate {pe:.3}, dense {pd:.3}");
-    check_order(name, p, expect[0](f64::from(tab.order + 1)));
-    check_order(name, pe, expect[1](f64::from(tab.embedded_order + 1)));
-    check_order(name, pd, expect[2](f64::from(tab.dense_order + 1)));
+    let orders = [
+        (&local, tab.order + 1, "local"),
+        (&estimate, tab.embedded_order + 1, "estimate"),
+        (&dense, tab.dense_order + 1, "dense"),
+    ];
+    for ((errs, p, what), expect) in orders.into_iter().zip(expect) {
+        let want = expect(f64::from(p));
+        if let Expect::Elsewhere(_) = want {
+            continue;
+        }
+        let got = resolved_order(hs, errs);
+        println!("{name}: {what} order {got:.3}");
+        check_order(&format!("{name} {what}"), got, want);
+    }
 }
 
 #[test]
@@ -500,7 +524,16 @@ fn vern6_local_estimate_and_dense_orders() {
         &Vern6Method::TABLEAU,
         "Vern6",
         &[0.4, 0.2, 0.1, 0.05, 0.025],
-        [Expect::AtLeast; 3],
+        [Expect::AtLeast, Expect::Elsewhere, Expect::AtLeast],
+    );
+    // The estimate is not asymptotic at h = 0.4 (slopes 4.6, 5.7, 5.94, 5.95 from h = 0.4
+    // down): measured from h = 0.2.
+    local_orders::<Vern6Method, _>(
+        &Coupled,
+        &Vern6Method::TABLEAU,
+        "Vern6 (estimate)",
+        &[0.2, 0.1, 0.05, 0.025, 0.0125],
+        [Expect::Elsewhere, Expect::Exact, Expect::Elsewhere],
     );
 }
 
@@ -566,7 +599,11 @@ fn f32_runs() {
         b.step(&Decay, 2.0).unwrap();
     }
     let e = (-2.0f32).exp();
-    println!("f32: Tsit5 {:e}, Vern6 {:e}", a.current().1[0] - e, b.current().1[0] - e);
+    println!(
+        "f32: Tsit5 {:e}, Vern6 {:e}",
+        a.current().1[0] - e,
+        b.current().1[0] - e
+    );
     assert!((a.current().1[0] - e).abs() < 1e-5);
     // Vern6's weights b₆ ≈ −176, b₇ ≈ 172 amplify f32 rounding (ε = 1.2·10⁻⁷) about
     // 10²-fold: measured −1.14·10⁻⁵ at rtol 10⁻⁵.
