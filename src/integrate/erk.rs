@@ -125,82 +125,138 @@ impl<T: Real, const N: usize, const D: usize> Interpolant<T, N> for PowerInterpo
     }
 }
 
-/// `y₀ + h·Σ_j a_j k_j` over a sparse row.
+/// A pair's coefficients as dense constant arrays over its `K` stages (the extension's
+/// included) and the `D` powers of its extension, derived at compile time from its
+/// [`ExplicitTableau`]: the step's loops then run over constants the compiler unrolls, and
+/// the zero entries drop out.
+pub(crate) trait Pair<const K: usize, const D: usize> {
+    /// The tableau.
+    const TABLEAU: ExplicitTableau;
+    /// `A`, dense.
+    const A: [[f64; K]; K] = dense_rows(Self::TABLEAU.a);
+    /// `b̂ − b`, dense.
+    const E: [f64; K] = dense_row(Self::TABLEAU.error);
+    /// `r_jm`, dense (`R[j][m − 1]`).
+    const R: [[f64; D]; K] = dense_poly(Self::TABLEAU.dense);
+}
+
+const fn dense_row<const K: usize>(row: &[(usize, f64)]) -> [f64; K] {
+    let mut out = [0.0; K];
+    let mut n = 0;
+    while n < row.len() {
+        out[row[n].0] = row[n].1;
+        n += 1;
+    }
+    out
+}
+
+const fn dense_rows<const K: usize>(rows: &[&[(usize, f64)]]) -> [[f64; K]; K] {
+    let mut out = [[0.0; K]; K];
+    let mut i = 0;
+    while i < rows.len() {
+        out[i] = dense_row(rows[i]);
+        i += 1;
+    }
+    out
+}
+
+const fn dense_poly<const K: usize, const D: usize>(rows: &[(usize, &[f64])]) -> [[f64; D]; K] {
+    let mut out = [[0.0; D]; K];
+    let mut n = 0;
+    while n < rows.len() {
+        let (j, r) = rows[n];
+        let mut m = 0;
+        while m < r.len() {
+            out[j][m] = r[m];
+            m += 1;
+        }
+        n += 1;
+    }
+    out
+}
+
+/// `y₀ + h·Σ_j a_j k_j` over the first `upto` stages of a constant row.
 #[inline(always)]
 fn combine<T: Real, const N: usize, const K: usize>(
     y: &SVector<T, N>,
-    row: &[(usize, f64)],
+    row: &[f64; K],
+    upto: usize,
     k: &[SVector<T, N>; K],
     h: T,
 ) -> SVector<T, N> {
     let mut acc = SVector::<T, N>::zeros();
-    for &(j, a) in row {
-        acc += k[j] * lit::<T>(a);
+    for j in 0..upto {
+        if row[j] != 0.0 {
+            acc += k[j] * lit::<T>(row[j]);
+        }
     }
     y + acc * h
 }
 
-/// One accepted step of the pair `tab` (`K` = all its stages, `D` = the degree of its
+/// One accepted step of the pair `P` (`K` = all its stages, `D` = the degree of its
 /// extension): the retry loop of [`Core::adapt`](super::Core::adapt) around the trial
 /// stages, then the extension's stages and coefficients.
 #[inline(always)]
-pub(crate) fn advance<T: Real, const N: usize, const K: usize, const D: usize, S>(
-    tab: &ExplicitTableau,
+pub(crate) fn advance<T: Real, const N: usize, const K: usize, const D: usize, P, S>(
     parts: StepParts<'_, T, N>,
     dense: &mut MethodDense<T, N, PowerInterpolant<T, N, D>>,
     sys: &S,
     t_limit: T,
 ) -> Result<(), IntegrateError>
 where
+    P: Pair<K, D>,
     S: Dynamics<T, N>,
 {
-    debug_assert!(tab.c.len() == K && tab.a.len() == K && tab.stages <= K);
+    let stages = P::TABLEAU.stages;
+    let c = P::TABLEAU.c;
     let StepParts { tol, ctrl, core } = parts;
     core.begin(sys, t_limit)?;
     let (t, y) = (core.t, core.y);
-    let h = core.proposed(sys, tab.order, tol, ctrl.opts.h_max, t_limit);
-    let last = tab.stages - 1;
+    let h = core.proposed(sys, P::TABLEAU.order, tol, ctrl.opts.h_max, t_limit);
+    let last = stages - 1;
     let mut k = [SVector::<T, N>::zeros(); K];
     k[0] = core.f;
-    let at = |c: f64, hs: T, t_new: T| {
-        if c == 1.0 {
-            t_new
-        } else {
-            t + lit::<T>(c) * hs
-        }
-    };
     let a = core.adapt(ctrl, t_limit, h, |stats, hs, t_new| {
         for i in 1..last {
-            let yt = combine(&y, tab.a[i], &k, hs);
+            let yt = combine(&y, &P::A[i], i, &k, hs);
+            let ti = if c[i] == 1.0 {
+                t_new
+            } else {
+                t + lit::<T>(c[i]) * hs
+            };
             let mut out = SVector::zeros();
-            sys.rhs(at(tab.c[i], hs, t_new), &yt, &mut out);
+            sys.rhs(ti, &yt, &mut out);
             k[i] = out;
         }
-        let y_new = combine(&y, tab.a[last], &k, hs);
+        let y_new = combine(&y, &P::A[last], last, &k, hs);
         let mut f_new = SVector::zeros();
         sys.rhs(t_new, &y_new, &mut f_new);
         k[last] = f_new;
         stats.rhs_evals += last as u64;
         Ok(Trial::new(y_new, f_new, || {
             let mut e = SVector::<T, N>::zeros();
-            for &(j, w) in tab.error {
-                e += k[j] * lit::<T>(w);
+            for j in 0..stages {
+                if P::E[j] != 0.0 {
+                    e += k[j] * lit::<T>(P::E[j]);
+                }
             }
             tol.error_norm(&(e * hs), &y, &y_new)
         }))
     })?;
     let hs = a.hs;
-    for i in tab.stages..K {
-        let yt = combine(&y, tab.a[i], &k, hs);
+    for i in stages..K {
+        let yt = combine(&y, &P::A[i], i, &k, hs);
         let mut out = SVector::zeros();
-        sys.rhs(t + lit::<T>(tab.c[i]) * hs, &yt, &mut out);
+        sys.rhs(t + lit::<T>(c[i]) * hs, &yt, &mut out);
         k[i] = out;
     }
-    core.stats.rhs_evals += (K - tab.stages) as u64;
+    core.stats.rhs_evals += (K - stages) as u64;
     let mut q = [SVector::<T, N>::zeros(); D];
-    for &(j, r) in tab.dense {
-        for (qm, &rm) in q.iter_mut().zip(r) {
-            *qm += k[j] * lit::<T>(rm);
+    for (kj, rj) in k.iter().zip(&P::R) {
+        for (qm, &rm) in q.iter_mut().zip(rj) {
+            if rm != 0.0 {
+                *qm += kj * lit::<T>(rm);
+            }
         }
     }
     // The coefficients are rounded and cancel (up to 10⁵ in magnitude for Vern6): put the

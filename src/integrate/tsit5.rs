@@ -5,7 +5,7 @@
 
 use super::IntegrateError;
 use super::adaptive::{Adaptive, Method, MethodDense, StepParts, sealed};
-use super::erk::{self, ExplicitTableau, PowerInterpolant};
+use super::erk::{self, ExplicitTableau, Pair, PowerInterpolant};
 use crate::{Dynamics, Real};
 
 /// The explicit Runge–Kutta pair of Tsitouras (2011), order 5 with an embedded order-4
@@ -131,6 +131,10 @@ impl Tsit5Method {
 
 impl sealed::Sealed for Tsit5Method {}
 
+impl Pair<7, 4> for Tsit5Method {
+    const TABLEAU: ExplicitTableau = Self::TABLEAU;
+}
+
 impl<T: Real, const N: usize> Method<T, N> for Tsit5Method {
     const ORDER: u8 = 5;
     const ERROR_ORDER: f64 = 5.0;
@@ -142,6 +146,6 @@ impl<T: Real, const N: usize> Method<T, N> for Tsit5Method {
         sys: &S,
         t_limit: T,
     ) -> Result<(), IntegrateError> {
-        erk::advance::<T, N, 7, 4, S>(&Self::TABLEAU, parts, dense, sys, t_limit)
+        erk::advance::<T, N, 7, 4, Self, S>(parts, dense, sys, t_limit)
     }
 }

@@ -5,7 +5,7 @@
 
 use super::IntegrateError;
 use super::adaptive::{Adaptive, Method, MethodDense, StepParts, sealed};
-use super::erk::{self, ExplicitTableau, PowerInterpolant};
+use super::erk::{self, ExplicitTableau, Pair, PowerInterpolant};
 use crate::{Dynamics, Real};
 
 /// Verner's "most efficient" explicit Runge–Kutta pair of order 6 with an embedded order-5
@@ -261,6 +261,10 @@ impl Vern6Method {
 
 impl sealed::Sealed for Vern6Method {}
 
+impl Pair<12, 6> for Vern6Method {
+    const TABLEAU: ExplicitTableau = Self::TABLEAU;
+}
+
 impl<T: Real, const N: usize> Method<T, N> for Vern6Method {
     const ORDER: u8 = 6;
     const ERROR_ORDER: f64 = 6.0;
@@ -272,6 +276,6 @@ impl<T: Real, const N: usize> Method<T, N> for Vern6Method {
         sys: &S,
         t_limit: T,
     ) -> Result<(), IntegrateError> {
-        erk::advance::<T, N, 12, 6, S>(&Self::TABLEAU, parts, dense, sys, t_limit)
+        erk::advance::<T, N, 12, 6, Self, S>(parts, dense, sys, t_limit)
     }
 }
