@@ -235,9 +235,9 @@ where
         stats.rhs_evals += last as u64;
         Ok(Trial::new(y_new, f_new, || {
             let mut e = SVector::<T, N>::zeros();
-            for j in 0..stages {
-                if P::E[j] != 0.0 {
-                    e += k[j] * lit::<T>(P::E[j]);
+            for (kj, &w) in k.iter().zip(&P::E) {
+                if w != 0.0 {
+                    e += kj * lit::<T>(w);
                 }
             }
             tol.error_norm(&(e * hs), &y, &y_new)

@@ -27,6 +27,14 @@ use crate::{Dynamics, Real};
 /// `Σ_j b_j(θ) = θ`; stage 0 enters no other order condition (`c₀ = 0`). They differ from
 /// the rounded rationals by at most `7·10⁻¹⁴` (the stages') and `4·10⁻¹²` (the extension's).
 ///
+/// # Rounding of the stage times
+/// The nodes `c₆ = 0.9995` and `c₇ = c₈ = 1` carry weights `b₆ ≈ −176`, `b₇ ≈ 172` (and
+/// error weights ≈ ±100): the rounding of a stage time `t + c_i h` to the spacing of `t`
+/// enters the step as `h·Σ_i b_i ∂_t f·δt_i`, with `(Σ b_i²)^{1/2} ≈ 250` where DOPRI5 has
+/// about 1. On a forced system run to large `t` at a tight tolerance this term, and the same
+/// noise in the error estimate, can exceed the tolerance (rejected steps accumulate); keep
+/// `t` small (restart the clock each period) or use [`Dop853`](super::Dop853) there.
+///
 /// # References
 /// J. H. Verner, *Numerically optimal Runge–Kutta pairs with interpolants*, Numer.
 /// Algorithms 53 (2010) 383–396; the coefficients as published on Verner's web page and
