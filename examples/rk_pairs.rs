@@ -26,22 +26,28 @@
 //! the comparison at equal error: the second table of each mode interpolates each
 //! method's evaluations and time (log–log between its rows) at DOPRI5's error.
 //!
-//! # Measured (one run, 2 shared cores, 3 turns; the ratios at equal accuracy)
-//! - **W2, plain**: Tsit5 needs 1.17 / 1.10 / 0.96 the evaluations of DOPRI5 at DOPRI5's
-//!   error for rtol 1e-8 / 1e-10 / 1e-12 (CPU 1.34 / 1.30 / 0.98), Vern6 1.40 / 1.23 / 1.36
-//!   (CPU 1.48 / 1.39 / 1.14), DOP853 2.02 / 1.58 / 1.10 (CPU 1.88 / 1.62 / 1.03).
-//! - **W2, turning points**: Tsit5 0.91 / 0.92 / 1.01 (CPU 0.96 / 1.02 / 1.03), Vern6
-//!   1.31 / 1.13 / 1.23 (CPU 1.21 / 1.29 / 1.11), DOP853 1.57 / 1.22 / 0.91 (CPU 1.20 /
-//!   1.23 / 0.99). At equal *rtol* 1e-12 DOP853 with turning points takes 0.79× the
-//!   evaluations and 0.81× the time of DOPRI5 with them, at 3.4× its error. No pair wins
-//!   the paper's workload: the steps there are bounded by the contact onsets and exits and
-//!   the reversals, not by the smooth flow between them.
-//! - **Duffing–Ueda** (smooth): DOP853 0.49 / 0.39 / 0.28 (CPU 0.36 / 0.46 / 0.37), Vern6
-//!   0.71 / 0.59 / 1.53 (CPU 0.72 / 0.62 / 1.66), Tsit5 0.85 / 0.84 / 0.82 (CPU 1.04 / 1.07
-//!   / 0.95: its steps cost more per evaluation than the hand-written DOPRI5). Vern6 at
-//!   1e-12 rejects 10 % of its steps over 2000 periods (192 708, against 1 481 over the
-//!   first 200 in the `--quick` run): the rounding of the stage times to the spacing of
-//!   `t ≈ 10⁴`, multiplied by its large weights (see [`Vern6`]).
+//! # Measured (two runs on 2 shared cores, 3 turns each, at commit 59aaa33)
+//! The evaluation counts are deterministic; the CPU ratios moved by up to ±20 % between the
+//! two runs (both given). Ratios to DOPRI5 at DOPRI5's error, for rtol 1e-8 / 1e-10 / 1e-12:
+//! - **W2, plain**: Tsit5 1.17 / 1.10 / 0.96 the evaluations (CPU 1.25–1.34 / 1.12–1.30 /
+//!   0.98–1.18), Vern6 1.40 / 1.23 / 1.36 (CPU 1.41–1.48 / 1.18–1.39 / 1.14–1.47), DOP853
+//!   2.02 / 1.58 / 1.10 (CPU 1.77–1.88 / 1.49–1.62 / 1.03–1.18).
+//! - **W2, turning points**: Tsit5 0.91 / 0.92 / 1.01 (CPU 0.96 / 1.02–1.18 / 1.01–1.03),
+//!   Vern6 1.31 / 1.13 / 1.23 (CPU 1.21–1.56 / 1.29–1.31 / 1.07–1.11), DOP853 1.57 / 1.22 /
+//!   0.91 (CPU 1.20–1.68 / 1.23–1.32 / 0.79–0.99). At equal *rtol* 1e-12, DOP853 with
+//!   turning points takes 0.79× the evaluations and 0.70–0.81× the time of DOPRI5 with
+//!   them, at 3.4× its error. No new pair wins the paper's workload: its steps are bounded
+//!   by the contact onsets and exits and the reversals, not by the smooth flow between them.
+//! - **Duffing–Ueda** (smooth): DOP853 0.49 / 0.39 / 0.28 (CPU 0.36–0.73 / 0.44–0.46 /
+//!   0.34–0.37), Vern6 0.71 / 0.59 / 1.53 (CPU 0.72–0.97 / 0.62–0.65 / 1.66–1.73), Tsit5
+//!   0.85 / 0.84 / 0.82 (CPU 1.04–1.15 / 1.02–1.07 / 0.95–1.05: its step costs more per
+//!   evaluation than the hand-written DOPRI5 on this cheap right-hand side). Vern6 at
+//!   1e-12 rejects 10 % of its steps over 2000 periods (192 708): the rounding of the stage
+//!   times to the spacing of `t` (up to `1.3·10⁴` here), multiplied by its large weights
+//!   (see [`Vern6`]). The last table runs the same 200 periods with the clock started at
+//!   `t₀ = 0`, `1.2·10⁴` and `1.2·10⁵`: Vern6 takes 91 750 / 271 717 / 1 955 997 accepted
+//!   and 1 481 / 35 049 / 277 096 rejected steps, DOPRI5 214 178 / 212 252 / 214 008 and
+//!   23 / 26 / 32.
 //!
 //! [`Vern6`]: nonsmooth::integrate::Vern6
 //!
@@ -466,5 +472,25 @@ fn main() -> nonsmooth::Result<()> {
         .collect();
     let acc = Accuracy::new(&ueda, starts, 3)?;
     table(&ueda, ueda_periods, &[false], reps, &acc)?;
+    clock_rounding(&ueda)
+}
+
+/// The same 200 Duffing–Ueda periods from `(3, 0)` at rtol 1e-12, starting the clock at
+/// `t₀ = 0`, `2π·1900` and `2π·19000` (the forcing is the same): Vern6's steps against the
+/// size of `t`, DOPRI5's for reference.
+fn clock_rounding(w: &Ueda) -> nonsmooth::Result<()> {
+    println!("\n### Duffing–Ueda, 200 periods at rtol 1e-12 from (3, 0), by the clock's start\n");
+    println!("| t0 | Vern6 accepted | Vern6 rejected | DOPRI5 accepted | DOPRI5 rejected |");
+    println!("|---|---|---|---|---|");
+    let tol = w.tolerances(1e-12)?;
+    for k0 in [0.0, 1900.0, 19000.0] {
+        let start = (k0 * w.period(), w.start().1);
+        let a = simulate(w, start, plain::<Vern6Method>(tol), 200)?.stats;
+        let b = simulate(w, start, plain::<Dopri5Method>(tol), 200)?.stats;
+        println!(
+            "| {:.0} | {} | {} | {} | {} |",
+            start.0, a.accepted, a.rejected, b.accepted, b.rejected
+        );
+    }
     Ok(())
 }
