@@ -16,6 +16,10 @@
 //!   estimated as (attempts of time stepping alone − attempts of the time stepper outside
 //!   the segments) / segments.
 //!
+//! - `rk_pairs_w2_100`: `w2_100` at rtol 1e-10 and 1e-12 with DOPRI5, Tsit5, Vern6 and
+//!   DOP853, each plain and with `TurningPoints` over it (the same method in time and in
+//!   the segments), the configurations `examples/rk_pairs.rs` compares.
+//!
 //! Time per period = reported time / 100.
 
 use criterion::{Criterion, criterion_group, criterion_main};
@@ -23,7 +27,10 @@ use nalgebra::Vector2;
 use nonsmooth::Dynamics;
 use nonsmooth::drive::Simulation;
 use nonsmooth::event::{Direction, Event, Level};
-use nonsmooth::integrate::{Dop853, Dopri5, Stepper, Tolerances, TurningPoints};
+use nonsmooth::integrate::{
+    Adaptive, Dop853, Dop853Method, Dopri5, Dopri5Method, Method, Stepper, Tolerances, Tsit5Method,
+    TurningPoints, Vern6Method,
+};
 use nonsmooth::sample::{ImpactSequence, Stroboscopic};
 use nonsmooth::systems::paper::PAPER;
 use std::hint::black_box;
@@ -43,6 +50,38 @@ fn run<St: Stepper<f64, 2>>(st: St, y0: Vector2<f64>, periods: u32) -> (usize, V
 
 fn turning(rtol: f64) -> TurningPoints<f64, Dopri5<f64, 2>, Dopri5<f64, 2>> {
     TurningPoints::dopri5(tol(rtol), 3e-3).unwrap()
+}
+
+/// Turning points with method `M` in time and in the segments.
+type Turning<M> = TurningPoints<f64, Adaptive<f64, 2, M>, Adaptive<f64, 2, M>>;
+
+/// `TurningPoints` with method `M` in time and in the segments (the segment tolerances of
+/// `TurningPoints::dopri5`).
+fn turning_with<M: Method<f64, 2>>(rtol: f64) -> Turning<M> {
+    let segment = Tolerances::per_component(rtol, [100.0 * rtol, rtol * 1e-4]).unwrap();
+    TurningPoints::new(Adaptive::new(tol(rtol)), Adaptive::new(segment), 3e-3).unwrap()
+}
+
+/// The plain and turning-point runs of method `M` in group `g`.
+fn bench_pair<M: Method<f64, 2>>(
+    g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    name: &str,
+    on_attractor: Vector2<f64>,
+) {
+    for rtol in [1e-10, 1e-12] {
+        g.bench_function(format!("plain/{name}/{rtol:e}"), |b| {
+            b.iter(|| {
+                black_box(run(
+                    Adaptive::<f64, 2, M>::new(tol(rtol)),
+                    on_attractor,
+                    100,
+                ))
+            })
+        });
+        g.bench_function(format!("turning/{name}/{rtol:e}"), |b| {
+            b.iter(|| black_box(run(turning_with::<M>(rtol), on_attractor, 100)))
+        });
+    }
 }
 
 /// Attempts per period and per switching point, time stepping alone against segments.
@@ -159,6 +198,13 @@ fn bench(c: &mut Criterion) {
             b.iter(|| black_box(run(turning(rtol), on_attractor, 100)))
         });
     }
+    g.finish();
+    let mut g = c.benchmark_group("rk_pairs_w2_100");
+    g.sample_size(10);
+    bench_pair::<Dopri5Method>(&mut g, "dopri5", on_attractor);
+    bench_pair::<Tsit5Method>(&mut g, "tsit5", on_attractor);
+    bench_pair::<Vern6Method>(&mut g, "vern6", on_attractor);
+    bench_pair::<Dop853Method>(&mut g, "dop853", on_attractor);
     g.finish();
 }
 

@@ -25,18 +25,24 @@
 mod adaptive;
 mod dop853;
 pub(crate) mod dopri5;
+mod erk;
 mod rk4;
 mod rosenbrock;
+mod tsit5;
 pub mod turning;
+mod vern6;
 
 pub use adaptive::{Adaptive, Interpolant, Method, MethodDense};
 pub use dop853::{Dop853, Dop853Dense, Dop853Interpolant, Dop853Method};
 pub use dopri5::{Dopri5, Dopri5Dense, Dopri5Interpolant, Dopri5Method};
+pub use erk::{ExplicitTableau, PowerInterpolant};
 pub use rk4::{HermiteDense, Rk4};
 pub use rosenbrock::{
     Rosenbrock23, Rosenbrock23Dense, Rosenbrock23Interpolant, Rosenbrock23Method,
 };
+pub use tsit5::{Tsit5, Tsit5Dense, Tsit5Interpolant, Tsit5Method};
 pub use turning::{SegmentCounts, TurningDense, TurningPoints};
+pub use vern6::{Vern6, Vern6Dense, Vern6Interpolant, Vern6Method};
 
 use nalgebra::SVector;
 use thiserror::Error;
