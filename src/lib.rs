@@ -13,7 +13,7 @@
 //! | models | `ẏ = f(t, y)`; N-DOF systems from elements, the 1-DOF oscillator | [`Dynamics`], [`model::Mechanical`], [`model::Oscillator`] |
 //! | catalogue | ready systems: the paper's cart, Duffing–Ueda, a 2-DOF impact oscillator | [`systems`] |
 //! | utilities | Brent's root bracketing, golden-section search, the fast `sin`/`cos` of the forcing | [`util`] |
-//! | integrators | DOPRI5, DOP853, Rosenbrock 2(3) on one adaptive stepper, RK4, turning points; dense output | [`integrate`] |
+//! | integrators | DOPRI5, DOP853, Tsitouras 5(4), Verner 6(5), Rosenbrock 2(3) on one adaptive stepper, RK4, turning points; dense output | [`integrate`] |
 //! | events | crossings located on dense output, grazing pairs, resets, Zeno guard | [`event`] |
 //! | driver | system + stepper + events + observers | [`drive`] |
 //! | sliding | Filippov systems: crossing and sliding on switching surfaces, saltation, monodromy, orbits | [`filippov`] |

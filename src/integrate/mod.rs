@@ -9,6 +9,8 @@
 //! |---|---|---|---|---|
 //! | [`Dopri5`] | explicit, embedded 5(4), FSAL | 5 | 4th order (Hairer's continuous extension) | default |
 //! | [`Dop853`] | explicit, embedded 8(5,3) | 8 | 7th order | tight tolerances |
+//! | [`Tsit5`] | explicit, embedded 5(4), FSAL | 5 | 4th order (free) | alternative to DOPRI5 |
+//! | [`Vern6`] | explicit, embedded 6(5), FSAL | 6 | 6th order (3 extra stages) | smooth flows, moderate t |
 //! | [`Rk4`] | explicit, fixed step | 4 | cubic Hermite (3rd order) | reference, tests |
 //! | [`Rosenbrock23`] | linearly implicit, embedded 2(3), FSAL | 2 | quadratic (the method's own) | stiff phases |
 //!
