@@ -1098,22 +1098,37 @@ impl StepObserver<f64> for Jumps {
     }
 }
 
+/// Siconos' `Woodpecker.ref` (θ = ½, h = 2e-5): the rows (= steps done) where ω_S or ω_B
+/// jump, and the contact that acts (0 beak, 1 and 2 the sleeve's edges).
+const WOODPECKER_IMPACTS: [(usize, usize); 8] = [
+    (3896, 2),
+    (4052, 0),
+    (4081, 2),
+    (5941, 1),
+    (11200, 2),
+    (11355, 0),
+    (11384, 2),
+    (13241, 1),
+];
+
+/// The last row of `Woodpecker.ref` (row 14999, t = 0.29998): `y, ẏ, φ_S, ω_S, φ_B, ω_B`.
+#[allow(clippy::excessive_precision)] // transcribed digit for digit
+const WOODPECKER_LAST_ROW: [f64; 6] = [
+    -4.134818676833654e-02,
+    -2.601373307913771e-01,
+    -1.034684682717361e-01,
+    -2.220446049250313e-16,
+    -3.409339755504301e-01,
+    -8.327555353239312e+00,
+];
+
 #[test]
 fn woodpecker_impacts_match_siconos_reference() {
     // Siconos' `Woodpecker.ref` (θ = ½, h = 2e-5, 0 ≤ t ≤ 0.3): the rows (= steps done) where
     // ω_S or ω_B jump as above, and the contact that acts (0 beak, 1 and 2 the sleeve's
     // edges g₂ = r_S − r_0 + h_S φ_S, g₃ = r_S − r_0 − h_S φ_S); the cycle from one beak
     // impact to the next is beak, g₃, g₂, g₃ and lasts 0.14606 s in the file.
-    let reference = [
-        (3896, 2),
-        (4052, 0),
-        (4081, 2),
-        (5941, 1),
-        (11200, 2),
-        (11355, 0),
-        (11384, 2),
-        (13241, 1),
-    ];
+    let reference = WOODPECKER_IMPACTS;
     let mut scheme = MoreauJean::new(Woodpecker, Woodpecker::contacts().unwrap(), 2e-5).unwrap();
     let (mut q, mut v) = (Woodpecker::Q0, Woodpecker::V0);
     let mut jumps = Jumps {
@@ -1137,15 +1152,7 @@ fn woodpecker_impacts_match_siconos_reference() {
     // Last row of the file (row 14999, t = 0.29998): `y, ẏ, φ_S, ω_S, φ_B, ω_B`, compared at
     // 1e-3 of each coordinate's scale (the spring's implicit/explicit treatment again;
     // measured: 3.7e-4 here, 4e-5 and 6e-5 at t = 0.1 and 0.2 in the example).
-    #[allow(clippy::excessive_precision)] // transcribed digit for digit
-    let last = [
-        -4.134818676833654e-02,
-        -2.601373307913771e-01,
-        -1.034684682717361e-01,
-        -2.220446049250313e-16,
-        -3.409339755504301e-01,
-        -8.327555353239312e+00,
-    ];
+    let last = WOODPECKER_LAST_ROW;
     let scale = [1e-2, 0.3, 0.1, 10.0, 0.3, 10.0];
     let kept = jumps.kept.unwrap();
     let worst = (0..6).fold(0.0_f64, |a, i| a.max((kept[i] - last[i]).abs() / scale[i]));
@@ -1386,4 +1393,66 @@ fn position_projection_keeps_a_curved_contact_closed_and_converges_to_the_pendul
     // Measured: 3.7e-4, 1.8e-4, 8.9e-5, 4.4e-5 (order 1.01), the scheme's first order.
     assert!(errors[3] < 6e-5, "{errors:?}");
     assert!((0.9..1.15).contains(&order), "order {order}: {errors:?}");
+}
+
+#[test]
+fn implicit_forces_match_siconos_woodpecker_and_keep_a_stiff_spring_stable() {
+    // The woodpecker with its spring taken implicitly, as Siconos' MoreauJeanOSI does for a
+    // linear time-invariant system: against the last row of `Woodpecker.ref`
+    // (t = 0.29998; see `woodpecker_impacts_match_siconos_reference`).
+    let mut scheme = MoreauJean::new(Woodpecker, Woodpecker::contacts().unwrap(), 2e-5)
+        .unwrap()
+        .with_implicit_forces()
+        .unwrap();
+    let (mut q, mut v) = (Woodpecker::Q0, Woodpecker::V0);
+    let mut jumps = Jumps {
+        keep_at: 14999,
+        ..Jumps::default()
+    };
+    scheme.run(0.0, &mut q, &mut v, 0.3, &mut jumps).unwrap();
+    let last = WOODPECKER_LAST_ROW;
+    let scale = [1e-2, 0.3, 0.1, 10.0, 0.3, 10.0];
+    let kept = jumps.kept.unwrap();
+    let worst = (0..6).fold(0.0_f64, |a, i| a.max((kept[i] - last[i]).abs() / scale[i]));
+    println!("woodpecker, implicit spring, at t = 0.29998: {worst:e} of the scales");
+    // Measured: 1.5e-14 (3.7e-4 with the spring explicit): the same scheme as Siconos'.
+    assert!(worst < 1e-12, "{kept:?} against {last:?}: {worst:e}");
+    assert_eq!(
+        jumps.impacts, WOODPECKER_IMPACTS,
+        "every impact on the reference's step"
+    );
+
+    // A stiff spring (ω = 1000 rad/s) stepped at hω = 10, θ = ½: the explicit force
+    // treatment blows up; the implicit one is the trapezoidal rule, which keeps the energy
+    // ½mv² + ½kq² of a linear oscillator to rounding.
+    let k = 1e6;
+    let spring = nonsmooth::model::Mechanical::with_masses([1.0])
+        .unwrap()
+        .with_stiffness(nalgebra::Matrix1::new(k))
+        .unwrap();
+    let energy = |q: f64, v: f64| 0.5 * v * v + 0.5 * k * q * q;
+    let floor = LinearContact::new([1.0], 1.0, [0.0], 0.0, 0.0).unwrap(); // q ≥ −1: never hit
+    let run = |implicit: bool| {
+        let mut scheme = MoreauJean::new(spring, vec![floor], 1e-2).unwrap();
+        if implicit {
+            scheme = scheme.with_implicit_forces().unwrap();
+        }
+        let (mut q, mut v) = (vec![1e-3], vec![0.0]);
+        let out = scheme.run(0.0, &mut q, &mut v, 2.0, &mut ());
+        (out, q[0], v[0])
+    };
+    let (out, q, v) = run(true);
+    out.unwrap();
+    let e0 = energy(1e-3, 0.0);
+    assert!(
+        (energy(q, v) - e0).abs() < 1e-12 * e0,
+        "{} vs {e0}",
+        energy(q, v)
+    );
+    let (out, q, v) = run(false);
+    assert!(
+        out.is_err() || energy(q, v) > 1e6 * e0,
+        "explicit: {out:?}, energy {}",
+        energy(q, v)
+    );
 }

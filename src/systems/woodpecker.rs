@@ -110,6 +110,20 @@ impl Lagrangian<f64> for Woodpecker {
         f[1] = spring - mb * Self::L_S * g;
         f[2] = -spring - mb * Self::L_G * g;
     }
+    /// The spring's stiffness `c_φ` on `φ_B − φ_S`; no damping.
+    fn force_jacobians(
+        &self,
+        _t: f64,
+        _q: &[f64],
+        _v: &[f64],
+        k: &mut [f64],
+        c: &mut [f64],
+    ) -> bool {
+        let s = Self::C_PHI;
+        k.copy_from_slice(&[0.0, 0.0, 0.0, 0.0, s, -s, 0.0, -s, s]);
+        c.fill(0.0);
+        true
+    }
     fn potential(&self, _t: f64, q: &[f64]) -> f64 {
         let (ms, mb, g) = (Self::M_S, Self::M_B, Self::G);
         let d = q[2] - q[1];

@@ -69,11 +69,22 @@ const PROJECTION_ITERATIONS: usize = 20;
 struct Workspace<T> {
     n: usize,
     m: usize,
+    /// `M` is diagonal (the kinetic energy's shortcut).
     diagonal: bool,
     constant: bool,
     factored: bool,
+    /// The stiff forces are taken implicitly (the iteration matrix `W` replaces `M`).
+    implicit: bool,
+    /// How the matrix the velocities are solved with is factorized.
+    factor: Factor,
     mass: Vec<T>,
+    /// The factor: Cholesky `L` of `M`, or the LU factors of `W` (row-major).
     chol: Vec<T>,
+    /// The LU factorization's row of each pivot.
+    piv: Vec<usize>,
+    /// `K = −∂f/∂q`, `C = −∂f/∂q̇` (implicit forces only).
+    tan_k: Vec<T>,
+    tan_c: Vec<T>,
     inv_diag: Vec<T>,
     f0: Vec<T>,
     f1: Vec<T>,
@@ -106,8 +117,13 @@ impl<T: Real> Workspace<T> {
             diagonal: false,
             constant: true,
             factored: false,
+            implicit: false,
+            factor: Factor::Cholesky,
             mass: vec![z; n * n],
             chol: vec![z; n * n],
+            piv: Vec::new(),
+            tan_k: Vec::new(),
+            tan_c: Vec::new(),
             inv_diag: vec![z; n],
             f0: vec![z; n],
             f1: vec![z; n],
@@ -133,10 +149,79 @@ impl<T: Real> Workspace<T> {
     }
 }
 
+/// How the matrix of the velocity solves is factorized.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Factor {
+    /// `M` diagonal: its inverse diagonal.
+    Diagonal,
+    /// `M = LLᵀ`.
+    Cholesky,
+    /// `W = M + hθC + h²θ²K = P⁻¹LU` (implicit forces; `W` need not be symmetric).
+    Lu,
+}
+
 /// Sparse row `a` of the rows stored at `offsets`.
 #[inline(always)]
 fn row<'a, T>(rows: &'a [(usize, T)], offsets: &[usize], a: usize) -> &'a [(usize, T)] {
     &rows[offsets[a]..offsets[a + 1]]
+}
+
+/// LU factorization with partial pivoting of the row-major `n × n` matrix `a` in place
+/// (`L` below the diagonal with a unit diagonal, `U` on and above it), the pivot rows in
+/// `piv`. Fails with `(column, pivot)` where the largest pivot candidate is zero or not
+/// finite.
+fn lu_in_place<T: Real>(a: &mut [T], piv: &mut [usize], n: usize) -> Result<(), (usize, T)> {
+    for j in 0..n {
+        let p = (j..n)
+            .max_by(|&x, &y| {
+                a[x * n + j]
+                    .abs()
+                    .partial_cmp(&a[y * n + j].abs())
+                    .unwrap_or(core::cmp::Ordering::Equal)
+            })
+            .unwrap_or(j);
+        let pivot = a[p * n + j];
+        if !(pivot.abs() > T::zero() && pivot.is_finite()) {
+            return Err((j, pivot));
+        }
+        piv[j] = p;
+        if p != j {
+            for c in 0..n {
+                a.swap(j * n + c, p * n + c);
+            }
+        }
+        for i in j + 1..n {
+            let l = a[i * n + j] / pivot;
+            a[i * n + j] = l;
+            for c in j + 1..n {
+                let u = a[j * n + c];
+                a[i * n + c] -= l * u;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// `x ← A⁻¹ x` with the factors of [`lu_in_place`].
+fn lu_solve<T: Real>(lu: &[T], piv: &[usize], x: &mut [T]) {
+    let n = piv.len();
+    for j in 0..n {
+        x.swap(j, piv[j]);
+    }
+    for i in 0..n {
+        let mut s = x[i];
+        for k in 0..i {
+            s -= lu[i * n + k] * x[k];
+        }
+        x[i] = s;
+    }
+    for i in (0..n).rev() {
+        let mut s = x[i];
+        for k in i + 1..n {
+            s -= lu[i * n + k] * x[k];
+        }
+        x[i] = s / lu[i * n + i];
+    }
 }
 
 /// The stored row of the problem's row `a`: frictional problems use every row (normal,
@@ -184,6 +269,11 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
         let mut ws = Workspace::new(n, m);
         ws.diagonal = system.diagonal_mass();
         ws.constant = system.constant_mass();
+        ws.factor = if ws.diagonal {
+            Factor::Diagonal
+        } else {
+            Factor::Cholesky
+        };
         Ok(Self {
             system,
             contacts,
@@ -259,6 +349,45 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
         let mut solver = Lemke::new();
         solver.reserve(self.contacts.len().min(1024));
         self.projection = Some(Projection { tolerance, solver });
+        Ok(self)
+    }
+
+    /// Takes the smooth forces implicitly where the system provides their Jacobians
+    /// ([`Lagrangian::force_jacobians`]): the linearized θ-method of Siconos' `MoreauJeanOSI`,
+    /// $$ W = M + h\theta C + h^2\theta^2 K,\qquad K = -\partial f/\partial q,\;
+    ///    C = -\partial f/\partial \dot q, $$
+    /// $$ W (v_{\rm free} - v_k) = h\big((1-\theta) f(t_k, q_k, v_k) +
+    ///    \theta f(t_{k+1}, q_k, v_k)\big) - h^2\theta K v_k, $$
+    /// and the impulses act through `W⁻¹` (`v_{k+1} = v_free + W⁻¹Hᵀp`, the Delassus matrix
+    /// `H W⁻¹ Hᵀ`). For forces linear in `(q, q̇)` this is the θ-method itself: a stiff
+    /// spring does not bound the step (the explicit treatment is unstable for
+    /// `hω > 2`). `W` is built and LU-factorized at every step (it depends on `h`, `q`
+    /// and `q̇`).
+    ///
+    /// # Errors
+    /// [`TimeStepError::Parameter`] if the system does not provide its Jacobians
+    /// (`force_jacobians` returns `false`).
+    pub fn with_implicit_forces(mut self) -> Result<Self, TimeStepError> {
+        let n = self.ws.n;
+        let (mut k, mut c) = (vec![T::zero(); n * n], vec![T::zero(); n * n]);
+        let zero = vec![T::zero(); n];
+        if !self
+            .system
+            .force_jacobians(T::zero(), &zero, &zero, &mut k, &mut c)
+        {
+            return Err(ParameterError::new(
+                "implicit forces",
+                0.0,
+                "a system that provides its force Jacobians (Lagrangian::force_jacobians)",
+            )
+            .into());
+        }
+        let ws = &mut self.ws;
+        ws.implicit = true;
+        ws.factor = Factor::Lu;
+        ws.piv = vec![0; n];
+        ws.tan_k = k;
+        ws.tan_c = c;
         Ok(self)
     }
 
@@ -437,13 +566,39 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
         }
     }
 
-    /// Factorizes the mass matrix at `q` (Cholesky, or the inverse diagonal).
-    fn factor(&mut self, k: usize, t: T, q: &[T]) -> Result<(), TimeStepError> {
+    /// Factorizes the mass matrix at `q` (Cholesky, or the inverse diagonal), or with
+    /// implicit forces the iteration matrix `W` of the step `h` at `(t, q, v)` (LU).
+    fn factor(&mut self, k: usize, t: T, h: T, q: &[T], v: &[T]) -> Result<(), TimeStepError> {
         let ws = &mut self.ws;
         let n = ws.n;
         self.system.mass(q, &mut ws.mass);
         Self::nonfinite(k, t, "mass", &ws.mass)?;
-        if ws.diagonal {
+        if ws.implicit {
+            if !self
+                .system
+                .force_jacobians(t, q, v, &mut ws.tan_k, &mut ws.tan_c)
+            {
+                return Err(ParameterError::new(
+                    "implicit forces",
+                    to_f64(t),
+                    "force Jacobians at every time (Lagrangian::force_jacobians returned false)",
+                )
+                .into());
+            }
+            Self::nonfinite(k, t, "stiffness K", &ws.tan_k)?;
+            Self::nonfinite(k, t, "damping C", &ws.tan_c)?;
+            let ht = h * self.theta;
+            for i in 0..n * n {
+                ws.chol[i] = ws.mass[i] + ht * ws.tan_c[i] + ht * ht * ws.tan_k[i];
+            }
+            lu_in_place(&mut ws.chol, &mut ws.piv, n).map_err(|(pivot, value)| {
+                TimeStepError::MassMatrix {
+                    t: to_f64(t),
+                    pivot,
+                    value: to_f64(value),
+                }
+            })?;
+        } else if ws.diagonal {
             for i in 0..n {
                 let d = ws.mass[i * n + i];
                 if !(d > T::zero()) {
@@ -485,14 +640,18 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
         Ok(())
     }
 
-    /// `x ← M⁻¹ x` with the factorization.
-    fn solve_mass(diagonal: bool, inv_diag: &[T], l: &[T], x: &mut [T]) {
+    /// `x ← M⁻¹ x` (or `W⁻¹ x`) with the factorization.
+    fn solve_mass(factor: Factor, inv_diag: &[T], l: &[T], piv: &[usize], x: &mut [T]) {
         let n = inv_diag.len();
-        if diagonal {
-            for i in 0..n {
-                x[i] *= inv_diag[i];
+        match factor {
+            Factor::Diagonal => {
+                for i in 0..n {
+                    x[i] *= inv_diag[i];
+                }
+                return;
             }
-            return;
+            Factor::Lu => return lu_solve(l, piv, x),
+            Factor::Cholesky => {}
         }
         for i in 0..n {
             let mut s = x[i];
@@ -521,8 +680,8 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
         v: &mut [T],
     ) -> Result<LcpReport, TimeStepError> {
         let h = tb - ta;
-        if !self.ws.factored || !self.ws.constant {
-            self.factor(k, ta, q)?;
+        if !self.ws.factored || !self.ws.constant || self.ws.implicit {
+            self.factor(k, ta, tb - ta, q, v)?;
         }
         self.free_velocity(k, ta, tb, q, v)?;
         self.activate(k, ta, h, q, v)?;
@@ -667,16 +826,32 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
         let (h, theta, n) = (tb - ta, self.theta, self.ws.n);
         let ws = &mut self.ws;
         self.system.forces(ta, q, v, &mut ws.f0);
-        for i in 0..n {
-            ws.qpred[i] = q[i] + h * v[i];
+        if ws.implicit {
+            // f(t_{k+1}, q_k, v_k); the change of q over the step enters through W and
+            // −h²θ K v_k.
+            self.system.forces(tb, q, v, &mut ws.f1);
+        } else {
+            for i in 0..n {
+                ws.qpred[i] = q[i] + h * v[i];
+            }
+            self.system.forces(tb, &ws.qpred, v, &mut ws.f1);
         }
-        self.system.forces(tb, &ws.qpred, v, &mut ws.f1);
         Self::nonfinite(k, ta, "force", &ws.f0)?;
         Self::nonfinite(k, tb, "force", &ws.f1)?;
         for i in 0..n {
             ws.vfree[i] = h * ((T::one() - theta) * ws.f0[i] + theta * ws.f1[i]);
         }
-        Self::solve_mass(ws.diagonal, &ws.inv_diag, &ws.chol, &mut ws.vfree);
+        if ws.implicit {
+            let hht = h * h * theta;
+            for i in 0..n {
+                let mut kv = T::zero();
+                for j in 0..n {
+                    kv += ws.tan_k[i * n + j] * v[j];
+                }
+                ws.vfree[i] -= hht * kv;
+            }
+        }
+        Self::solve_mass(ws.factor, &ws.inv_diag, &ws.chol, &ws.piv, &mut ws.vfree);
         for i in 0..n {
             ws.vfree[i] += v[i];
         }
@@ -819,10 +994,10 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
         if ws.w.len() < d * d {
             ws.w.resize(d * d, T::zero());
         }
-        if !ws.diagonal && ws.dense.len() < d * n {
+        if ws.factor != Factor::Diagonal && ws.dense.len() < d * n {
             ws.dense.resize(d * n, T::zero());
         }
-        if !ws.diagonal {
+        if ws.factor != Factor::Diagonal {
             for b in 0..d {
                 let rb = row_index(b, frictional);
                 let (lo, hi) = (ws.offsets[rb], ws.offsets[rb + 1]);
@@ -834,9 +1009,10 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
             }
             for b in 0..d {
                 Self::solve_mass(
-                    false,
+                    ws.factor,
                     &ws.inv_diag,
                     &ws.chol,
+                    &ws.piv,
                     &mut ws.dense[b * n..(b + 1) * n],
                 );
             }
@@ -845,7 +1021,7 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
             let ra = row(&ws.rows, &ws.offsets, row_index(a, frictional));
             for b in 0..d {
                 let mut s = T::zero();
-                if ws.diagonal {
+                if ws.factor == Factor::Diagonal {
                     let rb = row(&ws.rows, &ws.offsets, row_index(b, frictional));
                     for &(i, x) in ra {
                         for &(j, y) in rb {
@@ -876,7 +1052,7 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
             if pa == T::zero() {
                 continue;
             }
-            if ws.diagonal {
+            if ws.factor == Factor::Diagonal {
                 for &(j, x) in row(&ws.rows, &ws.offsets, row_index(a, frictional)) {
                     ws.vnew[j] += pa * x * ws.inv_diag[j];
                 }

@@ -52,11 +52,18 @@ pub trait Lagrangian<T: Real> {
     fn potential(&self, _t: T, _q: &[T]) -> T {
         T::zero()
     }
+    /// Writes the force Jacobians `K = −∂f/∂q` and `C = −∂f/∂q̇` at `(t, q, q̇)`
+    /// (row-major, `dofs()²` each) and returns `true`; needed for
+    /// [`MoreauJean::with_implicit_forces`](super::MoreauJean::with_implicit_forces).
+    /// Default: `false` (not provided).
+    fn force_jacobians(&self, _t: T, _q: &[T], _v: &[T], _k: &mut [T], _c: &mut [T]) -> bool {
+        false
+    }
 }
 
 /// A [`Mechanical`] system as the smooth part: its constant mass matrix and its generalized
-/// force `f(t) − Kq − Cq̇ − Σ w F` (elements and loads). The potential energy is not known
-/// to it (reported as 0).
+/// force `f(t) − Kq − Cq̇ − Σ w F` (elements and loads), with its tangent stiffness and
+/// damping as the force Jacobians. The potential energy is not known to it (reported as 0).
 impl<T: Real, const N: usize, El: Elements<T, N>, Ld: Loads<T, N>> Lagrangian<T>
     for Mechanical<T, N, El, Ld>
 {
@@ -78,6 +85,18 @@ impl<T: Real, const N: usize, El: Elements<T, N>, Ld: Loads<T, N>> Lagrangian<T>
     fn forces(&self, t: T, q: &[T], v: &[T], f: &mut [T]) {
         let g = self.generalized_force(t, q, v);
         f[..N].copy_from_slice(g.as_slice());
+    }
+    /// The tangent stiffness and damping of the elements with `K` and `C`
+    /// ([`Mechanical::tangent`]); the loads depend on time only.
+    fn force_jacobians(&self, _t: T, q: &[T], v: &[T], k: &mut [T], c: &mut [T]) -> bool {
+        let (kt, ct) = self.tangent(q, v);
+        for i in 0..N {
+            for j in 0..N {
+                k[i * N + j] = kt[(i, j)];
+                c[i * N + j] = ct[(i, j)];
+            }
+        }
+        true
     }
 }
 
