@@ -131,6 +131,7 @@
 
 mod approach;
 mod error;
+mod extrema;
 mod field;
 mod friction;
 mod load;
@@ -141,6 +142,7 @@ mod tangent;
 
 pub use approach::Approach;
 pub use error::FilippovError;
+pub use extrema::{ControlExtremum, second_rate};
 pub use friction::DryFriction;
 pub use load::RelayLoad;
 pub use relay::LinearRelay;
