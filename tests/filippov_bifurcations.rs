@@ -10,9 +10,7 @@
 //! piecewise-linear flow).
 
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
-use nonsmooth::filippov::{
-    Filippov, FilippovSimulation, Settings, Side, Switched, TransitionKind,
-};
+use nonsmooth::filippov::{Filippov, FilippovSimulation, Settings, Side, Switched, TransitionKind};
 use nonsmooth::integrate::{Dopri5, Tolerances};
 use nonsmooth::orbit::sliding::{
     SlidingBifurcationKind, SlidingContinuation, follow_sliding, follow_sliding_arclength,
@@ -67,13 +65,12 @@ fn belt_period(f0: f64, w: f64, u: f64, x0: SVector<f64, 2>) -> Vec<(f64, Transi
     let period = 2.0 * PI / w;
     let mut settings = Settings::default();
     settings.exit_samples = 32;
-    let mut sim = FilippovSimulation::new(Timed(belt(f0, w, u), period / 32.0), Dopri5::new(tol2()))
-        .with_settings(settings)
-        .unwrap();
+    let mut sim =
+        FilippovSimulation::new(Timed(belt(f0, w, u), period / 32.0), Dopri5::new(tol2()))
+            .with_settings(settings)
+            .unwrap();
     let warm = sim.run(0.0, x0, 80.0 * period, &mut ()).unwrap();
-    let run = sim
-        .run(warm.t, warm.x, warm.t + period, &mut ())
-        .unwrap();
+    let run = sim.run(warm.t, warm.x, warm.t + period, &mut ()).unwrap();
     run.transitions
         .iter()
         .filter(|tr| tr.kind != TransitionKind::Graze)
@@ -99,7 +96,11 @@ fn bisect_by_simulation(
     width: f64,
 ) -> (f64, f64) {
     let at_lo = signature(&belt_period(lo, w, u, x0));
-    assert_ne!(at_lo, signature(&belt_period(hi, w, u, x0)), "no change in [{lo}, {hi}]");
+    assert_ne!(
+        at_lo,
+        signature(&belt_period(hi, w, u, x0)),
+        "no change in [{lo}, {hi}]"
+    );
     while hi - lo > width {
         let mid = 0.5 * (lo + hi);
         if signature(&belt_period(mid, w, u, x0)) == at_lo {
@@ -163,8 +164,16 @@ fn switching_and_crossing_sliding_on_the_belt_oscillator_branch() {
             "{:?} at F₀ = {:.12} (g_cs {:.1e}, curvature {c:.4}); simulation brackets it in [{lo:.12}, {hi:.12}]",
             b.kind, b.p, b.value
         );
-        assert!(b.p > lo - 1e-9 && b.p < hi + 1e-9, "{} outside [{lo}, {hi}]", b.p);
-        assert_eq!(c < 0.0, b.kind == SlidingBifurcationKind::SwitchingSliding, "{c}");
+        assert!(
+            b.p > lo - 1e-9 && b.p < hi + 1e-9,
+            "{} outside [{lo}, {hi}]",
+            b.p
+        );
+        assert_eq!(
+            c < 0.0,
+            b.kind == SlidingBifurcationKind::SwitchingSliding,
+            "{c}"
+        );
         assert!(c.abs() > 0.1, "a degenerate fold: {c}");
     }
     // Switching-sliding: above it (g_cs > 0) the arrival from below crosses, the orbit
@@ -183,7 +192,10 @@ fn switching_and_crossing_sliding_on_the_belt_oscillator_branch() {
         e.into_iter().fold(f64::INFINITY, f64::min)
     };
     let (e4, e5) = (excursion(1e-4), excursion(1e-5));
-    println!("switching-sliding: excursion {e4:.3e} at +1e-4, {e5:.3e} at +1e-5 (ratio {:.4})", e4 / e5);
+    println!(
+        "switching-sliding: excursion {e4:.3e} at +1e-4, {e5:.3e} at +1e-5 (ratio {:.4})",
+        e4 / e5
+    );
     assert!((e4 / e5 - 10.0).abs() < 0.2, "{e4} / {e5}");
     assert_eq!(signature(&belt_period(sw.p - 1e-5, w, u, sw.state)), (0, 1));
     // Crossing-sliding: below it the arrival from below slides for a short time and
@@ -198,7 +210,10 @@ fn switching_and_crossing_sliding_on_the_belt_oscillator_branch() {
             .fold(f64::INFINITY, f64::min)
     };
     let (s4, s5) = (slide(1e-4), slide(1e-5));
-    println!("crossing-sliding: sliding segment {s4:.3e} at −1e-4, {s5:.3e} at −1e-5 (ratio {:.4})", s4 / s5);
+    println!(
+        "crossing-sliding: sliding segment {s4:.3e} at −1e-4, {s5:.3e} at −1e-5 (ratio {:.4})",
+        s4 / s5
+    );
     assert!((s4 / s5 - 10.0).abs() < 0.2, "{s4} / {s5}");
     assert_eq!(signature(&belt_period(cs.p + 1e-5, w, u, cs.state)).1, 0);
 }
@@ -227,7 +242,11 @@ fn adding_sliding_on_the_belt_oscillator_branch() {
     let add = &branch.bifurcations[0];
     // One sliding segment per period before, two after.
     for q in &branch.points {
-        assert_eq!(q.tests.sliding_segments, if q.p < add.p { 1 } else { 2 }, "{q:?}");
+        assert_eq!(
+            q.tests.sliding_segments,
+            if q.p < add.p { 1 } else { 2 },
+            "{q:?}"
+        );
     }
     // Closed form: along the located orbit's stick, q's extremum is at the friction limit.
     let mut sim = build(add.p).unwrap();
@@ -235,7 +254,11 @@ fn adding_sliding_on_the_belt_oscillator_branch() {
     let f0 = add.p;
     let r = -u / (f0 * w);
     let mut touch = f64::INFINITY;
-    for entry in run.transitions.iter().filter(|tr| tr.kind == TransitionKind::SlidingEntry) {
+    for entry in run
+        .transitions
+        .iter()
+        .filter(|tr| tr.kind == TransitionKind::SlidingEntry)
+    {
         let (ts, xs) = (entry.t, entry.x[0]);
         let q = |t: f64| -xs - u * (t - ts) + f0 * (w * t).cos();
         // The first extrema after t_s.
@@ -248,20 +271,29 @@ fn adding_sliding_on_the_belt_oscillator_branch() {
             }
         }
     }
-    println!("adding-sliding at F₀ = {:.12} (g_as {:.1e}); 1 − |q| at the stick's extremum {touch:.1e}", add.p, add.value);
+    println!(
+        "adding-sliding at F₀ = {:.12} (g_as {:.1e}); 1 − |q| at the stick's extremum {touch:.1e}",
+        add.p, add.value
+    );
     assert!(touch < 1e-8, "{touch}");
     // Plain simulations (no shooting, no test function): one sliding entry per period
     // below, two above, once the excursion is long enough for the simulation's samples of
     // the equivalent control to see it; bisected to 10⁻⁹.
     let (lo, hi) = bisect_by_simulation((add.p - 0.01, add.p + 0.01), (w, u), add.state, 1e-9);
     println!("simulation: one sliding entry up to {lo:.12}, two from {hi:.12}");
-    assert!(lo > add.p - 1e-9 && hi < add.p + 1e-4, "{} vs [{lo}, {hi}]", add.p);
+    assert!(
+        lo > add.p - 1e-9 && hi < add.p + 1e-4,
+        "{} vs [{lo}, {hi}]",
+        add.p
+    );
     // Above it the stick is split by an excursion whose duration grows as the square root
     // of the distance (the extremum of α passes its bound quadratically): e² is linear in
     // F₀ and extrapolates to zero at the bifurcation.
     let excursion = |d: f64| {
         let per = belt_period(add.p + d, w, u, add.state);
-        excursions(&per, period).into_iter().fold(f64::INFINITY, f64::min)
+        excursions(&per, period)
+            .into_iter()
+            .fold(f64::INFINITY, f64::min)
     };
     let (e1, e2, e4) = (excursion(1e-4), excursion(2e-4), excursion(4e-4));
     let zero = add.p + 1e-4 - e1 * e1 * 1e-4 / (e2 * e2 - e1 * e1);
@@ -323,7 +355,12 @@ impl Filippov<f64, 2, 1> for DuffingBelt {
 
 #[test]
 fn arclength_passes_the_folds_of_a_duffing_oscillator_on_a_belt() {
-    let build = |w: f64| Ok(FilippovSimulation::new(DuffingBelt { w }, Dopri5::new(tol2())));
+    let build = |w: f64| {
+        Ok(FilippovSimulation::new(
+            DuffingBelt { w },
+            Dopri5::new(tol2()),
+        ))
+    };
     let period = |w: f64| 2.0 * PI / w;
     let settings = SlidingContinuation::new(1.0, 3.0, 0.05, 0)
         .unwrap()
@@ -348,7 +385,10 @@ fn arclength_passes_the_folds_of_a_duffing_oscillator_on_a_belt() {
             .iter()
             .map(|m| (m - 1.0).norm())
             .fold(f64::INFINITY, f64::min);
-        println!("fold at ω = {:.12}: τ_p = {:.1e}, |μ − 1| = {nearest:.1e}", f.p, f.tangent_p);
+        println!(
+            "fold at ω = {:.12}: τ_p = {:.1e}, |μ − 1| = {nearest:.1e}",
+            f.p, f.tangent_p
+        );
         assert!(nearest < 1e-8, "{:?}", f.multipliers);
     }
     assert!(f1.p > f2.p + 0.5, "{} {}", f1.p, f2.p);
@@ -368,12 +408,24 @@ fn arclength_passes_the_folds_of_a_duffing_oscillator_on_a_belt() {
             1 => (f2.p, f1.p),
             _ => (f2.p, 3.0),
         };
-        assert!(b.p >= lo - 1e-9 && b.p <= hi + 1e-9, "ω = {} on leg {leg}", b.p);
+        assert!(
+            b.p >= lo - 1e-9 && b.p <= hi + 1e-9,
+            "ω = {} on leg {leg}",
+            b.p
+        );
         let unstable = b.multipliers.iter().any(|m| m.norm() > 1.0 + 1e-9);
-        assert_eq!(unstable, leg == 1, "ω = {} on leg {leg}: {:?}", b.p, b.multipliers);
+        assert_eq!(
+            unstable,
+            leg == 1,
+            "ω = {} on leg {leg}: {:?}",
+            b.p,
+            b.multipliers
+        );
     }
     assert_eq!(leg, 2);
-    let counts: Vec<usize> = (0..3).map(|l| legs.iter().filter(|&&k| k == l).count()).collect();
+    let counts: Vec<usize> = (0..3)
+        .map(|l| legs.iter().filter(|&&k| k == l).count())
+        .collect();
     println!("points on the upper, middle and lower branch: {counts:?}");
     let i1 = f1.after;
     // Past ω₁ the upper orbit is gone: shooting from the fold's orbit at ω₁ + 10⁻³ does
@@ -383,13 +435,26 @@ fn arclength_passes_the_folds_of_a_duffing_oscillator_on_a_belt() {
     let mut sim = build(f1.p + 1e-3).unwrap().with_settings(capped).unwrap();
     let tol6 = Tolerances::<f64, 6>::new(1e-11, 1e-13).unwrap();
     match sim.find_orbit(0.0, f1.state, period(f1.p + 1e-3), false, tol6, 1e-11, 30) {
-        Ok(o) => assert!((o.state - f1.state).amax() > 0.1, "{:?} near {:?}", o.state, f1.state),
+        Ok(o) => assert!(
+            (o.state - f1.state).amax() > 0.1,
+            "{:?} near {:?}",
+            o.state,
+            f1.state
+        ),
         Err(e) => println!("past the fold the shooting fails: {e}"),
     }
     // Before it, two orbits: the upper (stable) and the middle (unstable) one.
     let mut sim = build(f1.p - 1e-3).unwrap();
     let upper = sim
-        .find_orbit(0.0, pts[i1].state, period(f1.p - 1e-3), false, tol6, 1e-11, 30)
+        .find_orbit(
+            0.0,
+            pts[i1].state,
+            period(f1.p - 1e-3),
+            false,
+            tol6,
+            1e-11,
+            30,
+        )
         .unwrap();
     let mu = upper.monodromy.multipliers();
     println!("below the fold, the upper orbit: {mu:?}");
@@ -480,7 +545,11 @@ impl ExactPlant {
                 x[0] = 0.0;
                 // The far field's rate x₂ ∓ 1: crossing if it carries on, else sliding.
                 let far = x[1] + f64::from(piece);
-                if far * f64::from(piece) < 0.0 { -piece } else { 0 }
+                if far * f64::from(piece) < 0.0 {
+                    -piece
+                } else {
+                    0
+                }
             };
         }
     }
@@ -525,7 +594,8 @@ fn relay_feedback_orbit_continued_in_the_damping_against_the_exact_flow() {
         .unwrap()
         .autonomous();
     let tol12 = Tolerances::<f64, 12>::new(1e-12, 1e-14).unwrap();
-    let branch = follow_sliding(build, move |_| period, 0.0, 0.05, start, tol12, &settings).unwrap();
+    let branch =
+        follow_sliding(build, move |_| period, 0.0, 0.05, start, tol12, &settings).unwrap();
     assert_eq!(branch.points.len(), 5, "{:?}", branch.end);
     for b in &branch.bifurcations {
         println!("relay branch: {:?} at ζ = {:.10}", b.kind, b.p);
@@ -560,7 +630,11 @@ fn relay_feedback_orbit_continued_in_the_damping_against_the_exact_flow() {
         let worst = q
             .multipliers
             .iter()
-            .map(|m| ex.iter().map(|e| (m - e).norm()).fold(f64::INFINITY, f64::min))
+            .map(|m| {
+                ex.iter()
+                    .map(|e| (m - e).norm())
+                    .fold(f64::INFINITY, f64::min)
+            })
             .fold(0.0, f64::max);
         println!(
             "ζ = {:.4}: period {:.12}, exact flow closes within {closure:.1e}; multipliers {:?}, exact {ex:?}, worst difference {worst:.1e}; segments {}",

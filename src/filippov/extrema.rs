@@ -71,7 +71,8 @@ impl<T: Real, const N: usize, const S: usize, Sys: Filippov<T, N, S>> EventSet<T
 
     fn value(&self, _i: usize, t: T, y: &SVector<T, N>) -> T {
         let sides = &self.field.mode.sides;
-        let alpha = |t: T, y: &SVector<T, N>| rates(self.field.sys, self.surface, sides, t, y).alpha();
+        let alpha =
+            |t: T, y: &SVector<T, N>| rates(self.field.sys, self.surface, sides, t, y).alpha();
         let mut f = SVector::zeros();
         self.field.eval(t, y, &mut f);
         rate_along_flow(alpha, t, y, &f, self.field.sys.time_scale(t))
@@ -155,7 +156,12 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
         St: Stepper<T, N> + Clone,
     {
         if surface >= S {
-            return Err(ParameterError::new("surface", surface as f64, "< S (the number of surfaces)").into());
+            return Err(ParameterError::new(
+                "surface",
+                surface as f64,
+                "< S (the number of surfaces)",
+            )
+            .into());
         }
         let field = ModeField {
             sys: self.system(),

@@ -19,16 +19,59 @@
 //!   [`Approach`]); positive while the orbit stays off the surface, zero where it grazes,
 //!   negative once it slides. (An orbit that crosses the surface has approach 0: this test
 //!   is for orbits that, without sliding, do not reach the surface.)
-//! - **crossing-sliding** (a crossing point of the orbit reaches the boundary of the
-//!   sliding region, where the far field is tangent, and the crossing turns into a short
-//!   sliding segment): over the orbit's arrivals at the surface from a region (crossings
-//!   and sliding entries, arriving from side `a` with `h_a ≠ 0`), the far-side rate signed
-//!   so that a crossing is positive,
+//! - **crossing-sliding** and **switching-sliding** (a point where the orbit arrives at
+//!   the surface from a region reaches the boundary of the sliding region, where the far
+//!   field `F_ā` is tangent, `h_ā = 0`, a fold of `F_ā`): over the orbit's arrivals at the
+//!   surface from a region (crossings and sliding entries, arriving from side `a` with
+//!   `h_a ≠ 0`), the far-side rate signed so that a crossing is positive,
 //!   $$ g_{\mathrm{cs}} = -\operatorname{sgn}(a)\, h_{\bar a}\quad\text{at the arrival with the smallest } |h_{\bar a}| , $$
 //!   positive for a crossing, negative for a sliding entry, zero where the arrival point is
 //!   on the boundary `h_ā = 0` of the sliding region. The field on the far side is
 //!   continuous there, so the arrival point, and `g_cs`, move continuously through the
-//!   bifurcation.
+//!   bifurcation. Which of the two it is depends on the fold, i.e. on the far field's
+//!   orbit through the arrival point, `H(τ) ≈ h_ā τ + ½ L²_{F_ā}H τ²`: with
+//!   $$ c = \operatorname{sgn}(\bar a)\, L^2_{F_{\bar a}} H, \qquad L^2_F H = \frac{d}{dt}\big(\nabla H\cdot F + \partial_t H\big) \text{ along } F $$
+//!   (by [`second_rate`]),
+//!   `c > 0` (a fold visible from the far region: its orbit moves away into it) makes a
+//!   **crossing-sliding**: on the crossing side the orbit goes on in the far region, on
+//!   the other it slides for a time `∝ |g_cs|` and leaves at the fold; `c < 0` (an
+//!   invisible fold: the far orbit turns back to the surface) makes a
+//!   **switching-sliding**: on the crossing side the orbit makes an excursion into the far
+//!   region of duration `≈ 2h_ā/|L²H| ∝ |g_cs|` and slides where it comes back (arriving
+//!   from `ā`, where `F_a` still pushes into the surface), on the other it slides at once.
+//! - **adding-sliding** (a sliding segment's exit point reaches a point of the boundary
+//!   of the sliding region where the departing field's orbit has a cubic tangency,
+//!   `h_b = 0` and `L²_{F_b}H = 0`; there the sliding flow is tangent to the boundary):
+//!   along each sliding segment the equivalent control `α` (exit into `H < 0` at `α = 0`,
+//!   into `H > 0` at `α = 1`) has local extrema, and
+//!   $$ g_{\mathrm{as}} = \min\!\big(\alpha, 1 - \alpha\big) \text{ at the extremum nearest to its bound}, $$
+//!   found by [`FilippovSimulation::control_extrema`] (zeros of `dα/dt` along the sliding
+//!   flow). To keep the test continuous, the sliding flow of a segment that exits into side
+//!   `b` and re-enters sliding from side `b` is continued past its exit (the sliding field
+//!   is defined while `h₋ > h₊`) up to the re-entry: its extremum there lies beyond the
+//!   bound and `g_as < 0`. So `g_as > 0` while the segment slides past the near-touch,
+//!   `0` where `α` touches its bound, `< 0` once the segment splits around an excursion,
+//!   whose duration grows as `√|g_as|`.
+//!
+//! The four are the sliding bifurcations of di Bernardo, Kowalczyk & Nordmark (2003) (and
+//! di Bernardo et al. 2008, §8.5): all occur where the orbit meets the fold of `F_b` that
+//! bounds the sliding region — crossing it (crossing- and switching-sliding, by the
+//! visibility of the fold), grazing at it (grazing-sliding), or sliding into a point of it
+//! where the fold changes visibility (adding-sliding; in the classification of Jeffrey &
+//! Hogan (2011) a cusp of the boundary's projection).
+//!
+//! # Autonomous orbits
+//! With [`SlidingContinuation::autonomous`] the period is an unknown of each shooting
+//! ([`FilippovSimulation::find_orbit`] with the phase fixed by the section through the
+//! guess normal to the field there), seeded by the secant extrapolation of the last two
+//! periods; [`SlidingBranchPoint::period`] records it and the tests run over it.
+//!
+//! # Folds
+//! [`follow_sliding`] steps in `p` and cannot pass a turning point of the branch;
+//! [`follow_sliding_arclength`] follows the curve `φ(x; p) = x` in `(x, p)` by
+//! pseudo-arclength (tangent from `[Φ − I, ∂φ/∂p]`, `Φ` with the saltation matrices, so
+//! through crossings and sliding) and locates folds as zeros of the tangent's
+//! `p`-component, where a Floquet multiplier is 1.
 //!
 //! A sign change of a test between two grid points is located by the Illinois method in
 //! `p` (each trial a shooting from the interpolated state) to the settings' tolerance, and
@@ -42,7 +85,8 @@
 //! Kuznetsov, *SlideCont: an Auto97 driver for bifurcation analysis of Filippov systems*,
 //! ACM TOMS 31(1), 2005 (their test functions); M. di Bernardo, P. Kowalczyk, A. Nordmark,
 //! *Sliding bifurcations: a novel mechanism for the sudden onset of chaos in dry friction
-//! oscillators*, IJBC 13(10), 2003.
+//! oscillators*, IJBC 13(10), 2003; M. R. Jeffrey, S. J. Hogan, *The geometry of generic
+//! sliding bifurcations*, SIAM Review 53(3), 2011.
 
 use nalgebra::{Complex, SVector};
 
@@ -408,7 +452,8 @@ where
                 + system.surface_time_rate(surface, tr.t, &tr.x);
             let c = -a.sign::<f64>() * h;
             if c.is_finite() && crossing.is_none_or(|best| c.abs() < best.0.abs()) {
-                let curvature = a.flip().sign::<f64>() * second_rate(system, surface, &far, tr.t, &tr.x);
+                let curvature =
+                    a.flip().sign::<f64>() * second_rate(system, surface, &far, tr.t, &tr.x);
                 crossing = Some((c, curvature));
             }
         }
@@ -928,7 +973,9 @@ impl<B, P> Problem<'_, B, P> {
         }
         match best {
             Some(c) => Ok(c),
-            None => self.correct::<Sys, St, N, S, M>(a, 0.5 * sigma, tol).map(|c| c.0),
+            None => self
+                .correct::<Sys, St, N, S, M>(a, 0.5 * sigma, tol)
+                .map(|c| c.0),
         }
     }
 }
