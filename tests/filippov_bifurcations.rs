@@ -78,6 +78,14 @@ fn belt_period(f0: f64, w: f64, u: f64, x0: SVector<f64, 2>) -> Vec<(f64, Transi
         .collect()
 }
 
+/// The belt oscillator's state after 80 forcing periods from `(0.5, 0)` at `f0`.
+fn settled(f0: f64, w: f64, u: f64) -> SVector<f64, 2> {
+    let mut sim = FilippovSimulation::new(belt(f0, w, u), Dopri5::new(tol2()));
+    sim.run(0.0, SVector::from([0.5, 0.0]), 80.0 * 2.0 * PI / w, &mut ())
+        .unwrap()
+        .x
+}
+
 /// The counts of crossings and sliding entries over a period.
 fn signature(period: &[(f64, TransitionKind, Side)]) -> (usize, usize) {
     let count = |k: TransitionKind| period.iter().filter(|tr| tr.1 == k).count();
@@ -139,11 +147,7 @@ fn switching_and_crossing_sliding_on_the_belt_oscillator_branch() {
         .unwrap()
         .with_locate_tolerance(1e-12)
         .unwrap();
-    let mut sim = build(1.3).unwrap();
-    let x0 = sim
-        .run(0.0, SVector::from([0.5, 0.0]), 80.0 * PI, &mut ())
-        .unwrap()
-        .x;
+    let x0 = settled(1.3, w, u);
     let branch = follow_sliding(build, |_| PI, 0.0, 1.3, x0, tol6(), &settings).unwrap();
     let kinds: Vec<_> = branch.bifurcations.iter().map(|b| b.kind).collect();
     assert_eq!(
@@ -231,11 +235,7 @@ fn adding_sliding_on_the_belt_oscillator_branch() {
         .unwrap()
         .with_locate_tolerance(1e-12)
         .unwrap();
-    let mut sim = build(0.75).unwrap();
-    let x0 = sim
-        .run(0.0, SVector::from([0.5, 0.0]), 80.0 * period, &mut ())
-        .unwrap()
-        .x;
+    let x0 = settled(0.75, w, u);
     let branch = follow_sliding(build, move |_| period, 0.0, 0.75, x0, tol6(), &settings).unwrap();
     let kinds: Vec<_> = branch.bifurcations.iter().map(|b| b.kind).collect();
     assert_eq!(kinds, [SlidingBifurcationKind::AddingSliding]);
@@ -597,9 +597,19 @@ fn relay_feedback_orbit_continued_in_the_damping_against_the_exact_flow() {
     let branch =
         follow_sliding(build, move |_| period, 0.0, 0.05, start, tol12, &settings).unwrap();
     assert_eq!(branch.points.len(), 5, "{:?}", branch.end);
-    for b in &branch.bifurcations {
-        println!("relay branch: {:?} at ζ = {:.10}", b.kind, b.p);
-    }
+    // Not located: along this branch pairs of short sliding segments vanish (14 segments
+    // per period at ζ = 0.05, 12 from about 0.0502, then 10, 8 and 6 by 0.06): an
+    // interior region arc that entered the surface for a short slide (0.0017 at
+    // ζ = 0.0501) misses it at ζ = 0.0503 — a grazing-sliding of one arc of an orbit that
+    // slides elsewhere, which the global test g_gs (closest approach of an orbit that does
+    // not slide) does not see. Recorded, not asserted.
+    assert!(branch.bifurcations.is_empty(), "{:?}", branch.bifurcations);
+    let segments: Vec<usize> = branch
+        .points
+        .iter()
+        .map(|q| q.tests.sliding_segments)
+        .collect();
+    println!("relay branch: sliding segments per period {segments:?}");
     let mut last_period = 0.0;
     for q in branch.points.iter().step_by(2) {
         let exact = ExactPlant::new(&relay(q.p));

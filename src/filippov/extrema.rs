@@ -11,7 +11,7 @@ use super::system::{Filippov, Mode, Side};
 use crate::Real;
 use crate::drive::modes::rate_along_flow;
 use crate::drive::{Control, EventRecord, Observer, Simulation};
-use crate::event::{Direction, EventSet};
+use crate::event::{Direction, Event, EventFunction};
 use crate::integrate::Stepper;
 use crate::validate::ParameterError;
 
@@ -57,47 +57,23 @@ pub struct ControlExtremum<T> {
     pub minimum: bool,
 }
 
-/// The event `dα/dt = 0` along the sliding flow (`dα/dt` by a central difference along the
+/// The event function `dα/dt` along the sliding flow (a central difference along the
 /// flow); rising through zero at a minimum of `α`, falling at a maximum.
 struct ControlRate<'a, Sys, const S: usize> {
     field: ModeField<'a, Sys, S>,
     surface: usize,
 }
 
-impl<T: Real, const N: usize, const S: usize, Sys: Filippov<T, N, S>> EventSet<T, N>
+impl<T: Real, const N: usize, const S: usize, Sys: Filippov<T, N, S>> EventFunction<T, N>
     for ControlRate<'_, Sys, S>
 {
-    const LEN: usize = 1;
-
-    fn value(&self, _i: usize, t: T, y: &SVector<T, N>) -> T {
+    fn value(&self, t: T, y: &SVector<T, N>) -> T {
         let sides = &self.field.mode.sides;
         let alpha =
             |t: T, y: &SVector<T, N>| rates(self.field.sys, self.surface, sides, t, y).alpha();
         let mut f = SVector::zeros();
         self.field.eval(t, y, &mut f);
         rate_along_flow(alpha, t, y, &f, self.field.sys.time_scale(t))
-    }
-
-    fn rate(&self, _i: usize, _t: T, _y: &SVector<T, N>, _dy: &SVector<T, N>) -> Option<T> {
-        None
-    }
-
-    fn direction(&self, _i: usize) -> Direction {
-        Direction::Either
-    }
-
-    fn is_terminal(&self, _i: usize) -> bool {
-        false
-    }
-
-    fn resets(&self, _i: usize) -> bool {
-        false
-    }
-
-    fn apply_reset(&self, _i: usize, _t: T, _y: &mut SVector<T, N>) {}
-
-    fn interior_samples(&self, _i: usize) -> usize {
-        3
     }
 }
 
@@ -169,7 +145,10 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
             exit_samples: 0,
         };
         let mut sim = Simulation::new(field, self.stepper().clone())
-            .with_events(ControlRate { field, surface })
+            .with_events(
+                Event::new(ControlRate { field, surface }, Direction::Either)
+                    .with_interior_samples(3),
+            )
             .event_tolerance(self.settings().event_tol)?;
         let mut collect = Collect {
             sys: self.system(),

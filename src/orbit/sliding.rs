@@ -202,6 +202,18 @@ impl SlidingContinuation {
     }
 }
 
+/// [`OrbitError::InvalidSetting`] for a tested surface the system lacks.
+fn check_surface<const S: usize>(settings: &SlidingContinuation) -> Result<()> {
+    if settings.surface >= S {
+        return Err(invalid(
+            "the tested surface",
+            "< S (the number of surfaces)",
+            settings.surface as f64,
+        ));
+    }
+    Ok(())
+}
+
 fn invalid(what: &'static str, requirement: &'static str, value: f64) -> OrbitError {
     OrbitError::InvalidSetting {
         what,
@@ -681,13 +693,7 @@ where
     Sys: Filippov<f64, N, S> + Clone,
     St: Stepper<f64, N> + Clone,
 {
-    if settings.surface >= S {
-        return Err(invalid(
-            "the tested surface",
-            "< S (the number of surfaces)",
-            settings.surface as f64,
-        ));
-    }
+    check_surface::<S>(settings)?;
     let problem = Problem {
         build: &build,
         period: &period,
@@ -1022,13 +1028,7 @@ where
     Sys: Filippov<f64, N, S> + Clone,
     St: Stepper<f64, N> + Clone,
 {
-    if settings.surface >= S {
-        return Err(invalid(
-            "the tested surface",
-            "< S (the number of surfaces)",
-            settings.surface as f64,
-        ));
-    }
+    check_surface::<S>(settings)?;
     if settings.autonomous {
         return Err(invalid(
             "autonomous orbits in arclength continuation",
