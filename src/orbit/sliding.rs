@@ -337,7 +337,7 @@ where
         (t0, run.t),
         approach.closest.map(|c| c.0),
     );
-    tests.adding_sliding = adding_test(sim, surface, &run, (t0, x0))?;
+    tests.adding_sliding = adding_test(sim, surface, &run, (t0, x0));
     Ok(tests)
 }
 
@@ -352,13 +352,14 @@ struct Window<const N: usize, const S: usize> {
 /// `g_as` of a run over one period: the extremum of `α` nearest to its bound over every
 /// sliding segment on `surface`, each continued past its exit up to a re-entry from the
 /// side it left to (a segment open at the period's end is continued into the next period
-/// up to the end of the first segment's window).
+/// up to the end of the first segment's window). A window whose integration fails offers
+/// no candidate.
 fn adding_test<Sys, St, const N: usize, const S: usize>(
     sim: &FilippovSimulation<f64, Sys, St>,
     surface: usize,
     run: &FilippovRun<f64, N, S>,
     (t0, x0): (f64, SVector<f64, N>),
-) -> Result<Option<f64>>
+) -> Option<f64>
 where
     Sys: Filippov<f64, N, S>,
     St: Stepper<f64, N> + Clone,
@@ -409,13 +410,18 @@ where
     }
     let mut best: Option<f64> = None;
     for w in windows.iter().filter(|w| w.end > w.t) {
-        for e in sim.control_extrema(surface, w.sides, w.t, w.x, w.end)? {
+        // A window whose continued sliding flow cannot be integrated (it left the domain
+        // where h₋ > h₊ far from the surface) offers no candidate.
+        let Ok(extrema) = sim.control_extrema(surface, w.sides, w.t, w.x, w.end) else {
+            continue;
+        };
+        for e in extrema {
             if e.t > w.t && e.t < w.end && best.is_none_or(|b| e.margin.abs() < b.abs()) {
                 best = Some(e.margin);
             }
         }
     }
-    Ok(best)
+    best
 }
 
 /// The tests from a run's transitions and the closest approach of its region steps
