@@ -8,7 +8,9 @@
 //!   marked;
 //! - the belt oscillator's periodic orbit followed in the forcing amplitude by shooting
 //!   (`orbit::sliding::follow_sliding`), with its sliding bifurcations (grazing-sliding,
-//!   crossing-sliding) located on the branch as zeros of their test functions.
+//!   switching-sliding, crossing-sliding) located on the branch as zeros of their test
+//!   functions, and at forcing frequency 0.8 an adding-sliding (a stick split in two),
+//!   checked against the closed form of the equivalent control along the stick.
 //!
 //! `cargo run --release [--features plot] --example sliding -- [--out DIR]`
 //!
@@ -70,15 +72,16 @@ impl SlidingObserver<f64, 3, 1> for Samples {
 
 /// The belt oscillator `ẍ + x = F₀ cos 2t − sgn(ẋ − 0.5)`.
 fn belt(f0: f64) -> impl Filippov<f64, 2, 1> + Clone {
+    belt_at(f0, 2.0)
+}
+
+/// The belt oscillator at forcing `f0` and frequency `w`.
+fn belt_at(f0: f64, w: f64) -> impl Filippov<f64, 2, 1> + Clone {
     Switched::new(
         |x: &SVector<f64, 2>| x[1] - 0.5,
         |_x: &SVector<f64, 2>| SVector::from([0.0, 1.0]),
-        move |t: f64, x: &SVector<f64, 2>| {
-            SVector::from([x[1], -x[0] + f0 * (2.0 * t).cos() + 1.0])
-        },
-        move |t: f64, x: &SVector<f64, 2>| {
-            SVector::from([x[1], -x[0] + f0 * (2.0 * t).cos() - 1.0])
-        },
+        move |t: f64, x: &SVector<f64, 2>| SVector::from([x[1], -x[0] + f0 * (w * t).cos() + 1.0]),
+        move |t: f64, x: &SVector<f64, 2>| SVector::from([x[1], -x[0] + f0 * (w * t).cos() - 1.0]),
     )
 }
 
@@ -311,6 +314,57 @@ fn run() -> Result<(), String> {
             graze.p
         ));
     }
+    // At ω = 0.8 the stick-slip orbit's stick splits in two (adding-sliding) where the
+    // spring and forcing q = −x + F₀ cos ωt, along the stick x = x_s + u(t − t_s), touch
+    // the friction limit at an extremum (sin ωt = −u/(F₀ω)).
+    let w = 0.8;
+    let period = 2.0 * PI / w;
+    let build_w = |f0: f64| Ok(FilippovSimulation::new(belt_at(f0, w), Dopri5::new(tol2)));
+    let settings_w = SlidingContinuation::new(0.7, 0.95, 0.05, 0)
+        .and_then(|s| s.with_locate_tolerance(1e-12))
+        .map_err(|e| e.to_string())?;
+    let mut warm = build_w(0.75).map_err(|e: nonsmooth::orbit::OrbitError| e.to_string())?;
+    let x_w = warm
+        .run(0.0, SVector::from([0.5, 0.0]), 80.0 * period, &mut ())
+        .map_err(|e| e.to_string())?
+        .x;
+    let branch_w = follow_sliding(build_w, |_| period, 0.0, 0.75, x_w, tol6, &settings_w)
+        .map_err(|e| e.to_string())?;
+    let adding = branch_w
+        .bifurcations
+        .iter()
+        .find(|bif| bif.kind == SlidingBifurcationKind::AddingSliding)
+        .ok_or("no adding-sliding on the ω = 0.8 branch")?;
+    let mut sim = build_w(adding.p).map_err(|e| e.to_string())?;
+    let run = sim
+        .run(0.0, adding.state, period, &mut ())
+        .map_err(|e| e.to_string())?;
+    let r = -0.5 / (adding.p * w);
+    let mut touch = f64::INFINITY;
+    for entry in run
+        .transitions
+        .iter()
+        .filter(|tr| tr.kind == TransitionKind::SlidingEntry)
+    {
+        let q = |t: f64| -entry.x[0] - 0.5 * (t - entry.t) + adding.p * (w * t).cos();
+        for k in -1..3 {
+            for base in [r.asin(), PI - r.asin()] {
+                let t = (base + 2.0 * PI * f64::from(k)) / w;
+                if t > entry.t && t < entry.t + period {
+                    touch = touch.min((1.0 - q(t).abs()).abs());
+                }
+            }
+        }
+    }
+    println!(
+        "belt branch at ω = 0.8: AddingSliding at F₀ = {:.12}, 1 − |q| at the stick's extremum {touch:.1e}",
+        adding.p
+    );
+    if touch > 1e-8 {
+        failures.push(format!(
+            "adding-sliding: 1 − |q| = {touch:e} at the located orbit"
+        ));
+    }
     write_table_path(
         out.join("belt_branch.csv"),
         &["f0", "x0", "v0", "sliding_time", "mu1"],
@@ -336,7 +390,7 @@ fn run() -> Result<(), String> {
             .with(Series::dots(region.iter().map(|r| (r[1], r[2]))).color(Rgb::BLUE))
             .with(Series::dots(slide.iter().map(|r| (r[1], r[2]))).color(Rgb::RED));
         let mut diagram = Panel::new("F₀", "largest ẋ")
-            .title("belt oscillator: grazing-sliding (red), crossing-sliding (orange)")
+            .title("belt oscillator: grazing- (red), switching- (green), crossing-sliding (orange)")
             .with(Series::dots(rows.iter().map(|r| (r[0], r[1]))).color(Rgb::BLACK))
             .hline(0.5, Rgb::GRAY)
             .vline(b, Rgb::RED);
@@ -350,6 +404,8 @@ fn run() -> Result<(), String> {
         for bif in &branch.bifurcations {
             let color = match bif.kind {
                 SlidingBifurcationKind::GrazingSliding => Rgb::RED,
+                SlidingBifurcationKind::SwitchingSliding => Rgb::GREEN,
+                SlidingBifurcationKind::AddingSliding => Rgb::PURPLE,
                 _ => Rgb::ORANGE,
             };
             along = along.vline(bif.p, color);

@@ -70,8 +70,13 @@
 //! # Test functions
 //! The transitions carry what sliding bifurcations are located by: `α` at an exit (an exit
 //! at `α = 0` versus `1`), `h±` at an arrival (a crossing turning into a sliding entry where
-//! `h₊` changes sign: crossing-sliding), and a [`TransitionKind::Graze`] (the minimum of
-//! `H` along a region's orbit reaching zero: grazing-sliding).
+//! `h₊` changes sign: crossing- or switching-sliding, told apart by the sign of the far
+//! field's second-order rate [`second_rate`] there), and a [`TransitionKind::Graze`] (the
+//! minimum of `H` along a region's orbit reaching zero: grazing-sliding).
+//! [`FilippovSimulation::control_extrema`] finds the local extrema of the equivalent
+//! control `α` along the sliding flow (continued past the exit when asked for a longer
+//! span): where one touches its bound, a sliding segment splits in two (adding-sliding).
+//! The branches and their test functions are in [`orbit::sliding`](crate::orbit::sliding).
 //!
 //! # Dry friction: `StickSlip` is this path
 //! A mass whose coordinate rubs on a surface of velocity `u` with Coulomb friction of
@@ -131,6 +136,7 @@
 
 mod approach;
 mod error;
+mod extrema;
 mod field;
 mod friction;
 mod load;
@@ -141,6 +147,7 @@ mod tangent;
 
 pub use approach::Approach;
 pub use error::FilippovError;
+pub use extrema::{ControlExtremum, second_rate};
 pub use friction::DryFriction;
 pub use load::RelayLoad;
 pub use relay::LinearRelay;

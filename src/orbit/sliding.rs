@@ -19,16 +19,59 @@
 //!   [`Approach`]); positive while the orbit stays off the surface, zero where it grazes,
 //!   negative once it slides. (An orbit that crosses the surface has approach 0: this test
 //!   is for orbits that, without sliding, do not reach the surface.)
-//! - **crossing-sliding** (a crossing point of the orbit reaches the boundary of the
-//!   sliding region, where the far field is tangent, and the crossing turns into a short
-//!   sliding segment): over the orbit's arrivals at the surface from a region (crossings
-//!   and sliding entries, arriving from side `a` with `h_a ≠ 0`), the far-side rate signed
-//!   so that a crossing is positive,
+//! - **crossing-sliding** and **switching-sliding** (a point where the orbit arrives at
+//!   the surface from a region reaches the boundary of the sliding region, where the far
+//!   field `F_ā` is tangent, `h_ā = 0`, a fold of `F_ā`): over the orbit's arrivals at the
+//!   surface from a region (crossings and sliding entries, arriving from side `a` with
+//!   `h_a ≠ 0`), the far-side rate signed so that a crossing is positive,
 //!   $$ g_{\mathrm{cs}} = -\operatorname{sgn}(a)\, h_{\bar a}\quad\text{at the arrival with the smallest } |h_{\bar a}| , $$
 //!   positive for a crossing, negative for a sliding entry, zero where the arrival point is
 //!   on the boundary `h_ā = 0` of the sliding region. The field on the far side is
 //!   continuous there, so the arrival point, and `g_cs`, move continuously through the
-//!   bifurcation.
+//!   bifurcation. Which of the two it is depends on the fold, i.e. on the far field's
+//!   orbit through the arrival point, `H(τ) ≈ h_ā τ + ½ L²_{F_ā}H τ²`: with
+//!   $$ c = \operatorname{sgn}(\bar a)\, L^2_{F_{\bar a}} H, \qquad L^2_F H = \frac{d}{dt}\big(\nabla H\cdot F + \partial_t H\big) \text{ along } F $$
+//!   (by [`second_rate`]),
+//!   `c > 0` (a fold visible from the far region: its orbit moves away into it) makes a
+//!   **crossing-sliding**: on the crossing side the orbit goes on in the far region, on
+//!   the other it slides for a time `∝ |g_cs|` and leaves at the fold; `c < 0` (an
+//!   invisible fold: the far orbit turns back to the surface) makes a
+//!   **switching-sliding**: on the crossing side the orbit makes an excursion into the far
+//!   region of duration `≈ 2h_ā/|L²H| ∝ |g_cs|` and slides where it comes back (arriving
+//!   from `ā`, where `F_a` still pushes into the surface), on the other it slides at once.
+//! - **adding-sliding** (a sliding segment's exit point reaches a point of the boundary
+//!   of the sliding region where the departing field's orbit has a cubic tangency,
+//!   `h_b = 0` and `L²_{F_b}H = 0`; there the sliding flow is tangent to the boundary):
+//!   along each sliding segment the equivalent control `α` (exit into `H < 0` at `α = 0`,
+//!   into `H > 0` at `α = 1`) has local extrema, and
+//!   $$ g_{\mathrm{as}} = \min\!\big(\alpha, 1 - \alpha\big) \text{ at the extremum nearest to its bound}, $$
+//!   found by [`FilippovSimulation::control_extrema`] (zeros of `dα/dt` along the sliding
+//!   flow). To keep the test continuous, the sliding flow of a segment that exits into side
+//!   `b` and re-enters sliding from side `b` is continued past its exit (the sliding field
+//!   is defined while `h₋ > h₊`) up to the re-entry: its extremum there lies beyond the
+//!   bound and `g_as < 0`. So `g_as > 0` while the segment slides past the near-touch,
+//!   `0` where `α` touches its bound, `< 0` once the segment splits around an excursion,
+//!   whose duration grows as `√|g_as|`.
+//!
+//! The four are the sliding bifurcations of di Bernardo, Kowalczyk & Nordmark (2003) (and
+//! di Bernardo et al. 2008, §8.5): all occur where the orbit meets the fold of `F_b` that
+//! bounds the sliding region — crossing it (crossing- and switching-sliding, by the
+//! visibility of the fold), grazing at it (grazing-sliding), or sliding into a point of it
+//! where the fold changes visibility (adding-sliding; in the classification of Jeffrey &
+//! Hogan (2011) a cusp of the boundary's projection).
+//!
+//! # Autonomous orbits
+//! With [`SlidingContinuation::autonomous`] the period is an unknown of each shooting
+//! ([`FilippovSimulation::find_orbit`] with the phase fixed by the section through the
+//! guess normal to the field there), seeded by the secant extrapolation of the last two
+//! periods; [`SlidingBranchPoint::period`] records it and the tests run over it.
+//!
+//! # Folds
+//! [`follow_sliding`] steps in `p` and cannot pass a turning point of the branch;
+//! [`follow_sliding_arclength`] follows the curve `φ(x; p) = x` in `(x, p)` by
+//! pseudo-arclength (tangent from `[Φ − I, ∂φ/∂p]`, `Φ` with the saltation matrices, so
+//! through crossings and sliding) and locates folds as zeros of the tangent's
+//! `p`-component, where a Floquet multiplier is 1.
 //!
 //! A sign change of a test between two grid points is located by the Illinois method in
 //! `p` (each trial a shooting from the interpolated state) to the settings' tolerance, and
@@ -42,13 +85,15 @@
 //! Kuznetsov, *SlideCont: an Auto97 driver for bifurcation analysis of Filippov systems*,
 //! ACM TOMS 31(1), 2005 (their test functions); M. di Bernardo, P. Kowalczyk, A. Nordmark,
 //! *Sliding bifurcations: a novel mechanism for the sudden onset of chaos in dry friction
-//! oscillators*, IJBC 13(10), 2003.
+//! oscillators*, IJBC 13(10), 2003; M. R. Jeffrey, S. J. Hogan, *The geometry of generic
+//! sliding bifurcations*, SIAM Review 53(3), 2011.
 
 use nalgebra::{Complex, SVector};
 
 use super::{BranchEnd, OrbitError, Result};
 use crate::filippov::{
-    Approach, Filippov, FilippovSimulation, SlidingOrbit, Transition, TransitionKind,
+    Approach, Filippov, FilippovRun, FilippovSimulation, Side, SlidingOrbit, Transition,
+    TransitionKind, second_rate,
 };
 use crate::integrate::{Stepper, Tolerances};
 
@@ -63,6 +108,7 @@ pub struct SlidingContinuation {
     xtol: f64,
     max_iterations: usize,
     max_points: usize,
+    autonomous: bool,
 }
 
 impl SlidingContinuation {
@@ -94,6 +140,7 @@ impl SlidingContinuation {
             xtol: 1e-11,
             max_iterations: 30,
             max_points: 10_000,
+            autonomous: false,
         })
     }
 
@@ -143,6 +190,30 @@ impl SlidingContinuation {
     }
 }
 
+impl SlidingContinuation {
+    /// Orbits of an autonomous system: the period is an unknown of the shooting (its guess
+    /// at the first point is `period(p₀)`, later the secant extrapolation of the last two
+    /// periods), the phase fixed by the section through the guess normal to the field
+    /// there (see [`FilippovSimulation::find_orbit`]). Default: forced (the period is
+    /// `period(p)`).
+    pub fn autonomous(mut self) -> Self {
+        self.autonomous = true;
+        self
+    }
+}
+
+/// [`OrbitError::InvalidSetting`] for a tested surface the system lacks.
+fn check_surface<const S: usize>(settings: &SlidingContinuation) -> Result<()> {
+    if settings.surface >= S {
+        return Err(invalid(
+            "the tested surface",
+            "< S (the number of surfaces)",
+            settings.surface as f64,
+        ));
+    }
+    Ok(())
+}
+
 fn invalid(what: &'static str, requirement: &'static str, value: f64) -> OrbitError {
     OrbitError::InvalidSetting {
         what,
@@ -159,6 +230,15 @@ pub struct SlidingTests {
     /// `g_cs`: the signed far-side rate at the arrival nearest to the boundary of the
     /// sliding region; `None` if the orbit never arrives at the surface from a region.
     pub crossing_sliding: Option<f64>,
+    /// `c = s_ā L²_{F_ā}H` at that arrival (`ā` the far side, `s_ā = ±1` its sign): where
+    /// `g_cs = 0`, positive if the far field's orbit through the arrival point moves into
+    /// the far region (a visible fold: crossing-sliding), negative if it turns back to the
+    /// surface (an invisible fold: switching-sliding).
+    pub crossing_curvature: Option<f64>,
+    /// `g_as`: the margin `α` or `1 − α` at the local extremum of the equivalent control
+    /// along a sliding segment (continued past its exit up to a re-entry from the side it
+    /// left to) nearest to its bound; `None` if there is no such extremum.
+    pub adding_sliding: Option<f64>,
     /// The number of sliding segments on the surface over one period.
     pub sliding_segments: usize,
     /// The time spent sliding on the surface over one period.
@@ -172,6 +252,8 @@ pub struct SlidingBranchPoint<const N: usize> {
     pub p: f64,
     /// The orbit's state at the section time.
     pub state: SVector<f64, N>,
+    /// The period (the forcing period, or an autonomous orbit's).
+    pub period: f64,
     /// The Floquet multipliers, largest modulus first.
     pub multipliers: Vec<Complex<f64>>,
     /// The test functions.
@@ -183,8 +265,17 @@ pub struct SlidingBranchPoint<const N: usize> {
 pub enum SlidingBifurcationKind {
     /// An orbit off the surface grazes it in the sliding region (`g_gs = 0`).
     GrazingSliding,
-    /// A crossing point reaches the boundary of the sliding region (`g_cs = 0`).
+    /// A crossing point reaches the boundary of the sliding region (`g_cs = 0`) at a fold
+    /// of the far field that is visible from the far region (`c > 0`): a crossing turns
+    /// into a short sliding segment.
     CrossingSliding,
+    /// A crossing point reaches the boundary of the sliding region (`g_cs = 0`) at an
+    /// invisible fold of the far field (`c < 0`): the excursion into the far region
+    /// between a crossing and a sliding entry from the far side shrinks to nothing.
+    SwitchingSliding,
+    /// The equivalent control along a sliding segment touches its bound at a local
+    /// extremum (`g_as = 0`): a sliding segment splits in two around a short excursion.
+    AddingSliding,
 }
 
 /// A sliding bifurcation located on a branch.
@@ -220,7 +311,7 @@ struct Evaluated<const N: usize> {
 }
 
 /// Evaluates the sliding tests of an orbit of `sim` on surface `i` over one period from
-/// `(t0, x0)`.
+/// `(t0, x0)` (the system must be periodic in `t` with that period, or autonomous).
 ///
 /// # Errors
 /// The errors of the run ([`OrbitError::Filippov`], [`OrbitError::Run`]).
@@ -233,22 +324,108 @@ pub fn sliding_tests<Sys, St, const N: usize, const S: usize>(
 ) -> Result<SlidingTests>
 where
     Sys: Filippov<f64, N, S> + Clone,
-    St: Stepper<f64, N>,
+    St: Stepper<f64, N> + Clone,
 {
     let system = sim.system().clone();
     let mut approach = Approach::new(&system, surface, t0, 8);
     let run = sim.run(t0, x0, t0 + period, &mut approach)?;
-    Ok(tests_of_run(
+    let mut tests = tests_of_run(
         &system,
         surface,
         &run.transitions,
         run.start_mode.sliding == Some(surface),
         (t0, run.t),
         approach.closest.map(|c| c.0),
-    ))
+    );
+    tests.adding_sliding = adding_test(sim, surface, &run, (t0, x0));
+    Ok(tests)
 }
 
-/// The tests from a run's transitions and the closest approach of its region steps.
+/// A sliding segment's start and the end of the window its extrema are sought in.
+struct Window<const N: usize, const S: usize> {
+    t: f64,
+    x: SVector<f64, N>,
+    sides: [Side; S],
+    end: f64,
+}
+
+/// `g_as` of a run over one period: the extremum of `α` nearest to its bound over every
+/// sliding segment on `surface`, each continued past its exit up to a re-entry from the
+/// side it left to (a segment open at the period's end is continued into the next period
+/// up to the end of the first segment's window). A window whose integration fails offers
+/// no candidate.
+fn adding_test<Sys, St, const N: usize, const S: usize>(
+    sim: &FilippovSimulation<f64, Sys, St>,
+    surface: usize,
+    run: &FilippovRun<f64, N, S>,
+    (t0, x0): (f64, SVector<f64, N>),
+) -> Option<f64>
+where
+    Sys: Filippov<f64, N, S>,
+    St: Stepper<f64, N> + Clone,
+{
+    let all = &run.transitions;
+    let mut windows: Vec<Window<N, S>> = Vec::new();
+    let starts_sliding = run.start_mode.sliding == Some(surface);
+    let mut open = starts_sliding.then_some((t0, x0, run.start_mode.sides));
+    // The end of the window of the segment open at t0, if it closes within the period.
+    let mut first_end = None;
+    for (k, tr) in all.iter().enumerate() {
+        let slides_after = tr.to.sliding == Some(surface);
+        let slid_before = tr.from.sliding == Some(surface);
+        if slides_after && !slid_before {
+            open = Some((tr.t, tr.x, tr.to.sides));
+        } else if slid_before
+            && !slides_after
+            && let Some((t, x, sides)) = open.take()
+        {
+            let side = tr.to.sides[surface];
+            let end = match all.get(k + 1) {
+                Some(next)
+                    if next.surface == surface
+                        && next.kind == TransitionKind::SlidingEntry
+                        && next.from.sides[surface] == side =>
+                {
+                    next.t
+                }
+                _ => tr.t,
+            };
+            if t == t0 && starts_sliding && first_end.is_none() && windows.is_empty() {
+                first_end = Some(end);
+            }
+            windows.push(Window { t, x, sides, end });
+        }
+    }
+    if let Some((t, x, sides)) = open {
+        // Open at the end: continued over the period boundary (the first segment's window
+        // is then a part of this one).
+        let end = match first_end {
+            Some(e) => {
+                windows.retain(|w| w.t != t0);
+                run.t + (e - t0)
+            }
+            None => run.t,
+        };
+        windows.push(Window { t, x, sides, end });
+    }
+    let mut best: Option<f64> = None;
+    for w in windows.iter().filter(|w| w.end > w.t) {
+        // A window whose continued sliding flow cannot be integrated (it left the domain
+        // where h₋ > h₊ far from the surface) offers no candidate.
+        let Ok(extrema) = sim.control_extrema(surface, w.sides, w.t, w.x, w.end) else {
+            continue;
+        };
+        for e in extrema {
+            if e.t > w.t && e.t < w.end && best.is_none_or(|b| e.margin.abs() < b.abs()) {
+                best = Some(e.margin);
+            }
+        }
+    }
+    best
+}
+
+/// The tests from a run's transitions and the closest approach of its region steps
+/// (all but `g_as`).
 fn tests_of_run<Sys, const N: usize, const S: usize>(
     system: &Sys,
     surface: usize,
@@ -264,7 +441,7 @@ where
     let mut sliding_time = 0.0;
     let mut segments = 0usize;
     let mut since = if starts_sliding { Some(t0) } else { None };
-    let mut crossing: Option<f64> = None;
+    let mut crossing: Option<(f64, f64)> = None;
     for tr in transitions.iter().filter(|tr| tr.surface == surface) {
         let slides_after = tr.to.sliding == Some(surface);
         let slid_before = tr.from.sliding == Some(surface);
@@ -292,8 +469,10 @@ where
             let h = system.gradient(surface, tr.t, &tr.x).dot(&f)
                 + system.surface_time_rate(surface, tr.t, &tr.x);
             let c = -a.sign::<f64>() * h;
-            if c.is_finite() && crossing.is_none_or(|best| c.abs() < best.abs()) {
-                crossing = Some(c);
+            if c.is_finite() && crossing.is_none_or(|best| c.abs() < best.0.abs()) {
+                let curvature =
+                    a.flip().sign::<f64>() * second_rate(system, surface, &far, tr.t, &tr.x);
+                crossing = Some((c, curvature));
             }
         }
     }
@@ -310,7 +489,9 @@ where
     };
     SlidingTests {
         grazing_sliding,
-        crossing_sliding: crossing,
+        crossing_sliding: crossing.map(|c| c.0),
+        crossing_curvature: crossing.map(|c| c.1),
+        adding_sliding: None,
         sliding_segments: segments,
         sliding_time,
     }
@@ -331,22 +512,23 @@ impl<B, P> Problem<'_, B, P> {
     fn evaluate<Sys, St, const N: usize, const S: usize, const M: usize>(
         &self,
         p: f64,
-        guess: SVector<f64, N>,
+        (guess, period_guess): (SVector<f64, N>, f64),
         tol: Tolerances<f64, M>,
     ) -> Result<Evaluated<N>>
     where
         B: Fn(f64) -> Result<FilippovSimulation<f64, Sys, St>>,
         P: Fn(f64) -> f64,
         Sys: Filippov<f64, N, S> + Clone,
-        St: Stepper<f64, N>,
+        St: Stepper<f64, N> + Clone,
     {
         let mut sim = (self.build)(p)?;
-        let period = (self.period)(p);
+        let auto = self.settings.autonomous;
+        let period = if auto { period_guess } else { (self.period)(p) };
         let orbit: SlidingOrbit<f64, N, S> = sim.find_orbit(
             self.t0,
             guess,
             period,
-            false,
+            auto,
             tol,
             self.settings.xtol,
             self.settings.max_iterations,
@@ -356,12 +538,13 @@ impl<B, P> Problem<'_, B, P> {
             self.settings.surface,
             self.t0,
             orbit.state,
-            period,
+            orbit.period,
         )?;
         Ok(Evaluated {
             point: SlidingBranchPoint {
                 p,
                 state: orbit.state,
+                period: orbit.period,
                 multipliers: orbit
                     .monodromy
                     .multipliers()
@@ -385,7 +568,7 @@ impl<B, P> Problem<'_, B, P> {
         B: Fn(f64) -> Result<FilippovSimulation<f64, Sys, St>>,
         P: Fn(f64) -> f64,
         Sys: Filippov<f64, N, S> + Clone,
-        St: Stepper<f64, N>,
+        St: Stepper<f64, N> + Clone,
     {
         let (Some(mut fa), Some(mut fb)) = (test(&a.tests), test(&b.tests)) else {
             return Ok(None);
@@ -394,7 +577,7 @@ impl<B, P> Problem<'_, B, P> {
             return Ok(None);
         }
         let (mut pa, mut pb) = (a.p, b.p);
-        let (mut xa, mut xb) = (a.state, b.state);
+        let (mut xa, mut xb) = ((a.state, a.period), (b.state, b.period));
         let mut best = if fb.abs() < fa.abs() {
             (b.clone(), fb)
         } else {
@@ -412,22 +595,26 @@ impl<B, P> Problem<'_, B, P> {
                 pc = 0.5 * (pa + pb);
             }
             let w = (pc - pa) / (pb - pa);
-            let guess = xa + (xb - xa) * w;
+            let guess = (xa.0 + (xb.0 - xa.0) * w, xa.1 + (xb.1 - xa.1) * w);
             let ev = match self.evaluate::<Sys, St, N, S, M>(pc, guess, tol) {
                 Ok(ev) => ev,
                 // A failed shooting inside the bracket (e.g. a start at a tangency): try
                 // the midpoint, else report the bracket reached so far.
                 Err(_) if pc != 0.5 * (pa + pb) => {
                     let pm = 0.5 * (pa + pb);
-                    match self.evaluate::<Sys, St, N, S, M>(pm, xa + (xb - xa) * 0.5, tol) {
+                    match self.evaluate::<Sys, St, N, S, M>(
+                        pm,
+                        (xa.0 + (xb.0 - xa.0) * 0.5, 0.5 * (xa.1 + xb.1)),
+                        tol,
+                    ) {
                         Ok(ev) => {
                             let Some(fm) = test(&ev.point.tests) else {
                                 return Ok(None);
                             };
                             if fm.signum() == fa.signum() {
-                                (pa, fa, xa) = (pm, fm, ev.point.state);
+                                (pa, fa, xa) = (pm, fm, (ev.point.state, ev.point.period));
                             } else {
-                                (pb, fb, xb) = (pm, fm, ev.point.state);
+                                (pb, fb, xb) = (pm, fm, (ev.point.state, ev.point.period));
                             }
                             best = (ev.point, fm);
                             side = 0;
@@ -441,7 +628,7 @@ impl<B, P> Problem<'_, B, P> {
             let Some(fc) = test(&ev.point.tests) else {
                 return Ok(None);
             };
-            let state = ev.point.state;
+            let state = (ev.point.state, ev.point.period);
             best = (ev.point, fc);
             if fc == 0.0 {
                 pa = pc;
@@ -463,6 +650,18 @@ impl<B, P> Problem<'_, B, P> {
             }
         }
         Ok(Some((best.0, best.1, (pa, pb))))
+    }
+}
+
+/// The test function whose zero is a bifurcation of `kind` (`g_cs` for both crossing- and
+/// switching-sliding).
+fn test_of(kind: SlidingBifurcationKind) -> fn(&SlidingTests) -> Option<f64> {
+    match kind {
+        SlidingBifurcationKind::GrazingSliding => |t| Some(t.grazing_sliding),
+        SlidingBifurcationKind::CrossingSliding | SlidingBifurcationKind::SwitchingSliding => {
+            |t| t.crossing_sliding
+        }
+        SlidingBifurcationKind::AddingSliding => |t| t.adding_sliding,
     }
 }
 
@@ -498,22 +697,16 @@ where
     B: Fn(f64) -> Result<FilippovSimulation<f64, Sys, St>>,
     P: Fn(f64) -> f64,
     Sys: Filippov<f64, N, S> + Clone,
-    St: Stepper<f64, N>,
+    St: Stepper<f64, N> + Clone,
 {
-    if settings.surface >= S {
-        return Err(invalid(
-            "the tested surface",
-            "< S (the number of surfaces)",
-            settings.surface as f64,
-        ));
-    }
+    check_surface::<S>(settings)?;
     let problem = Problem {
         build: &build,
         period: &period,
         t0,
         settings,
     };
-    let first = problem.evaluate::<Sys, St, N, S, M>(p0, guess, tol)?;
+    let first = problem.evaluate::<Sys, St, N, S, M>(p0, (guess, period(p0)), tol)?;
     let mut points = vec![first.point];
     let mut bifurcations = Vec::new();
     let mut k = 1usize;
@@ -529,32 +722,39 @@ where
         let last = &points[n - 1];
         let guess = if n >= 2 {
             let prev = &points[n - 2];
-            last.state + (last.state - prev.state) * ((p - last.p) / (last.p - prev.p))
+            let w = (p - last.p) / (last.p - prev.p);
+            (
+                last.state + (last.state - prev.state) * w,
+                last.period + (last.period - prev.period) * w,
+            )
         } else {
-            last.state
+            (last.state, last.period)
         };
         let Ok(ev) = problem
             .evaluate::<Sys, St, N, S, M>(p, guess, tol)
-            .or_else(|_| problem.evaluate::<Sys, St, N, S, M>(p, last.state, tol))
+            .or_else(|_| problem.evaluate::<Sys, St, N, S, M>(p, (last.state, last.period), tol))
         else {
             break BranchEnd::StepTooSmall { p: last.p };
         };
         let b = ev.point;
-        for (kind, test) in [
-            (
-                SlidingBifurcationKind::GrazingSliding,
-                (|t: &SlidingTests| Some(t.grazing_sliding)) as fn(&SlidingTests) -> Option<f64>,
-            ),
-            (
-                SlidingBifurcationKind::CrossingSliding,
-                |t: &SlidingTests| t.crossing_sliding,
-            ),
+        for kind in [
+            SlidingBifurcationKind::GrazingSliding,
+            SlidingBifurcationKind::CrossingSliding,
+            SlidingBifurcationKind::AddingSliding,
         ] {
+            let test = test_of(kind);
             let (fa, fb) = (test(&last.tests), test(&b.tests));
             if let Some((at, value, bracket)) =
                 problem.locate::<Sys, St, N, S, M>(last, &b, test, tol)?
                 && is_zero(value, fa, fb)
             {
+                // g_cs = 0 at a visible or an invisible fold of the far field.
+                let kind = match (kind, at.tests.crossing_curvature) {
+                    (SlidingBifurcationKind::CrossingSliding, Some(c)) if c < 0.0 => {
+                        SlidingBifurcationKind::SwitchingSliding
+                    }
+                    _ => kind,
+                };
                 bifurcations.push(SlidingBifurcation {
                     kind,
                     p: at.p,
@@ -572,4 +772,343 @@ where
         bifurcations,
         end,
     })
+}
+
+/// A fold (turning point in `p`) located on a branch of [`follow_sliding_arclength`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct SlidingFold<const N: usize> {
+    /// The index in [`SlidingArcBranch::points`] of the last point before the fold.
+    pub after: usize,
+    /// The parameter at the fold (an extremum of `p` along the branch).
+    pub p: f64,
+    /// The orbit there.
+    pub state: SVector<f64, N>,
+    /// The `p`-component of the unit tangent there (zero up to the location tolerance).
+    pub tangent_p: f64,
+    /// The Floquet multipliers there (one of them is 1 at a fold).
+    pub multipliers: Vec<Complex<f64>>,
+}
+
+/// A branch followed by pseudo-arclength ([`follow_sliding_arclength`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SlidingArcBranch<const N: usize> {
+    /// The points in order of arclength.
+    pub points: Vec<SlidingBranchPoint<N>>,
+    /// The folds, in order of arclength.
+    pub folds: Vec<SlidingFold<N>>,
+    /// Why it ended.
+    pub end: BranchEnd,
+}
+
+/// A corrected point of the arclength continuation: `z = (x, p)`, its unit tangent and the
+/// monodromy's multipliers.
+struct ArcPoint<const N: usize> {
+    x: SVector<f64, N>,
+    p: f64,
+    tangent: nalgebra::DVector<f64>,
+    multipliers: Vec<Complex<f64>>,
+}
+
+impl<B, P> Problem<'_, B, P> {
+    /// The period map's residual `φ(x; p) − x`, its Jacobian `[Φ − I, ∂φ/∂p]` (`∂φ/∂p` by a
+    /// central difference in `p`, the period `period(p)` included) and the multipliers.
+    #[allow(clippy::type_complexity)]
+    fn residual<Sys, St, const N: usize, const S: usize, const M: usize>(
+        &self,
+        x: &SVector<f64, N>,
+        p: f64,
+        tol: Tolerances<f64, M>,
+    ) -> Result<(SVector<f64, N>, nalgebra::DMatrix<f64>, Vec<Complex<f64>>)>
+    where
+        B: Fn(f64) -> Result<FilippovSimulation<f64, Sys, St>>,
+        P: Fn(f64) -> f64,
+        Sys: Filippov<f64, N, S>,
+        St: Stepper<f64, N>,
+    {
+        let mut sim = (self.build)(p)?;
+        let mono = sim.monodromy(self.t0, *x, self.t0 + (self.period)(p), tol)?;
+        let r = mono.run.x - x;
+        let h = 1e-6 * p.abs().max(1.0);
+        let end = |q: f64| -> Result<SVector<f64, N>> {
+            let mut sim = (self.build)(q)?;
+            Ok(sim.run(self.t0, *x, self.t0 + (self.period)(q), &mut ())?.x)
+        };
+        let dp = (end(p + h)? - end(p - h)?) / (2.0 * h);
+        let mut j = nalgebra::DMatrix::<f64>::zeros(N, N + 1);
+        for i in 0..N {
+            for k in 0..N {
+                j[(i, k)] = mono.matrix[(i, k)];
+            }
+            j[(i, i)] -= 1.0;
+            j[(i, N)] = dp[i];
+        }
+        let multipliers = mono
+            .multipliers()
+            .into_iter()
+            .map(|m| Complex::new(m.re, m.im))
+            .collect();
+        Ok((r, j, multipliers))
+    }
+
+    /// The unit tangent at a solution: the null vector of `[Φ − I, ∂φ/∂p]`, oriented along
+    /// `previous`.
+    fn tangent<const N: usize>(
+        j: &nalgebra::DMatrix<f64>,
+        previous: &nalgebra::DVector<f64>,
+    ) -> Option<nalgebra::DVector<f64>> {
+        let mut a = nalgebra::DMatrix::<f64>::zeros(N + 1, N + 1);
+        a.view_mut((0, 0), (N, N + 1)).copy_from(j);
+        for k in 0..=N {
+            a[(N, k)] = previous[k];
+        }
+        let mut rhs = nalgebra::DVector::<f64>::zeros(N + 1);
+        rhs[N] = 1.0;
+        let t = a.lu().solve(&rhs)?;
+        let n = t.norm();
+        (n.is_finite() && n > 0.0).then(|| t / n)
+    }
+
+    /// Newton's method on `φ(x; p) − x = 0`, `τ·(z − z_pred) = 0` from the prediction
+    /// `z_pred = z + σ τ`, then the tangent there.
+    fn correct<Sys, St, const N: usize, const S: usize, const M: usize>(
+        &self,
+        from: &ArcPoint<N>,
+        sigma: f64,
+        tol: Tolerances<f64, M>,
+    ) -> Result<(ArcPoint<N>, usize)>
+    where
+        B: Fn(f64) -> Result<FilippovSimulation<f64, Sys, St>>,
+        P: Fn(f64) -> f64,
+        Sys: Filippov<f64, N, S>,
+        St: Stepper<f64, N>,
+    {
+        let tau = &from.tangent;
+        let mut x = from.x + SVector::<f64, N>::from_fn(|i, _| sigma * tau[i]);
+        let mut p = from.p + sigma * tau[N];
+        let (x_pred, p_pred) = (x, p);
+        for it in 0..self.settings.max_iterations {
+            let (r, j, _) = self.residual::<Sys, St, N, S, M>(&x, p, tol)?;
+            let mut a = nalgebra::DMatrix::<f64>::zeros(N + 1, N + 1);
+            a.view_mut((0, 0), (N, N + 1)).copy_from(&j);
+            let mut b = nalgebra::DVector::<f64>::zeros(N + 1);
+            let mut arc = 0.0;
+            for k in 0..N {
+                a[(N, k)] = tau[k];
+                b[k] = -r[k];
+                arc += tau[k] * (x[k] - x_pred[k]);
+            }
+            a[(N, N)] = tau[N];
+            b[N] = -(arc + tau[N] * (p - p_pred));
+            let Some(d) = a.lu().solve(&b) else {
+                return Err(crate::filippov::FilippovError::Singular { iteration: it }.into());
+            };
+            for k in 0..N {
+                x[k] += d[k];
+            }
+            p += d[N];
+            if !(p.is_finite() && x.iter().all(|v| v.is_finite())) {
+                break;
+            }
+            if d.amax() <= self.settings.xtol * (1.0 + x.amax().max(p.abs())) {
+                let (_, j, multipliers) = self.residual::<Sys, St, N, S, M>(&x, p, tol)?;
+                let Some(tangent) = Self::tangent::<N>(&j, tau) else {
+                    return Err(crate::filippov::FilippovError::Singular { iteration: it }.into());
+                };
+                return Ok((
+                    ArcPoint {
+                        x,
+                        p,
+                        tangent,
+                        multipliers,
+                    },
+                    it + 1,
+                ));
+            }
+        }
+        Err(crate::filippov::FilippovError::NoConvergence {
+            iterations: self.settings.max_iterations,
+            residual: f64::NAN,
+            step: f64::NAN,
+        }
+        .into())
+    }
+
+    /// The fold between `a` and the point at arclength `sigma` from it (their tangents'
+    /// `p`-components of opposite signs): the zero of the `p`-component of the tangent, by
+    /// the Illinois method in the arclength from `a`.
+    fn locate_fold<Sys, St, const N: usize, const S: usize, const M: usize>(
+        &self,
+        a: &ArcPoint<N>,
+        b: &ArcPoint<N>,
+        sigma: f64,
+        tol: Tolerances<f64, M>,
+    ) -> Result<ArcPoint<N>>
+    where
+        B: Fn(f64) -> Result<FilippovSimulation<f64, Sys, St>>,
+        P: Fn(f64) -> f64,
+        Sys: Filippov<f64, N, S>,
+        St: Stepper<f64, N>,
+    {
+        let (mut sa, mut fa) = (0.0, a.tangent[N]);
+        let (mut sb, mut fb) = (sigma, b.tangent[N]);
+        let mut best: Option<ArcPoint<N>> = None;
+        let mut side = 0i8;
+        let width = self.settings.locate_tolerance * sigma.abs().max(1.0);
+        for _ in 0..100 {
+            if (sb - sa).abs() <= width {
+                break;
+            }
+            let mut sc = sb - fb * (sb - sa) / (fb - fa);
+            if !(sc > sa.min(sb) && sc < sa.max(sb)) {
+                sc = 0.5 * (sa + sb);
+            }
+            let (c, _) = self.correct::<Sys, St, N, S, M>(a, sc, tol)?;
+            let fc = c.tangent[N];
+            let done = fc == 0.0;
+            best = Some(c);
+            if done {
+                break;
+            }
+            if fc.signum() == fb.signum() {
+                (sb, fb) = (sc, fc);
+                if side == 1 {
+                    fa *= 0.5;
+                }
+                side = 1;
+            } else {
+                (sa, fa) = (sc, fc);
+                if side == -1 {
+                    fb *= 0.5;
+                }
+                side = -1;
+            }
+        }
+        match best {
+            Some(c) => Ok(c),
+            None => self
+                .correct::<Sys, St, N, S, M>(a, 0.5 * sigma, tol)
+                .map(|c| c.0),
+        }
+    }
+}
+
+/// Follows the periodic orbit of a forced Filippov system through `guess` at `p0` by
+/// **pseudo-arclength continuation** in `(x, p)`, so that the branch passes folds
+/// (turning points in `p`), and locates the folds.
+///
+/// # Method
+/// With `φ(x; p)` the state after one forcing period `period(p)` from `(t0, x)` (through
+/// crossings and sliding), the branch is the curve `R(x, p) = φ(x; p) − x = 0` in
+/// `ℝ^{N+1}`, followed from `z_k = (x_k, p_k)` with unit tangent `τ_k` (the null vector of
+/// `[Φ − I, ∂φ/∂p]`, `Φ` the monodromy with saltation matrices, `∂φ/∂p` a central
+/// difference) by the predictor `z_k + Δs τ_k` and Newton's method on
+/// $$ \begin{pmatrix} \Phi - I & \partial_p\varphi \\ \tau_k^{\mathsf T} \end{pmatrix}
+///    \Delta z = -\begin{pmatrix} R \\ \tau_k\cdot(z - z_k) - \Delta s \end{pmatrix}. $$
+/// `Δs` starts at `|step|` of the settings (the first tangent points to increasing `p` for
+/// `step > 0`), is halved when the corrector fails (the branch ends below `10⁻⁴|step|`)
+/// and grows by 1.5 after a corrector of at most 3 iterations (up to `4|step|`).
+///
+/// A **fold** is a zero of the tangent's `p`-component `τ_p` (there `Φ − I` is singular:
+/// a Floquet multiplier 1); a sign change of `τ_p` between two points is located by the
+/// Illinois method in the arclength to the settings' locate tolerance (relative to the
+/// step). The sliding tests of each point are evaluated as in [`follow_sliding`]; the
+/// sliding bifurcations are not located on this branch (use [`follow_sliding`] on a
+/// part of the branch that does not fold).
+///
+/// # Errors
+/// [`OrbitError::InvalidSetting`] for a tested surface `≥ S` or autonomous settings (not
+/// supported here); the errors of the first orbit. A corrector that fails down to the
+/// smallest step ends the branch ([`BranchEnd::StepTooSmall`]).
+pub fn follow_sliding_arclength<Sys, St, B, P, const N: usize, const S: usize, const M: usize>(
+    build: B,
+    period: P,
+    t0: f64,
+    p0: f64,
+    guess: SVector<f64, N>,
+    tol: Tolerances<f64, M>,
+    settings: &SlidingContinuation,
+) -> Result<SlidingArcBranch<N>>
+where
+    B: Fn(f64) -> Result<FilippovSimulation<f64, Sys, St>>,
+    P: Fn(f64) -> f64,
+    Sys: Filippov<f64, N, S> + Clone,
+    St: Stepper<f64, N> + Clone,
+{
+    check_surface::<S>(settings)?;
+    if settings.autonomous {
+        return Err(invalid(
+            "autonomous orbits in arclength continuation",
+            "a forced system",
+            1.0,
+        ));
+    }
+    let problem = Problem {
+        build: &build,
+        period: &period,
+        t0,
+        settings,
+    };
+    let first = problem.evaluate::<Sys, St, N, S, M>(p0, (guess, period(p0)), tol)?;
+    let (_, j, _) = problem.residual::<Sys, St, N, S, M>(&first.point.state, p0, tol)?;
+    let mut along_p = nalgebra::DVector::<f64>::zeros(N + 1);
+    along_p[N] = settings.step.signum();
+    let Some(tangent) = Problem::<B, P>::tangent::<N>(&j, &along_p) else {
+        return Err(crate::filippov::FilippovError::Singular { iteration: 0 }.into());
+    };
+    let point_of = |c: &ArcPoint<N>| -> Result<SlidingBranchPoint<N>> {
+        let mut sim = build(c.p)?;
+        let tests = sliding_tests(&mut sim, settings.surface, t0, c.x, period(c.p))?;
+        Ok(SlidingBranchPoint {
+            p: c.p,
+            state: c.x,
+            period: period(c.p),
+            multipliers: c.multipliers.clone(),
+            tests,
+        })
+    };
+    let mut current = ArcPoint {
+        x: first.point.state,
+        p: p0,
+        tangent,
+        multipliers: first.point.multipliers.clone(),
+    };
+    let mut points = vec![first.point];
+    let mut folds = Vec::new();
+    let ds_max = 4.0 * settings.step.abs();
+    let ds_min = 1e-4 * settings.step.abs();
+    let mut ds = settings.step.abs();
+    let end = loop {
+        if points.len() >= settings.max_points {
+            break BranchEnd::MaxPoints;
+        }
+        let (next, iterations) = match problem.correct::<Sys, St, N, S, M>(&current, ds, tol) {
+            Ok(c) => c,
+            Err(_) => {
+                ds *= 0.5;
+                if ds < ds_min {
+                    break BranchEnd::StepTooSmall { p: current.p };
+                }
+                continue;
+            }
+        };
+        if next.p < settings.lo || next.p > settings.hi {
+            break BranchEnd::ParameterRange;
+        }
+        if next.tangent[N].signum() != current.tangent[N].signum() {
+            let fold = problem.locate_fold::<Sys, St, N, S, M>(&current, &next, ds, tol)?;
+            folds.push(SlidingFold {
+                after: points.len() - 1,
+                p: fold.p,
+                state: fold.x,
+                tangent_p: fold.tangent[N],
+                multipliers: fold.multipliers,
+            });
+        }
+        points.push(point_of(&next)?);
+        current = next;
+        if iterations <= 3 {
+            ds = (ds * 1.5).min(ds_max);
+        }
+    };
+    Ok(SlidingArcBranch { points, folds, end })
 }
