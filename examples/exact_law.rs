@@ -107,7 +107,9 @@ use std::time::Instant;
 use nalgebra::Vector2;
 use nonsmooth::drive::{Control, EventRecord, Observer, Simulation, StepView};
 use nonsmooth::event::{Direction, Event, Stop};
-use nonsmooth::integrate::{DenseOutput, Dop853, Dopri5, Stats, Stepper, Tolerances};
+use nonsmooth::integrate::{
+    CuspSwitch, DenseOutput, Dop853, Dopri5, Stats, Stepper, Tolerances,
+};
 use nonsmooth::systems::paper::{PAPER, PaperParameters};
 
 /// The frequency of the comparison workloads W1 and W2 (chaotic attractor).
@@ -564,8 +566,120 @@ fn exact_check(omega: f64, y0: Vector2<f64>, h: u32) -> nonsmooth::Result<()> {
     Ok(())
 }
 
+/// The band of velocities in which [`CuspSwitch`] probes the cusp's stiffness (m/s).
+const CUSP_BAND: f64 = 1e-6;
+
+fn band() -> f64 {
+    std::env::var("CUSP_BAND").ok().and_then(|s| s.parse().ok()).unwrap_or(CUSP_BAND)
+}
+
+/// `reps` runs of one stepper (built by `make`): the work and the mean thread CPU time
+/// (fastest wall time without a CPU clock), as [`timed_dopri5`].
+#[allow(clippy::too_many_arguments)]
+fn timed<St: Stepper<f64, 2>>(
+    p: &PaperParameters,
+    omega: f64,
+    k0: u32,
+    y0: Vector2<f64>,
+    periods: u32,
+    reps: usize,
+    make: impl Fn() -> nonsmooth::Result<St>,
+) -> nonsmooth::Result<Run> {
+    let cpu = thread_cpu().is_some();
+    let mut run = simulate(p, omega, k0, y0, periods, make()?)?;
+    let mut total = run.seconds;
+    for _ in 1..reps {
+        let r = simulate(p, omega, k0, y0, periods, make()?)?;
+        total += r.seconds;
+        run.seconds = run.seconds.min(r.seconds);
+    }
+    if cpu {
+        run.seconds = total / reps as f64;
+    }
+    Ok(run)
+}
+
+/// The implicit cusp step on the exact law: W1 and the creeping regimes, each against
+/// `η = 1e-8` with DOPRI5 (evaluations and time, one run).
+fn cusp_table(reps: usize, w1_periods: u32, regime_periods: u32) -> nonsmooth::Result<()> {
+    println!(
+        "\n## 4. The exact law with the implicit cusp step (CuspSwitch: DOPRI5 + extrapolated backward Euler, band {CUSP_BAND:e} m/s)\n"
+    );
+    println!(
+        "| workload | rtol | η = 1e-8 DOPRI5: RHS, CPU s | η = 0 DOPRI5: RHS, CPU s | η = 0 CuspSwitch: RHS, CPU s | implicit steps, hand-overs | RHS ratio exact(switch)/η=1e-8 | CPU ratio | impacts η=1e-8 / switch |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|");
+    let rest = Vector2::new(PAPER.static_equilibrium()?, 0.0);
+    let mut cases: Vec<(String, f64, u32, Vector2<f64>, u32)> =
+        vec![(format!("W1 ({w1_periods} periods)"), OMEGA_W, 0, rest, w1_periods)];
+    for omega in [14.0, 17.0] {
+        let y = simulate(&PAPER, omega, 0, rest, 10, Dopri5::new(tolerances(1e-10)?))?.y;
+        cases.push((
+            format!("ω = {omega} ({regime_periods} periods)"),
+            omega,
+            10,
+            y,
+            regime_periods,
+        ));
+    }
+    let exact = with_eta(0.0);
+    for (name, omega, k0, y0, periods) in &cases {
+        for rtol in RTOLS {
+            let tol = tolerances(rtol)?;
+            let reg = timed(&PAPER, *omega, *k0, *y0, *periods, reps, || {
+                Ok(Dopri5::new(tol))
+            })?;
+            let plain = timed(&exact, *omega, *k0, *y0, *periods, reps, || {
+                Ok(Dopri5::new(tol))
+            });
+            let counts;
+            let sw = timed(&exact, *omega, *k0, *y0, *periods, reps, || {
+                Ok(CuspSwitch::dopri5(tol, band())?)
+            })?;
+            // The counts of one run (deterministic).
+            {
+                let period = PaperParameters::period(*omega);
+                let mut sim = Simulation::new(exact.oscillator::<f64>(*omega)?, CuspSwitch::dopri5(tol, band())?)
+                    .landing_grid(Some((0.0, period)))?;
+                let t0 = f64::from(*k0) * period;
+                sim.run(t0, *y0, t0 + f64::from(*periods) * period, &mut ())?;
+                counts = Some((sim.stepper().counts(), sim.stepper().implicit().stats().rhs_evals, *sim.stepper().explicit().stats()));
+            }
+            let plain_cell = match &plain {
+                Ok(r) => format!("{}, {:.3}", r.stats.rhs_evals, r.seconds),
+                Err(e) => format!("failed: {e}"),
+            };
+            let (c, imp_evals, ex) = counts.unwrap_or_default();
+            if std::env::var("CUSP_DEBUG").is_ok() {
+                println!("implicit evals {imp_evals}, explicit {ex:?}, probes {}", c.probes);
+            }
+            println!(
+                "| {name} | {rtol:.0e} | {}, {:.3} | {plain_cell} | {}, {:.3} | {}, {}/{} | {:.3} | {:.2} | {} / {} |",
+                reg.stats.rhs_evals,
+                reg.seconds,
+                sw.stats.rhs_evals,
+                sw.seconds,
+                c.implicit_steps,
+                c.to_implicit,
+                c.to_explicit,
+                sw.stats.rhs_evals as f64 / reg.stats.rhs_evals as f64,
+                sw.seconds / reg.seconds,
+                reg.rec.impacts,
+                sw.rec.impacts,
+            );
+        }
+    }
+    Ok(())
+}
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let quick = std::env::args().any(|a| a == "--quick");
+    if std::env::args().any(|a| a == "--cusp") {
+        let reps = if quick { 1 } else { 3 };
+        let periods = if quick { 3 } else { 10 };
+        cusp_table(reps, if quick { 110 } else { W1_PERIODS }, periods)?;
+        return Ok(());
+    }
     let (w2_periods, regime_periods, reps, h_periodic) = if quick {
         (200, 3, 1, 10)
     } else {
