@@ -166,7 +166,11 @@ fn rest_run(rtol: f64, v0: f64) -> (f64, f64, f64) {
                 "rtol {rtol}: x at rest {} vs {x_rest}",
                 y1[0]
             );
-            assert!(y1[1].abs() <= tol.atol[1], "rtol {rtol}: v at rest {}", y1[1]);
+            assert!(
+                y1[1].abs() <= tol.atol[1],
+                "rtol {rtol}: v at rest {}",
+                y1[1]
+            );
         }
     }
     let t_eps = t_eps.expect("|v| fell below v_eps");
@@ -182,7 +186,10 @@ fn rest_time_to_tolerance_and_dense_output() {
             println!(
                 "rtol {rtol:e} v0 {v0}: time of |v| = 1e-4|v0| rel. error {rel:.2e}; dense output error / (end error + scale) {smooth:.2} (smooth), {rest:.2} (approach to rest)"
             );
-            assert!(rel <= 10.0 * rtol, "rtol {rtol}, v0 {v0}: time off by {rel:e}");
+            assert!(
+                rel <= 10.0 * rtol,
+                "rtol {rtol}, v0 {v0}: time off by {rel:e}"
+            );
             assert!(smooth <= 2.0, "rtol {rtol}, v0 {v0}: dense output {smooth}");
             assert!(rest <= 10.0, "rtol {rtol}, v0 {v0}: dense output {rest}");
         }
@@ -299,11 +306,74 @@ fn switch_agrees_with_explicit_references() {
     for omega in [20.465, 14.0, 17.0] {
         let reference = paper_run(omega, 0, rest, 1, dopri.clone());
         // Measured: ≤ 2.9e-11 m, 5.0e-10 m/s at 1e-8; ≤ 1.3e-13 m, 3.4e-12 m/s at 1e-10.
-        compare(omega, 0, rest, 1, &reference, [[1e-9, 1e-8], [1e-11, 1e-10]]);
+        compare(
+            omega,
+            0,
+            rest,
+            1,
+            &reference,
+            [[1e-9, 1e-8], [1e-11, 1e-10]],
+        );
         if omega == 20.465 {
             w1_after_creep = reference.end;
         }
     }
     let reference = paper_run(20.465, 1, w1_after_creep, 3, Dop853::new(tol(1e-13)));
-    compare(20.465, 1, w1_after_creep, 3, &reference, [[1e-7, 1e-6], [1e-9, 1e-8]]);
+    compare(
+        20.465,
+        1,
+        w1_after_creep,
+        3,
+        &reference,
+        [[1e-7, 1e-6], [1e-9, 1e-8]],
+    );
+}
+
+/// Two degrees of freedom: the paper's exact laws on the first, a spring to a second mass.
+/// The system declares the cusp ([`Dynamics::cusp_exponent`]), the switch steps the creep
+/// implicitly (Gauss–Seidel over the two velocities), and agrees with DOPRI5 at rtol 1e-11.
+#[test]
+fn two_degrees_of_freedom_creep() {
+    use nonsmooth::excite::UnbalancedRotor;
+    use nonsmooth::force::LinearSpring;
+    use nonsmooth::model::{Element, Load, Mechanical};
+    let omega = 17.0;
+    let mut p = PAPER;
+    p.eta = 0.0;
+    let m = Mechanical::with_masses([p.m, 1.0])
+        .unwrap()
+        .with_elements((
+            Element::on_dof(0, p.laws::<f64>().unwrap()).unwrap(),
+            Element::between(1, 0, LinearSpring::new(100.0).unwrap()).unwrap(),
+        ))
+        .with_loads(Load::on_dof(0, UnbalancedRotor::new(p.m0e, omega).unwrap()).unwrap());
+    assert_eq!(Dynamics::<f64, 4>::velocity_exponent(&m), None);
+    assert_eq!(Dynamics::<f64, 4>::cusp_exponent(&m), Some(p.n3));
+    let x = PAPER.static_equilibrium().unwrap();
+    let y0 = SVector::<f64, 4>::new(x, x, 0.0, 0.0);
+    let t_end = PaperParameters::period(omega);
+    let tol4 = |rtol: f64| {
+        Tolerances::per_component(rtol, [rtol * 1e-4, rtol * 1e-4, rtol * 1e-2, rtol * 1e-2])
+            .unwrap()
+    };
+    let mut reference = Simulation::new(&m, nonsmooth::integrate::Dopri5::new(tol4(1e-11)));
+    let yr = reference.run(0.0, y0, t_end, &mut ()).unwrap().y;
+    for rtol in [1e-8, 1e-10] {
+        let mut sim = Simulation::new(&m, CuspSwitch::dopri5(tol4(rtol), 1e-6).unwrap());
+        let y = sim.run(0.0, y0, t_end, &mut ()).unwrap().y;
+        let c = sim.stepper().counts();
+        let d = (y - yr).abs();
+        println!(
+            "2 DOF, rtol {rtol:e}: |Δq| {:.1e} {:.1e} m, |Δq̇| {:.1e} {:.1e} m/s; implicit steps {}; RHS {} vs DOPRI5 1e-11 {}",
+            d[0],
+            d[1],
+            d[2],
+            d[3],
+            c.implicit_steps,
+            sim.stepper().stats().rhs_evals,
+            reference.stepper().stats().rhs_evals
+        );
+        assert!(c.implicit_steps > 0);
+        assert!(d[0].max(d[1]) <= 1e3 * rtol * 1e-4 && d[2].max(d[3]) <= 1e3 * rtol * 1e-2);
+    }
 }

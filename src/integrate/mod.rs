@@ -33,8 +33,7 @@ pub mod turning;
 
 pub use adaptive::{Adaptive, Interpolant, Method, MethodDense};
 pub use cusp::{
-    CuspDense, CuspImplicit, CuspInterpolant, CuspMethod, CuspSwitch, CuspSwitchDense,
-    SwitchCounts,
+    CuspDense, CuspImplicit, CuspInterpolant, CuspMethod, CuspSwitch, CuspSwitchDense, SwitchCounts,
 };
 pub use dop853::{Dop853, Dop853Dense, Dop853Interpolant, Dop853Method};
 pub use dopri5::{Dopri5, Dopri5Dense, Dopri5Interpolant, Dopri5Method};
