@@ -72,6 +72,18 @@ pub trait Dynamics<T: Real, const N: usize> {
         None
     }
 
+    /// For a system in mechanical form, state `(q, q̇)` of `N = 2n` components with `n ≥ 1`
+    /// degrees of freedom: the smallest exponent `q ∈ (0, 1)` of a term `∝ sgn(ġ)|ġ|^q` in
+    /// the rate of any coordinate, if there is one. The implicit cusp step
+    /// ([`CuspSwitch`](crate::integrate::CuspSwitch)) probes the velocities for the cusp's
+    /// stiffness when it is declared, and solves in the power scale it sets. Default:
+    /// [`velocity_exponent`](Self::velocity_exponent) (one degree of freedom);
+    /// [`Mechanical`](crate::model::Mechanical) declares it for any number of degrees of
+    /// freedom.
+    fn cusp_exponent(&self) -> Option<T> {
+        self.velocity_exponent()
+    }
+
     /// For a one-degree-of-freedom system with state `(x, ẋ)`: where a contact force starts
     /// as a power of the penetration, if it does (see
     /// [`ForceLaw::contact_onset`](crate::ForceLaw::contact_onset)), with the stop and the
@@ -106,6 +118,10 @@ impl<T: Real, const N: usize, D: Dynamics<T, N> + ?Sized> Dynamics<T, N> for &D 
     #[inline(always)]
     fn velocity_exponent(&self) -> Option<T> {
         (**self).velocity_exponent()
+    }
+    #[inline(always)]
+    fn cusp_exponent(&self) -> Option<T> {
+        (**self).cusp_exponent()
     }
     #[inline(always)]
     fn contact_onset(&self) -> Option<crate::force::ContactOnset<T>> {
@@ -221,6 +237,9 @@ impl<const M: usize, D: Dynamics<f64, M>> Dynamics<f64, M> for LaneByLane<D> {
     }
     fn velocity_exponent(&self) -> Option<f64> {
         self.0.velocity_exponent()
+    }
+    fn cusp_exponent(&self) -> Option<f64> {
+        self.0.cusp_exponent()
     }
     fn contact_onset(&self) -> Option<crate::force::ContactOnset<f64>> {
         self.0.contact_onset()

@@ -150,6 +150,14 @@ impl<T: Real, const N: usize, M: Method<T, N>> Adaptive<T, N, M> {
     pub fn proposed_step(&self) -> Option<T> {
         self.core.h
     }
+
+    /// Sets the step the next step tries first (a stepper that hands its state over to this
+    /// one passes on its step size).
+    pub(crate) fn set_proposed_step(&mut self, h: T) {
+        if h.is_finite() && h > T::zero() {
+            self.core.h = Some(h.min(self.ctrl.opts.h_max));
+        }
+    }
 }
 
 impl<T: Real, const N: usize, M: Method<T, N>> Stepper<T, N> for Adaptive<T, N, M> {

@@ -13,6 +13,7 @@
 //! | [`Vern6`] | explicit, embedded 6(5), FSAL | 6 | 6th order (3 extra stages) | smooth flows, moderate t |
 //! | [`Rk4`] | explicit, fixed step | 4 | cubic Hermite (3rd order) | reference, tests |
 //! | [`Rosenbrock23`] | linearly implicit, embedded 2(3), FSAL | 2 | quadratic (the method's own) | stiff phases |
+//! | [`CuspImplicit`] | implicit Euler extrapolated, 3(2), mechanical form | 3 | limited cubic Hermite | creep at a velocity cusp ([`cusp`]) |
 //!
 //! # Step-size control
 //! The error of a step is measured in the weighted RMS norm
@@ -25,6 +26,7 @@
 //! accumulated over a long run.
 
 mod adaptive;
+pub mod cusp;
 mod dop853;
 pub(crate) mod dopri5;
 mod erk;
@@ -35,6 +37,9 @@ pub mod turning;
 mod vern6;
 
 pub use adaptive::{Adaptive, Interpolant, Method, MethodDense};
+pub use cusp::{
+    CuspDense, CuspImplicit, CuspInterpolant, CuspMethod, CuspSwitch, CuspSwitchDense, SwitchCounts,
+};
 pub use dop853::{Dop853, Dop853Dense, Dop853Interpolant, Dop853Method};
 pub use dopri5::{Dopri5, Dopri5Dense, Dopri5Interpolant, Dopri5Method};
 pub use erk::{ExplicitTableau, PowerInterpolant};
@@ -154,6 +159,18 @@ pub enum IntegrateError {
         row: usize,
         /// Column of the entry (the state component).
         col: usize,
+    },
+    /// An implicit cusp step ([`CuspImplicit`]) needs a system in mechanical form: a state
+    /// `(q, v)` of `N = 2n` components whose first `n` derivatives are the last `n`
+    /// components.
+    #[error(
+        "the implicit cusp step needs a state (q, v) with q' = v: component {index} of the derivative at t = {t} is not the velocity"
+    )]
+    NotMechanical {
+        /// Where.
+        t: f64,
+        /// The first component that breaks the form.
+        index: usize,
     },
     /// A parameter of the integrator is invalid.
     #[error(transparent)]

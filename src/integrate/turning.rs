@@ -948,7 +948,7 @@ impl<T: Real, TD: DenseOutput<T, 2>, SD: DenseOutput<T, 2>> DenseOutput<T, 2>
 
 /// The integer power `p = ⌈1/q⌉` of the scale `ẋ = sgn(u)|u|^p` for a declared exponent
 /// `q ∈ (0, 1)`; `None` beyond `p = 64` (a cusp too strong for the scale to be worth it).
-fn velocity_power<T: Real>(q: T) -> Option<i32> {
+pub(crate) fn velocity_power<T: Real>(q: T) -> Option<i32> {
     // The margin keeps 1/q = 3 + 1 ulp (q = 1/3 rounded) at p = 3.
     let inv = (crate::scalar::to_f64(T::one() / q) - 1e-9).ceil();
     (2.0..=64.0).contains(&inv).then_some(inv as i32)

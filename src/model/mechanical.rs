@@ -1178,6 +1178,17 @@ impl<T: Real, const N: usize, const M: usize, El: Elements<T, N>, Ld: Loads<T, N
             })
     }
 
+    /// For any number of degrees of freedom (state `(q, q̇)`): the smallest velocity
+    /// exponent that the elements' laws declare on any coordinate with finite weights
+    /// (a cusp in `ġ = w·q̇` is a cusp in the velocities).
+    fn cusp_exponent(&self) -> Option<T> {
+        state_size::<N, M>();
+        self.elements
+            .velocity_exponent_on(&|c: &Coordinate<T, N>, q| {
+                c.weights().iter().all(|w| w.is_finite()).then_some(q)
+            })
+    }
+
     /// For one degree of freedom (state `(x, ẋ)`): the first contact onset that the
     /// elements' laws declare ([`Elements::contact_onset_on`]), mapped from the law's
     /// coordinate `g = w·x + o` to `x`. A stop `g_I` on the side `Upper` (`δ_g = g − g_I`)
