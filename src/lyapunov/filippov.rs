@@ -112,8 +112,8 @@ where
     /// `(w_1, …, w_N)`, 10 blocks for the spread.
     ///
     /// # Errors
-    /// [`LyapunovError::InvalidSeparation`] unless `d0` is finite and > 0;
-    /// [`LyapunovError::InvalidWeight`] for a bad norm.
+    /// [`LyapunovError::InvalidSeparation`](super::LyapunovError::InvalidSeparation) unless `d0` is finite and > 0;
+    /// [`LyapunovError::InvalidWeight`](super::LyapunovError::InvalidWeight) for a bad norm.
     pub fn new(system: Sys, stepper: St, d0: T, norm: Norm<T, N>) -> Result<Self> {
         Self::from_simulation(FilippovSimulation::new(system, stepper), d0, norm)
     }
@@ -146,7 +146,7 @@ where
     /// Sets the direction of the initial perturbation (scaled to length `d0` in the norm).
     ///
     /// # Errors
-    /// [`LyapunovError::InvalidDirection`] if it is zero or not finite.
+    /// [`LyapunovError::InvalidDirection`](super::LyapunovError::InvalidDirection) if it is zero or not finite.
     pub fn with_direction(mut self, direction: SVector<T, N>) -> Result<Self> {
         self.runner.state.set_direction(direction)?;
         Ok(self)
@@ -155,7 +155,7 @@ where
     /// Sets the number of blocks for the standard error (default 10).
     ///
     /// # Errors
-    /// [`LyapunovError::InvalidBlocks`] if `blocks < 2`.
+    /// [`LyapunovError::InvalidBlocks`](super::LyapunovError::InvalidBlocks) if `blocks < 2`.
     pub fn with_blocks(mut self, blocks: usize) -> Result<Self> {
         self.runner.blocks = check_blocks(blocks)?;
         Ok(self)
@@ -164,8 +164,8 @@ where
     /// Places the reference at `(t0, x0)` and the perturbed trajectory at `x0 + d0·e`.
     ///
     /// # Errors
-    /// [`LyapunovError::NonFinite`] for a non-finite `t0` or `x0`;
-    /// [`LyapunovError::UnresolvedSeparation`] if `d0` is lost to rounding at `x0`.
+    /// [`LyapunovError::NonFinite`](super::LyapunovError::NonFinite) for a non-finite `t0` or `x0`;
+    /// [`LyapunovError::UnresolvedSeparation`](super::LyapunovError::UnresolvedSeparation) if `d0` is lost to rounding at `x0`.
     pub fn start(&mut self, t0: T, x0: SVector<T, N>) -> Result<()> {
         check_state(t0, &x0)?;
         let placed = self.runner.state.placed(x0)?;
@@ -210,11 +210,11 @@ where
     /// renormalization; the spread from blocks, see the [module docs](super)).
     ///
     /// # Errors
-    /// [`LyapunovError::NotStarted`], [`LyapunovError::InvalidInterval`],
-    /// [`LyapunovError::TooFewIntervals`] (fewer than 2),
-    /// [`LyapunovError::SeparationLost`] if the separation collapses or overflows,
-    /// [`LyapunovError::Filippov`] for a run that fails (two surfaces at once, a repelling
-    /// surface, …) and [`LyapunovError::Run`] for the integration's errors.
+    /// [`LyapunovError::NotStarted`](super::LyapunovError::NotStarted), [`LyapunovError::InvalidInterval`](super::LyapunovError::InvalidInterval),
+    /// [`LyapunovError::TooFewIntervals`](super::LyapunovError::TooFewIntervals) (fewer than 2),
+    /// [`LyapunovError::SeparationLost`](super::LyapunovError::SeparationLost) if the separation collapses or overflows,
+    /// [`LyapunovError::Filippov`](super::LyapunovError::Filippov) for a run that fails (two surfaces at once, a repelling
+    /// surface, …) and [`LyapunovError::Run`](super::LyapunovError::Run) for the integration's errors.
     pub fn estimate<const S: usize>(&mut self, tau: T, intervals: usize) -> Result<Estimate<T>>
     where
         Sys: Filippov<T, N, S>,
