@@ -190,8 +190,10 @@ impl<T: Real, S, const N: usize, const K: usize, const M: usize> Augmented<T, M,
 /// near `ln(tangent_atol)/τ` (for `ẏ = −800·y`, `τ = 1`, `tangent_atol = 10⁻¹¹` the method
 /// returns −26.6, not −800).
 ///
+/// `M = N + N·K` is inferred (a wrong `M` does not compile, see [`TangentDimension`]).
+///
 /// # Errors
-/// [`LyapunovError::TangentCount`] / [`LyapunovError::Dimension`] for mismatched `K`, `M`;
+/// [`LyapunovError::TangentCount`] unless `1 ≤ K ≤ N`;
 /// [`ParameterError`](crate::ParameterError) unless both tangent tolerances are finite and
 /// > 0.
 pub fn tangent_tolerances<T: Real, const N: usize, const K: usize, const M: usize>(
@@ -202,20 +204,6 @@ pub fn tangent_tolerances<T: Real, const N: usize, const K: usize, const M: usiz
 where
     Dims<N>: TangentDimension<K, M>,
 {
-    checked_tangent_tolerances::<T, N, K, M>(tol, tangent_rtol, tangent_atol)
-}
-
-/// [`tangent_tolerances`] with the sizes checked when called.
-pub(crate) fn checked_tangent_tolerances<
-    T: Real,
-    const N: usize,
-    const K: usize,
-    const M: usize,
->(
-    tol: &Tolerances<T, N>,
-    tangent_rtol: T,
-    tangent_atol: T,
-) -> Result<Tolerances<T, M>> {
     check_tangent_dims::<N, K, M>()?;
     crate::validate::positive("tangent_rtol", tangent_rtol)?;
     crate::validate::positive("tangent_atol", tangent_atol)?;
@@ -312,16 +300,18 @@ impl<T: Real, const K: usize> Record<T, K> {
 /// # Ok::<(), nonsmooth::Error>(())
 /// ```
 ///
-/// With fewer tangent vectors, `K` is the one size to write (`M` follows from
-/// [`tangent_tolerances`]):
+/// With fewer tangent vectors, `K` is the one size to write (`N` comes from the system,
+/// `M` follows):
 /// ```
 /// # use nalgebra::Vector2;
 /// # use nonsmooth::integrate::{Dopri5, Tolerances};
-/// # use nonsmooth::lyapunov::{Norm, TangentSpace, tangent_tolerances};
+/// # use nonsmooth::lyapunov::{Norm, TangentSpace};
 /// # use nonsmooth::testing::DampedOscillator;
-/// let tol = Tolerances::per_component(1e-10, [1e-12, 1e-12])?;
-/// let stepper = Dopri5::new(tangent_tolerances::<_, 2, 1, _>(&tol, 1e-10, 1e-10)?);
-/// let mut top = TangentSpace::new(DampedOscillator::new(2.0, 0.15)?, stepper, Norm::Euclidean)?;
+/// let osc = DampedOscillator::new(2.0, 0.15)?;
+/// let tol = Tolerances::new(1e-10, 1e-12)?;
+/// let mut top = TangentSpace::<_, _, 1, _, _, _>::with_tolerances(
+///     osc, Dopri5::new, &tol, (1e-10, 1e-10), Norm::Euclidean,
+/// )?;
 /// top.start(0.0, Vector2::new(1.0, 0.0))?;
 /// assert_eq!(top.estimate(1.0, 10)?.exponents.len(), 1);
 /// # Ok::<(), nonsmooth::Error>(())
@@ -389,9 +379,9 @@ where
 
     /// An estimator whose stepper is built from the system's tolerances: `make_stepper`
     /// receives them extended by [`tangent_tolerances`] with `tangent_rtol`,
-    /// `tangent_atol`; the sizes are written (for code generic in them) and checked when
-    /// called. For `K = N` prefer [`from_tolerances`](TangentSpace::from_tolerances), which
-    /// infers them.
+    /// `tangent_atol`. `M = N + N·K` is inferred (and a wrong one does not compile,
+    /// [`TangentDimension`]); for `K = N`, [`from_tolerances`](TangentSpace::from_tolerances)
+    /// infers `K` too.
     ///
     /// ```
     /// use nonsmooth::integrate::{Dopri5, Tolerances};
@@ -417,8 +407,11 @@ where
         tol: &Tolerances<T, N>,
         (tangent_rtol, tangent_atol): (T, T),
         norm: Norm<T, N>,
-    ) -> Result<Self> {
-        let t = checked_tangent_tolerances::<T, N, K, M>(tol, tangent_rtol, tangent_atol)?;
+    ) -> Result<Self>
+    where
+        Dims<N>: TangentDimension<K, M>,
+    {
+        let t = tangent_tolerances::<T, N, K, M>(tol, tangent_rtol, tangent_atol)?;
         Self::new(system, make_stepper(t), norm)
     }
 
