@@ -5,7 +5,7 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use nalgebra::Vector2;
 use nonsmooth::integrate::{Dopri5, Tolerances};
-use nonsmooth::lyapunov::{TangentSpace, TwoTrajectory, pair_tolerances, tangent_tolerances};
+use nonsmooth::lyapunov::{TangentSpace, TwoTrajectory, pair_tolerances};
 use nonsmooth::systems::paper::PAPER;
 use nonsmooth::systems::paper::lyapunov::{D0 as PAPER_D0, norm as paper_norm};
 use std::hint::black_box;
@@ -18,21 +18,17 @@ fn tle(c: &mut Criterion) {
     let tol = Tolerances::per_component(1e-8, [1e-12, 1e-10]).unwrap();
 
     // On the attractor first (100 transient periods from rest, outside the timing).
-    let mut tt = TwoTrajectory::<f64, 2, 4, _, _>::new(
+    let mut tt = TwoTrajectory::new(
         osc,
-        Dopri5::new(pair_tolerances::<f64, 2, 4>(&tol).unwrap()),
+        Dopri5::new(pair_tolerances(&tol).unwrap()),
         PAPER_D0,
         paper_norm(),
     )
     .unwrap();
     tt.start(0.0, y0).unwrap();
     tt.transient(tau, 100).unwrap();
-    let mut qr = TangentSpace::<f64, 2, 2, 6, _, _>::new(
-        osc,
-        Dopri5::new(tangent_tolerances::<f64, 2, 2, 6>(&tol, 1e-8, 1e-8).unwrap()),
-        paper_norm(),
-    )
-    .unwrap();
+    let mut qr =
+        TangentSpace::from_tolerances(osc, &tol, Dopri5::new, (1e-8, 1e-8), paper_norm()).unwrap();
     qr.start(0.0, y0).unwrap();
     qr.transient(tau, 100).unwrap();
 

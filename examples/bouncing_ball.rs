@@ -15,7 +15,7 @@ use std::time::Instant;
 use nonsmooth::drive::{Control, EventRecord, ModeLog, Observer, run_with_sticking};
 use nonsmooth::event::{Direction, Event};
 use nonsmooth::integrate::{Dopri5, Tolerances};
-use nonsmooth::lyapunov::{HybridTangentSpace, HybridTwoTrajectory, Norm, tangent_tolerances};
+use nonsmooth::lyapunov::{HybridTangentSpace, HybridTwoTrajectory, Norm};
 use nonsmooth::output::csv::write_table_path;
 use nonsmooth::systems::BouncingBallTable;
 use nonsmooth::testing::BallOnTableExact;
@@ -97,10 +97,11 @@ fn exponents(
         .and_then(|_| pair.estimate(1.0, seconds))
         .ok()
         .map(|e| (e.exponent, e.spread));
-    let ttol = tangent_tolerances::<f64, 2, 2, 6>(&tol, 1e-10, 1e-12)?;
-    let mut qr = HybridTangentSpace::<f64, 2, 2, 6, _, _, _>::new(
+    let mut qr = HybridTangentSpace::from_tolerances(
         p.model::<f64>()?,
-        Dopri5::new(ttol),
+        &tol,
+        Dopri5::new,
+        (1e-10, 1e-12),
         events,
         Norm::Euclidean,
     )?;

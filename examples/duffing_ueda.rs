@@ -94,20 +94,20 @@ fn main() -> nonsmooth::Result<()> {
     // 3. λ₁ two ways and the QR sum.
     let intervals = if quick { 600 } else { 5000 };
     let start = Instant::now();
-    let mut pair = TwoTrajectory::<_, 2, 4, _, _>::with_tolerances(
+    let mut pair = TwoTrajectory::from_tolerances(
         p.model::<f64>()?,
-        Dopri5::new,
         &tol,
+        Dopri5::new,
         1e-8,
         Norm::Euclidean,
     )?;
     pair.start(0.0, y0)?;
     pair.transient(TAU, 50)?;
     let two = pair.estimate(TAU, intervals)?;
-    let mut qr = TangentSpace::<_, 2, 2, 6, _, _>::with_tolerances(
+    let mut qr = TangentSpace::from_tolerances(
         p.model::<f64>()?,
-        Dopri5::new,
         &tol,
+        Dopri5::new,
         (1e-10, 1e-12),
         Norm::Euclidean,
     )?;

@@ -64,7 +64,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         if wide { 16 } else { 8 }
     );
 
-    let pair_tol = pair_tolerances::<f64, 2, 4>(&tol)?;
+    let pair_tol = pair_tolerances(&tol)?;
     let sub: Vec<usize> = (0..n).step_by(every.max(1)).collect();
     let start = Instant::now();
     let scalar: Vec<(f64, f64)> = {
@@ -72,7 +72,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         sub.par_iter()
             .map(|&i| -> nonsmooth::Result<(f64, f64)> {
                 let w = omegas[i];
-                let mut est = TwoTrajectory::<f64, 2, 4, _, _>::new(
+                let mut est = TwoTrajectory::new(
                     PAPER.oscillator::<f64>(w)?,
                     Dopri5::new(pair_tol),
                     PAPER_D0,

@@ -99,7 +99,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         args.step_transient,
         args.periods,
     )?;
-    let tol = pair_tolerances::<f64, 2, 4>(&Tolerances::per_component(1e-8, [1e-12, 1e-10])?)?;
+    let tol = pair_tolerances(&Tolerances::per_component(1e-8, [1e-12, 1e-10])?)?;
     let y0 = Vector2::new(PAPER.static_equilibrium()?, 0.0);
     println!(
         "TLE diagram: {n} values of ω in [{}, {}] rad/s (step {}), {} + {}/step transient and {} \

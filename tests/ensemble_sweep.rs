@@ -200,11 +200,9 @@ fn every_instruction_set_gives_the_same_bits() {
 /// The scalar estimator from rest (the paper example's `tle`).
 fn scalar_tle(w: f64, transient: usize, intervals: usize) -> (f64, f64) {
     use nonsmooth::lyapunov::{TwoTrajectory, pair_tolerances};
-    let tol = pair_tolerances::<f64, 2, 4>(&tol()).unwrap();
+    let tol = pair_tolerances(&tol()).unwrap();
     let osc = PAPER.oscillator::<f64>(w).unwrap();
-    let mut est =
-        TwoTrajectory::<f64, 2, 4, _, _>::new(osc, Dopri5::new(tol), PAPER_D0, paper_norm())
-            .unwrap();
+    let mut est = TwoTrajectory::new(osc, Dopri5::new(tol), PAPER_D0, paper_norm()).unwrap();
     est.start(0.0, rest()).unwrap();
     let tau = std::f64::consts::TAU / w;
     est.transient(tau, transient).unwrap();

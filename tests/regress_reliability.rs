@@ -208,14 +208,8 @@ fn lyapunov_interval_counts_and_times_are_bounded() {
     assert_eq!(d.len(), 616);
     assert!(d.iter().all(|v| v.is_finite() && *v > 0.0));
     assert!(decades::<f64>(0, 1, usize::MAX).len() <= 1_000_001);
-    let mut est = TwoTrajectory::<_, 2, 4, _, _>::with_tolerances(
-        osc(),
-        Dopri5::new,
-        &tol(),
-        1e-8,
-        Norm::Euclidean,
-    )
-    .unwrap();
+    let mut est =
+        TwoTrajectory::from_tolerances(osc(), &tol(), Dopri5::new, 1e-8, Norm::Euclidean).unwrap();
     // estimate(τ, usize::MAX) panicked with a capacity overflow.
     est.start(0.0, y0()).unwrap();
     let r = est.estimate(1.0, usize::MAX);

@@ -232,10 +232,10 @@ fn duffing_ueda_against_hand_written_and_its_exponents() {
     let tol = Tolerances::new(1e-10, 1e-12).unwrap();
     let tau = std::f64::consts::TAU;
     let y0 = Vector2::new(3.0, 0.0);
-    let mut pair = TwoTrajectory::<_, 2, 4, _, _>::with_tolerances(
+    let mut pair = TwoTrajectory::from_tolerances(
         p.model::<f64>().unwrap(),
-        Dopri5::new,
         &tol,
+        Dopri5::new,
         1e-8,
         Norm::Euclidean,
     )
@@ -243,10 +243,10 @@ fn duffing_ueda_against_hand_written_and_its_exponents() {
     pair.start(0.0, y0).unwrap();
     pair.transient(tau, 50).unwrap();
     let two = pair.estimate(tau, 600).unwrap();
-    let mut qr = TangentSpace::<_, 2, 2, 6, _, _>::with_tolerances(
+    let mut qr = TangentSpace::from_tolerances(
         p.model::<f64>().unwrap(),
-        Dopri5::new,
         &tol,
+        Dopri5::new,
         (1e-10, 1e-12),
         Norm::Euclidean,
     )

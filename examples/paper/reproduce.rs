@@ -286,9 +286,8 @@ pub fn entropy(omega: f64, record: u32, rtol: f64) -> Res<Entropy> {
 /// Returns (λ₁, standard error) in 1/s.
 pub fn tle(omega: f64, transient: usize, periods: usize, rtol: f64) -> Res<(f64, f64)> {
     let osc = PAPER.oscillator::<f64>(omega)?;
-    let tol = pair_tolerances::<f64, 2, 4>(&tolerances(rtol))?;
-    let mut est =
-        TwoTrajectory::<f64, 2, 4, _, _>::new(osc, Dopri5::new(tol), PAPER_D0, paper_norm())?;
+    let tol = pair_tolerances(&tolerances(rtol))?;
+    let mut est = TwoTrajectory::new(osc, Dopri5::new(tol), PAPER_D0, paper_norm())?;
     est.start(0.0, rest()?)?;
     let tau = TAU / omega;
     est.transient(tau, transient)?;
@@ -310,7 +309,7 @@ pub fn tle_fig5(
         step_transient,
         periods,
     )?;
-    let tol = pair_tolerances::<f64, 2, 4>(&tolerances(rtol))?;
+    let tol = pair_tolerances(&tolerances(rtol))?;
     Ok(tle_diagram(
         |w: f64| Ok(PAPER.oscillator::<f64>(w)?),
         &Dopri5::new(tol),

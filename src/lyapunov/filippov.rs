@@ -6,14 +6,11 @@
 use nalgebra::SVector;
 
 use super::Result;
-use super::{
-    DEFAULT_BLOCKS, Estimate, LyapunovError, Norm, block_standard_error, check_blocks,
-    check_interval_at, check_intervals, check_state, grid_time,
-};
+use super::runner::{Flow, Runner, Separation};
+use super::{Estimate, Norm, check_blocks, check_state};
 use crate::Real;
 use crate::filippov::{Filippov, FilippovSimulation};
 use crate::integrate::{Stats, Stepper};
-use crate::scalar::{lit, to_f64};
 
 /// The two-trajectory (Benettin) estimator of the top Lyapunov exponent of a Filippov
 /// system: two [`FilippovSimulation`]s of the same system, used in three stages like
@@ -63,13 +60,45 @@ use crate::scalar::{lit, to_f64};
 /// ```
 #[derive(Debug, Clone)]
 pub struct FilippovTwoTrajectory<T: Real, const N: usize, Sys, St> {
+    runs: Runs<T, Sys, St>,
+    runner: Runner<T, Separation<T, N>>,
+}
+
+/// The two event-driven runs and their work.
+#[derive(Debug, Clone)]
+struct Runs<T: Real, Sys, St> {
     reference: FilippovSimulation<T, Sys, St>,
     perturbed: FilippovSimulation<T, Sys, St>,
-    d0: T,
-    norm: Norm<T, N>,
-    direction: SVector<T, N>,
-    blocks: usize,
-    state: Option<(T, SVector<T, N>, SVector<T, N>)>,
+    work: Stats,
+}
+
+/// [`Runs`] for `S` switching surfaces.
+struct Sliding<'a, T: Real, Sys, St, const S: usize>(&'a mut Runs<T, Sys, St>);
+
+impl<T, const N: usize, const S: usize, Sys, St> Flow<T, Separation<T, N>>
+    for Sliding<'_, T, Sys, St, S>
+where
+    T: Real,
+    Sys: Filippov<T, N, S>,
+    St: Stepper<T, N>,
+{
+    fn advance(&mut self, pair: &mut Separation<T, N>, t: T, t_end: T) -> Result<T> {
+        let runs = &mut *self.0;
+        let rx = runs
+            .reference
+            .run::<N, S, ()>(t, pair.reference, t_end, &mut ())?;
+        let ry = runs
+            .perturbed
+            .run::<N, S, ()>(t, pair.perturbed, t_end, &mut ())?;
+        runs.work += &rx.stats;
+        runs.work += &ry.stats;
+        (pair.reference, pair.perturbed) = (rx.x, ry.x);
+        Ok(t_end)
+    }
+
+    fn work(&self) -> Stats {
+        self.0.work
+    }
 }
 
 impl<T, const N: usize, Sys, St> FilippovTwoTrajectory<T, N, Sys, St>
@@ -83,8 +112,8 @@ where
     /// `(w_1, …, w_N)`, 10 blocks for the spread.
     ///
     /// # Errors
-    /// [`LyapunovError::InvalidSeparation`] unless `d0` is finite and > 0;
-    /// [`LyapunovError::InvalidWeight`] for a bad norm.
+    /// [`LyapunovError::InvalidSeparation`](super::LyapunovError::InvalidSeparation) unless `d0` is finite and > 0;
+    /// [`LyapunovError::InvalidWeight`](super::LyapunovError::InvalidWeight) for a bad norm.
     pub fn new(system: Sys, stepper: St, d0: T, norm: Norm<T, N>) -> Result<Self> {
         Self::from_simulation(FilippovSimulation::new(system, stepper), d0, norm)
     }
@@ -99,20 +128,13 @@ where
         d0: T,
         norm: Norm<T, N>,
     ) -> Result<Self> {
-        if N == 0 || !(d0.is_finite() && d0 > T::zero()) {
-            return Err(LyapunovError::InvalidSeparation { d0: to_f64(d0) });
-        }
-        norm.validate()?;
-        let w = norm.scales();
-        let direction = w / norm.norm(&w);
         Ok(Self {
-            perturbed: simulation.clone(),
-            reference: simulation,
-            d0,
-            norm,
-            direction,
-            blocks: DEFAULT_BLOCKS,
-            state: None,
+            runner: Runner::new(Separation::new(d0, norm)?),
+            runs: Runs {
+                perturbed: simulation.clone(),
+                reference: simulation,
+                work: Stats::default(),
+            },
         })
     }
 }
@@ -124,53 +146,48 @@ where
     /// Sets the direction of the initial perturbation (scaled to length `d0` in the norm).
     ///
     /// # Errors
-    /// [`LyapunovError::InvalidDirection`] if it is zero or not finite.
+    /// [`LyapunovError::InvalidDirection`](super::LyapunovError::InvalidDirection) if it is zero or not finite.
     pub fn with_direction(mut self, direction: SVector<T, N>) -> Result<Self> {
-        self.direction = super::unit_direction(&self.norm, direction)?;
+        self.runner.state.set_direction(direction)?;
         Ok(self)
     }
 
     /// Sets the number of blocks for the standard error (default 10).
     ///
     /// # Errors
-    /// [`LyapunovError::InvalidBlocks`] if `blocks < 2`.
+    /// [`LyapunovError::InvalidBlocks`](super::LyapunovError::InvalidBlocks) if `blocks < 2`.
     pub fn with_blocks(mut self, blocks: usize) -> Result<Self> {
-        self.blocks = check_blocks(blocks)?;
+        self.runner.blocks = check_blocks(blocks)?;
         Ok(self)
     }
 
     /// Places the reference at `(t0, x0)` and the perturbed trajectory at `x0 + d0·e`.
     ///
     /// # Errors
-    /// [`LyapunovError::NonFinite`] for a non-finite `t0` or `x0`;
-    /// [`LyapunovError::UnresolvedSeparation`] if `d0` is lost to rounding at `x0`.
+    /// [`LyapunovError::NonFinite`](super::LyapunovError::NonFinite) for a non-finite `t0` or `x0`;
+    /// [`LyapunovError::UnresolvedSeparation`](super::LyapunovError::UnresolvedSeparation) if `d0` is lost to rounding at `x0`.
     pub fn start(&mut self, t0: T, x0: SVector<T, N>) -> Result<()> {
         check_state(t0, &x0)?;
-        let x1 = x0 + self.direction * self.d0;
-        let realized = self.norm.norm(&(x1 - x0));
-        if !((realized - self.d0).abs() <= lit::<T>(1e-3) * self.d0) {
-            return Err(LyapunovError::UnresolvedSeparation {
-                d0: to_f64(self.d0),
-                realized: to_f64(realized),
-            });
-        }
-        self.state = Some((t0, x0, x1));
+        let placed = self.runner.state.placed(x0)?;
+        self.runner.t = t0;
+        self.runner.state = placed;
+        self.runner.started = true;
         Ok(())
     }
 
     /// The reference state `(t, x)`, once started.
     pub fn reference(&self) -> Option<(T, SVector<T, N>)> {
-        self.state.map(|(t, x, _)| (t, x))
+        self.runner.current().map(|(t, pair)| (t, pair.reference))
     }
 
     /// The current separation `x̃ − x` (length `d0` after a renormalization), once started.
     pub fn separation(&self) -> Option<SVector<T, N>> {
-        self.state.map(|(_, x, y)| y - x)
+        self.runner.current().map(|(_, pair)| pair.delta())
     }
 
     /// The system.
     pub fn system(&self) -> &Sys {
-        self.reference.system()
+        self.runs.reference.system()
     }
 
     /// Runs `intervals` intervals of length `tau` and discards them (a separation that
@@ -184,10 +201,8 @@ where
         Sys: Filippov<T, N, S>,
         St: Stepper<T, N>,
     {
-        let (t, _, _) = self.state.ok_or(LyapunovError::NotStarted)?;
-        check_interval_at(t, tau)?;
-        let mut stats = Stats::default();
-        self.run::<S>(tau, intervals, true, &mut stats, |_, _| {})
+        let mut flow = Sliding::<T, Sys, St, S>(&mut self.runs);
+        self.runner.transient::<_, 1>(&mut flow, tau, intervals)
     }
 
     /// Runs `intervals` intervals of length `tau` and returns the estimate
@@ -195,87 +210,20 @@ where
     /// renormalization; the spread from blocks, see the [module docs](super)).
     ///
     /// # Errors
-    /// [`LyapunovError::NotStarted`], [`LyapunovError::InvalidInterval`],
-    /// [`LyapunovError::TooFewIntervals`] (fewer than 2),
-    /// [`LyapunovError::SeparationLost`] if the separation collapses or overflows,
-    /// [`LyapunovError::Filippov`] for a run that fails (two surfaces at once, a repelling
-    /// surface, …) and [`LyapunovError::Run`] for the integration's errors.
+    /// [`LyapunovError::NotStarted`](super::LyapunovError::NotStarted), [`LyapunovError::InvalidInterval`](super::LyapunovError::InvalidInterval),
+    /// [`LyapunovError::TooFewIntervals`](super::LyapunovError::TooFewIntervals) (fewer than 2),
+    /// [`LyapunovError::SeparationLost`](super::LyapunovError::SeparationLost) if the separation collapses or overflows,
+    /// [`LyapunovError::Filippov`](super::LyapunovError::Filippov) for a run that fails (two surfaces at once, a repelling
+    /// surface, …) and [`LyapunovError::Run`](super::LyapunovError::Run) for the integration's errors.
     pub fn estimate<const S: usize>(&mut self, tau: T, intervals: usize) -> Result<Estimate<T>>
     where
         Sys: Filippov<T, N, S>,
         St: Stepper<T, N>,
     {
-        let (t, _, _) = self.state.ok_or(LyapunovError::NotStarted)?;
-        check_interval_at(t, tau)?;
-        check_intervals(intervals, 2)?;
-        let blocks = self.blocks.min(intervals);
-        let mut stats = Stats::default();
-        let mut local = Vec::with_capacity(intervals.min(1 << 16));
-        let mut history = Vec::with_capacity(intervals.min(1 << 16));
-        let mut sum = T::zero();
-        self.run::<S>(tau, intervals, false, &mut stats, |k, s| {
-            local.push(s);
-            sum += s;
-            history.push(sum / lit::<T>((k + 1) as f64));
-        })?;
-        Ok(Estimate {
-            exponent: sum / lit::<T>(intervals as f64),
-            spread: block_standard_error(intervals, blocks, |k| local[k]),
-            history,
-            local,
-            interval: tau,
-            blocks,
-            stats,
-        })
-    }
-
-    /// The core loop: `intervals` intervals on the grid `t_start + kτ`,
-    /// `sink(k, ln(d_k/d_start)/τ)` after each.
-    fn run<const S: usize>(
-        &mut self,
-        tau: T,
-        intervals: usize,
-        reseed: bool,
-        stats: &mut Stats,
-        mut sink: impl FnMut(usize, T),
-    ) -> Result<()>
-    where
-        Sys: Filippov<T, N, S>,
-        St: Stepper<T, N>,
-    {
-        let (t_start, mut x, mut y) = self.state.ok_or(LyapunovError::NotStarted)?;
-        let mut d_start = self.norm.norm(&(y - x));
-        for k in 0..intervals {
-            let (ta, tb) = (grid_time(t_start, tau, k), grid_time(t_start, tau, k + 1));
-            let rx = self.reference.run::<N, S, ()>(ta, x, tb, &mut ())?;
-            let ry = self.perturbed.run::<N, S, ()>(ta, y, tb, &mut ())?;
-            *stats += &rx.stats;
-            *stats += &ry.stats;
-            x = rx.x;
-            let mut delta = ry.x - x;
-            let mut d = self.norm.norm(&delta);
-            if reseed && d == T::zero() {
-                delta = self.direction * self.d0;
-                d = self.norm.norm(&delta);
-            }
-            if !(d.is_finite() && d > T::zero()) {
-                self.state = Some((ta, x, ry.x));
-                return Err(LyapunovError::SeparationLost {
-                    t: to_f64(tb),
-                    separation: to_f64(d),
-                });
-            }
-            sink(k, (d / d_start).ln() / tau);
-            y = x + delta * (self.d0 / d);
-            d_start = self.norm.norm(&(y - x));
-            if !(d_start > T::zero()) {
-                return Err(LyapunovError::UnresolvedSeparation {
-                    d0: to_f64(self.d0),
-                    realized: to_f64(d_start),
-                });
-            }
-            self.state = Some((tb, x, y));
-        }
-        Ok(())
+        let mut flow = Sliding::<T, Sys, St, S>(&mut self.runs);
+        Ok(self
+            .runner
+            .estimate::<_, 1>(&mut flow, tau, intervals)?
+            .estimate())
     }
 }

@@ -6,8 +6,10 @@
 //! - [`HybridTwoTrajectory`]: a reference and a perturbed trajectory, each taking its own
 //!   impacts (they come at different times). The separation is measured at the grid times
 //!   `t0 + kτ` only when both have taken the same number of resets; otherwise both are
-//!   carried on by `τ/1000` until they have (at most 1000 times), so the comparison never
-//!   straddles an impact. The exponent is `Σ ln(d_k/d0) / Σ Δt_k`.
+//!   carried on by a thousandth of the interval until they have (at most 999 times, so the
+//!   next grid time is not passed), so the comparison never straddles an impact. The
+//!   exponent is `Σ ln(d_k/d_{k−1}') / Σ Δt_k` (`d'` the separation realized by the
+//!   previous renormalization).
 //! - [`HybridTangentSpace`]: the variational equations with `K` tangent vectors, mapped
 //!   across every reset by the **saltation matrix**
 //!   $$S = R_y + \frac{\bigl(f^+ - R_y f^- - R_t\bigr)\,\nabla g^{\mathsf T}}
@@ -26,14 +28,13 @@
 use nalgebra::{SMatrix, SVector};
 
 use super::Result;
-use super::{
-    DEFAULT_BLOCKS, Estimate, LyapunovError, Norm, Spectrum, Variational, block_standard_error,
-    check_blocks, check_interval, check_intervals, check_state,
-};
+use super::runner::{Flow, Frame, Runner, Separation, Simulated};
+use super::sizes::{Dims, TangentDimension};
+use super::tangent::check_jacobian_at;
+use super::{Estimate, LyapunovError, Norm, Spectrum, Variational, check_blocks, check_state};
 use crate::drive::{Control, EventRecord, Observer, Simulation};
 use crate::event::{Direction, EventError, EventSet};
-use crate::integrate::{Stats, Stepper};
-use crate::linalg::gram_schmidt;
+use crate::integrate::{Stats, Stepper, Tolerances};
 use crate::scalar::{epsilon, lit, to_f64};
 use crate::{Dynamics, Real};
 
@@ -50,16 +51,87 @@ impl<T: Real, const N: usize> Observer<T, N> for ResetCount {
     }
 }
 
+/// The reference and the perturbed trajectory as two runs of the event engine; an interval
+/// ends late while their reset counts differ.
+#[derive(Debug, Clone)]
+struct TwoRuns<T: Real, const N: usize, S, St, E> {
+    reference: Simulation<T, N, S, St, E>,
+    perturbed: Simulation<T, N, S, St, E>,
+    work: Stats,
+}
+
+impl<T, const N: usize, S, St, E> TwoRuns<T, N, S, St, E>
+where
+    T: Real,
+    S: Dynamics<T, N>,
+    St: Stepper<T, N>,
+    E: EventSet<T, N>,
+{
+    /// Both trajectories from `t` to `t_end`, counting resets.
+    fn both(
+        &mut self,
+        pair: &mut Separation<T, N>,
+        t: T,
+        t_end: T,
+        counts: &mut [ResetCount; 2],
+    ) -> Result<()> {
+        let oy = self
+            .reference
+            .run(t, pair.reference, t_end, &mut counts[0])?;
+        let oz = self
+            .perturbed
+            .run(t, pair.perturbed, t_end, &mut counts[1])?;
+        self.work += &oy.stats;
+        self.work += &oz.stats;
+        (pair.reference, pair.perturbed) = (oy.y, oz.y);
+        Ok(())
+    }
+}
+
+impl<T, const N: usize, S, St, E> Flow<T, Separation<T, N>> for TwoRuns<T, N, S, St, E>
+where
+    T: Real,
+    S: Dynamics<T, N>,
+    St: Stepper<T, N>,
+    E: EventSet<T, N>,
+{
+    const ON_GRID: bool = false;
+
+    fn advance(&mut self, pair: &mut Separation<T, N>, t: T, t_end: T) -> Result<T> {
+        let mut counts = [ResetCount::default(); 2];
+        self.both(pair, t, t_end, &mut counts)?;
+        // At most 999 extensions of a thousandth of the interval: the end stays before the
+        // next grid time.
+        let step = (t_end - t) * lit(1e-3);
+        let mut t1 = t_end;
+        for _ in 0..999 {
+            if counts[0].0 == counts[1].0 {
+                return Ok(t1);
+            }
+            let t2 = t1 + step;
+            self.both(pair, t1, t2, &mut counts)?;
+            t1 = t2;
+        }
+        if counts[0].0 == counts[1].0 {
+            return Ok(t1);
+        }
+        Err(LyapunovError::SeparationLost {
+            t: to_f64(t1),
+            separation: f64::INFINITY,
+        })
+    }
+
+    fn work(&self) -> Stats {
+        self.work
+    }
+}
+
 /// The two-trajectory (Benettin) estimate of the top exponent for a system with events and
 /// resets (see the [module docs](self)).
 #[derive(Debug, Clone)]
 pub struct HybridTwoTrajectory<T: Real, const N: usize, S, St, E> {
-    reference: Simulation<T, N, S, St, E>,
-    perturbed: Simulation<T, N, S, St, E>,
-    d0: T,
-    norm: Norm<T, N>,
-    blocks: usize,
-    state: Option<(T, SVector<T, N>, SVector<T, N>)>,
+    flow: TwoRuns<T, N, S, St, E>,
+    runner: Runner<T, Separation<T, N>>,
 }
 
 impl<T, const N: usize, S, St, E> HybridTwoTrajectory<T, N, S, St, E>
@@ -70,26 +142,34 @@ where
     E: EventSet<T, N> + Clone,
 {
     /// Two copies of `system`, each with its own stepper and the events `events`, initial
-    /// separation `d0` measured in `norm`.
+    /// separation `d0` measured in `norm` along the norm's first axis.
     ///
     /// # Errors
     /// [`LyapunovError::InvalidSeparation`] unless `d0` is finite and > 0; a bad norm.
     pub fn new(system: S, stepper: St, events: E, d0: T, norm: Norm<T, N>) -> Result<Self> {
-        if !(d0.is_finite() && d0 > T::zero()) {
-            return Err(LyapunovError::InvalidSeparation { d0: to_f64(d0) });
-        }
-        norm.validate()?;
+        let mut pair = Separation::new(d0, norm)?;
+        pair.direction = SVector::zeros();
+        pair.direction[0] = norm.scales()[0];
         let reference =
             Simulation::new(system.clone(), stepper.clone()).with_events(events.clone());
         let perturbed = Simulation::new(system, stepper).with_events(events);
         Ok(Self {
-            reference,
-            perturbed,
-            d0,
-            norm,
-            blocks: DEFAULT_BLOCKS,
-            state: None,
+            flow: TwoRuns {
+                reference,
+                perturbed,
+                work: Stats::default(),
+            },
+            runner: Runner::new(pair),
         })
+    }
+
+    /// Sets the direction of the initial perturbation (scaled to length `d0` in the norm).
+    ///
+    /// # Errors
+    /// [`LyapunovError::InvalidDirection`] if it is zero or not finite.
+    pub fn with_direction(mut self, direction: SVector<T, N>) -> Result<Self> {
+        self.runner.state.set_direction(direction)?;
+        Ok(self)
     }
 
     /// The number of blocks for the standard error (default 10).
@@ -97,122 +177,52 @@ where
     /// # Errors
     /// [`LyapunovError::InvalidBlocks`] if `blocks < 2`.
     pub fn with_blocks(mut self, blocks: usize) -> Result<Self> {
-        self.blocks = check_blocks(blocks)?;
+        self.runner.blocks = check_blocks(blocks)?;
         Ok(self)
     }
 
-    /// Starts at `(t0, y0)` with the perturbation `d0` along the norm's first axis.
+    /// Starts at `(t0, y0)` with the perturbation `d0` along the initial direction (the
+    /// norm's first axis unless set by [`with_direction`](Self::with_direction)).
     ///
     /// # Errors
     /// [`LyapunovError::NonFinite`] for a non-finite start;
     /// [`LyapunovError::UnresolvedSeparation`] if `d0` is lost to rounding on `y0`.
     pub fn start(&mut self, t0: T, y0: SVector<T, N>) -> Result<()> {
         check_state(t0, &y0)?;
-        let mut z = y0;
-        z[0] += self.d0 * self.norm.scales()[0];
-        let realized = self.norm.norm(&(z - y0));
-        if !(realized > T::zero()) {
-            return Err(LyapunovError::UnresolvedSeparation {
-                d0: to_f64(self.d0),
-                realized: to_f64(realized),
-            });
-        }
-        self.state = Some((t0, y0, z));
+        let placed = self.runner.state.placed(y0)?;
+        self.runner.start(&mut self.flow, t0, placed);
         Ok(())
     }
 
     /// The reference state `(t, y)`.
     pub fn reference(&self) -> Option<(T, SVector<T, N>)> {
-        self.state.map(|(t, y, _)| (t, y))
+        self.runner.current().map(|(t, pair)| (t, pair.reference))
     }
 
-    /// One interval: both trajectories to `t + tau` (longer while their reset counts
-    /// differ); returns `(ln(d/d0), Δt)` and renormalizes.
-    fn interval(&mut self, tau: T, stats: &mut Stats) -> Result<(T, T)> {
-        let (t, y, z) = self.state.ok_or(LyapunovError::NotStarted)?;
-        let (mut cy, mut cz) = (ResetCount::default(), ResetCount::default());
-        let mut t1 = t + tau;
-        let oy = self.reference.run(t, y, t1, &mut cy)?;
-        let oz = self.perturbed.run(t, z, t1, &mut cz)?;
-        *stats += &oy.stats;
-        *stats += &oz.stats;
-        let (mut y1, mut z1) = (oy.y, oz.y);
-        let step = tau * lit(1e-3);
-        let mut extensions = 0;
-        while cy.0 != cz.0 {
-            if extensions >= 1000 {
-                return Err(LyapunovError::SeparationLost {
-                    t: to_f64(t1),
-                    separation: f64::INFINITY,
-                });
-            }
-            let t2 = t1 + step;
-            let oy = self.reference.run(t1, y1, t2, &mut cy)?;
-            let oz = self.perturbed.run(t1, z1, t2, &mut cz)?;
-            *stats += &oy.stats;
-            *stats += &oz.stats;
-            y1 = oy.y;
-            z1 = oz.y;
-            t1 = t2;
-            extensions += 1;
-        }
-        let delta = z1 - y1;
-        let d = self.norm.norm(&delta);
-        if !(d.is_finite() && d > T::zero()) {
-            return Err(LyapunovError::SeparationLost {
-                t: to_f64(t1),
-                separation: to_f64(d),
-            });
-        }
-        self.state = Some((t1, y1, y1 + delta * (self.d0 / d)));
-        Ok(((d / self.d0).ln(), t1 - t))
-    }
-
-    /// Runs `intervals` intervals of length `tau` and discards them.
+    /// Runs `intervals` intervals of length `tau` and discards them (a separation that
+    /// collapsed to zero is re-seeded along the initial direction).
     ///
     /// # Errors
-    /// As [`estimate`](Self::estimate).
+    /// As [`estimate`](Self::estimate), except that 0 intervals are allowed.
     pub fn transient(&mut self, tau: T, intervals: usize) -> Result<()> {
-        check_interval(tau)?;
-        let mut stats = Stats::default();
-        for _ in 0..intervals {
-            self.interval(tau, &mut stats)?;
-        }
-        Ok(())
+        self.runner
+            .transient::<_, 1>(&mut self.flow, tau, intervals)
     }
 
-    /// Runs `intervals` intervals of length `tau` and returns the estimate
-    /// `λ = Σ ln(d_k/d0) / Σ Δt_k` (`local[k] = ln(d_k/d0)/Δt_k`).
+    /// Runs `intervals` intervals on the grid `t_s + kτ` and returns the estimate
+    /// `λ = Σ ln(d_k/d_{k−1}') / Σ Δt_k` (`local[k] = ln(d_k/d_{k−1}')/Δt_k`; an interval
+    /// that ended late because the reset counts differed is longer, the next one shorter).
     ///
     /// # Errors
     /// [`LyapunovError::InvalidInterval`], [`LyapunovError::TooFewIntervals`],
     /// [`LyapunovError::NotStarted`], [`LyapunovError::SeparationLost`] (collapse,
-    /// overflow, or reset counts that do not match within 1000 extensions), integration and
+    /// overflow, or reset counts that do not match within 999 extensions), integration and
     /// event errors.
     pub fn estimate(&mut self, tau: T, intervals: usize) -> Result<Estimate<T>> {
-        check_interval(tau)?;
-        check_intervals(intervals, 2)?;
-        let blocks = self.blocks.min(intervals);
-        let mut stats = Stats::default();
-        let (mut log_sum, mut time) = (T::zero(), T::zero());
-        let mut local = Vec::with_capacity(intervals.min(1 << 16));
-        let mut history = Vec::with_capacity(intervals.min(1 << 16));
-        for _ in 0..intervals {
-            let (l, dt) = self.interval(tau, &mut stats)?;
-            log_sum += l;
-            time += dt;
-            local.push(l / dt);
-            history.push(log_sum / time);
-        }
-        Ok(Estimate {
-            exponent: log_sum / time,
-            spread: block_standard_error(intervals, blocks, |k| local[k]),
-            history,
-            local,
-            interval: tau,
-            blocks,
-            stats,
-        })
+        Ok(self
+            .runner
+            .estimate::<_, 1>(&mut self.flow, tau, intervals)?
+            .estimate())
     }
 }
 
@@ -352,9 +362,36 @@ where
 /// the [module docs](self)), Gram–Schmidt every `τ`.
 #[derive(Debug, Clone)]
 pub struct HybridTangentSpace<T: Real, const N: usize, const K: usize, const M: usize, S, St, E> {
-    sim: Simulation<T, M, Variational<T, S, N, K, M>, St, Saltation<T, S, E, N, K>>,
-    blocks: usize,
-    state: Option<(T, SVector<T, M>)>,
+    flow: Simulated<T, M, Variational<T, S, N, K, M>, St, Saltation<T, S, E, N, K>>,
+    runner: Runner<T, Frame<T, N, K>>,
+}
+
+impl<T, const N: usize, const M: usize, S, St, E> HybridTangentSpace<T, N, N, M, S, St, E>
+where
+    T: Real,
+    S: Dynamics<T, N> + Clone,
+    St: Stepper<T, M>,
+    Dims<N>: TangentDimension<N, M>,
+    E: EventSet<T, N>,
+{
+    /// The whole spectrum (`K = N`) of `system` with the events `events`, the stepper built
+    /// from the system's tolerances `tol` (extended by
+    /// [`tangent_tolerances`](super::tangent_tolerances) with `tangent_rtol`,
+    /// `tangent_atol`), the size `M = N + N²` inferred: no size is written.
+    ///
+    /// # Errors
+    /// As [`tangent_tolerances`](super::tangent_tolerances) and [`new`](Self::new).
+    pub fn from_tolerances(
+        system: S,
+        tol: &Tolerances<T, N>,
+        make_stepper: impl FnOnce(Tolerances<T, M>) -> St,
+        (tangent_rtol, tangent_atol): (T, T),
+        events: E,
+        norm: Norm<T, N>,
+    ) -> Result<Self> {
+        let t = super::tangent_tolerances::<T, N, N, M>(tol, tangent_rtol, tangent_atol)?;
+        Self::new(system, make_stepper(t), events, norm)
+    }
 }
 
 impl<T, const N: usize, const K: usize, const M: usize, S, St, E>
@@ -379,9 +416,11 @@ where
             scales,
         };
         Ok(Self {
-            sim: Simulation::new(var, stepper).with_events(lifted),
-            blocks: DEFAULT_BLOCKS,
-            state: None,
+            flow: Simulated {
+                sim: Simulation::new(var, stepper).with_events(lifted),
+                work: Stats::default(),
+            },
+            runner: Runner::new(Frame::at(SVector::zeros())),
         })
     }
 
@@ -391,90 +430,31 @@ where
     /// [`LyapunovError::NonFinite`] for a non-finite start; [`LyapunovError::NoJacobian`]
     /// if the system has no Jacobian at `y0`.
     pub fn start(&mut self, t0: T, y0: SVector<T, N>) -> Result<()> {
-        check_state(t0, &y0)?;
-        if self.sim.system().system().jacobian(t0, &y0).is_none() {
-            return Err(LyapunovError::NoJacobian { t: to_f64(t0) });
-        }
-        let mut psi = SMatrix::<T, N, K>::zeros();
-        for c in 0..K {
-            psi[(c, c)] = T::one();
-        }
-        self.state = Some((t0, self.sim.system().join(&y0, &psi)));
+        check_jacobian_at(self.flow.sim.system().system(), t0, &y0)?;
+        self.runner.start(&mut self.flow, t0, Frame::at(y0));
         Ok(())
     }
 
-    fn interval(&mut self, tau: T, stats: &mut Stats) -> Result<[T; K]> {
-        let (t, z) = self.state.ok_or(LyapunovError::NotStarted)?;
-        let out = self.sim.run(t, z, t + tau, &mut ())?;
-        *stats += &out.stats;
-        let (y, mut psi) = self.sim.system().split(&out.y);
-        let r = gram_schmidt(&mut psi);
-        let mut logs = [T::zero(); K];
-        for (c, l) in logs.iter_mut().enumerate() {
-            if !(r[c].is_finite() && r[c] > T::zero()) {
-                return Err(LyapunovError::TangentCollapse {
-                    t: to_f64(out.t),
-                    index: c,
-                    value: to_f64(r[c]),
-                });
-            }
-            *l = r[c].ln();
-        }
-        self.state = Some((out.t, self.sim.system().join(&y, &psi)));
-        Ok(logs)
-    }
-
-    /// Runs `intervals` intervals of length `tau` and discards them.
+    /// Runs `intervals` intervals of length `tau` and discards them (a tangent vector that
+    /// collapsed is replaced, as in [`TangentSpace::transient`](super::TangentSpace::transient)).
     ///
     /// # Errors
-    /// As [`estimate`](Self::estimate).
+    /// As [`estimate`](Self::estimate), except that 0 intervals are allowed.
     pub fn transient(&mut self, tau: T, intervals: usize) -> Result<()> {
-        check_interval(tau)?;
-        let mut stats = Stats::default();
-        for _ in 0..intervals {
-            self.interval(tau, &mut stats)?;
-        }
-        Ok(())
+        self.runner
+            .transient::<_, K>(&mut self.flow, tau, intervals)
     }
 
-    /// Runs `intervals` intervals of length `tau` and returns the `K` exponents.
+    /// Runs `intervals` intervals on the grid `t_s + kτ` and returns the `K` exponents.
     ///
     /// # Errors
     /// [`LyapunovError::InvalidInterval`], [`LyapunovError::TooFewIntervals`],
     /// [`LyapunovError::NotStarted`], [`LyapunovError::TangentCollapse`], integration and
     /// event errors.
     pub fn estimate(&mut self, tau: T, intervals: usize) -> Result<Spectrum<T, K>> {
-        check_interval(tau)?;
-        check_intervals(intervals, 2)?;
-        let blocks = self.blocks.min(intervals);
-        let mut stats = Stats::default();
-        let mut sums = [T::zero(); K];
-        let mut local = Vec::with_capacity(intervals.min(1 << 16));
-        let mut history = Vec::with_capacity(intervals.min(1 << 16));
-        for k in 0..intervals {
-            let logs = self.interval(tau, &mut stats)?;
-            let mut rates = [T::zero(); K];
-            for c in 0..K {
-                sums[c] += logs[c];
-                rates[c] = logs[c] / tau;
-            }
-            local.push(rates);
-            let n = tau * lit::<T>((k + 1) as f64);
-            history.push(sums.map(|s| s / n));
-        }
-        let total = tau * lit::<T>(intervals as f64);
-        let mut spread = [T::zero(); K];
-        for (c, s) in spread.iter_mut().enumerate() {
-            *s = block_standard_error(intervals, blocks, |k| local[k][c]);
-        }
-        Ok(Spectrum {
-            exponents: sums.map(|s| s / total),
-            spread,
-            history,
-            local,
-            interval: tau,
-            blocks,
-            stats,
-        })
+        Ok(self
+            .runner
+            .estimate::<_, K>(&mut self.flow, tau, intervals)?
+            .spectrum())
     }
 }

@@ -3,6 +3,13 @@
 //! exponent-versus-parameter diagram.
 //!
 //! # The two methods
+//! Every estimator is a configuration of one renormalizing runner: a flow (one stepper on an
+//! augmented system, the event engine with resets, Filippov runs) and a renormalization (a
+//! separation vector, or `K` tangent vectors re-orthonormalized by QR); the grid, the
+//! transient, the records, the statistics and the errors are written once. Sizes are
+//! inferred: `M = 2N` and `M = N + N·K` come from the type system ([`PairDimension`],
+//! [`TangentDimension`]) in the constructors that take the system's tolerances.
+//!
 //! **Two trajectories** ([`TwoTrajectory`]). A reference trajectory `y` and a perturbed one
 //! `ỹ = y + δ` are integrated *together* as one system of dimension `M = 2N`
 //! ([`PerturbedPair`]), so that both take exactly the same steps and their discretizations
@@ -79,7 +86,7 @@
 //! ```
 //! use nalgebra::Vector3;
 //! use nonsmooth::integrate::{Dopri5, Tolerances};
-//! use nonsmooth::lyapunov::{Norm, TwoTrajectory, pair_tolerances};
+//! use nonsmooth::lyapunov::{Norm, TwoTrajectory};
 //! # #[derive(Clone, Copy)]
 //! # struct Lorenz;
 //! # impl nonsmooth::Dynamics<f64, 3> for Lorenz {
@@ -89,9 +96,10 @@
 //! #         dy[2] = y[0] * y[1] - 8.0 / 3.0 * y[2];
 //! #     }
 //! # }
-//! // The Lorenz system (σ, ρ, β) = (10, 28, 8/3); the pair has dimension 2·3 = 6.
-//! let tol = pair_tolerances::<f64, 3, 6>(&Tolerances::new(1e-9, 1e-9)?)?;
-//! let mut est = TwoTrajectory::<f64, 3, 6, _, _>::new(Lorenz, Dopri5::new(tol), 1e-8, Norm::Euclidean)?;
+//! // The Lorenz system (σ, ρ, β) = (10, 28, 8/3); the pair has dimension 2·3 = 6, inferred
+//! // from the system's tolerances (no size is written).
+//! let tol = Tolerances::new(1e-9, 1e-9)?;
+//! let mut est = TwoTrajectory::from_tolerances(Lorenz, &tol, Dopri5::new, 1e-8, Norm::Euclidean)?;
 //! est.start(0.0, Vector3::new(1.0, 1.0, 20.0))?;
 //! est.transient(1.0, 20)?;
 //! let e = est.estimate(1.0, 200)?;
@@ -110,6 +118,8 @@ mod diagram;
 mod filippov;
 pub mod hybrid;
 mod lanes;
+mod runner;
+mod sizes;
 mod tangent;
 mod two_trajectory;
 
@@ -121,6 +131,7 @@ pub use hybrid::{HybridTangentSpace, HybridTwoTrajectory, Saltation};
 pub use lanes::tle_independent;
 #[cfg(feature = "parallel")]
 pub use lanes::tle_independent_parallel;
+pub use sizes::{Dims, PairDimension, TangentDimension};
 pub use tangent::{Spectrum, TangentSpace, Variational, tangent_tolerances};
 pub use two_trajectory::{
     PerturbedPair, SeparationPoint, TwoTrajectory, decades, pair_tolerances, separation_study,
@@ -553,35 +564,6 @@ pub(crate) fn integrate_to<T: Real, const M: usize, D: Dynamics<T, M>, St: Stepp
         stepper.step(sys, t_target)?;
         steps += 1;
     }
-    Ok(())
-}
-
-/// Drops a stepper's derivative cache at its current state (after its system changed).
-pub(crate) fn refresh_cache<T: Real, const M: usize, St: crate::integrate::Stepper<T, M>>(
-    stepper: &mut St,
-) {
-    let (t, z) = stepper.current();
-    let z = *z;
-    stepper.reset_state(t, z);
-}
-
-/// Moves a started stepper's clock to `t0`, keeping its state.
-pub(crate) fn set_clock<T: Real, const M: usize, St: crate::integrate::Stepper<T, M>>(
-    stepper: &mut St,
-    started: bool,
-    t0: T,
-) -> Result<()> {
-    if !t0.is_finite() {
-        return Err(LyapunovError::NonFinite {
-            what: "t0",
-            value: crate::scalar::to_f64(t0),
-        });
-    }
-    if !started {
-        return Err(LyapunovError::NotStarted);
-    }
-    let z = *stepper.current().1;
-    stepper.reset_state(t0, z);
     Ok(())
 }
 

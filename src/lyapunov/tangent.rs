@@ -3,13 +3,14 @@
 use nalgebra::{SMatrix, SVector};
 
 use super::Result;
+use super::runner::{Augmented, Flow, Frame, Record, Runner, Stepped};
+use super::sizes::{Dims, TangentDimension};
 use super::{
-    DEFAULT_BLOCKS, DEFAULT_MAX_STEPS_PER_INTERVAL, LyapunovError, Norm, block_standard_error,
-    check_blocks, check_interval_at, check_intervals, check_state, grid_time, integrate_to,
+    DEFAULT_MAX_STEPS_PER_INTERVAL, LyapunovError, Norm, block_standard_error, check_blocks,
+    check_state,
 };
 use crate::integrate::{Stats, Stepper, Tolerances};
-use crate::linalg::gram_schmidt;
-use crate::scalar::{lit, nan, to_f64};
+use crate::scalar::{nan, to_f64};
 use crate::{Dynamics, Real};
 
 /// A system with `K` tangent vectors: state `(y, ψ_1, …, ψ_K)` of dimension
@@ -161,6 +162,20 @@ impl<T: Real, S: Dynamics<T, N>, const N: usize, const K: usize, const M: usize>
     }
 }
 
+impl<T: Real, S, const N: usize, const K: usize, const M: usize> Augmented<T, M, Frame<T, N, K>>
+    for Variational<T, S, N, K, M>
+{
+    #[inline]
+    fn pack(&self, state: &Frame<T, N, K>) -> SVector<T, M> {
+        self.join(&state.y, &state.psi)
+    }
+
+    #[inline]
+    fn unpack(&self, z: &SVector<T, M>, state: &mut Frame<T, N, K>) {
+        (state.y, state.psi) = self.split(z);
+    }
+}
+
 /// The tolerances of a [`Variational`] system: the system's tolerances for the state and
 /// `tangent_rtol`, `tangent_atol` for the tangent components.
 ///
@@ -175,15 +190,20 @@ impl<T: Real, S: Dynamics<T, N>, const N: usize, const K: usize, const M: usize>
 /// near `ln(tangent_atol)/τ` (for `ẏ = −800·y`, `τ = 1`, `tangent_atol = 10⁻¹¹` the method
 /// returns −26.6, not −800).
 ///
+/// `M = N + N·K` is inferred (a wrong `M` does not compile, see [`TangentDimension`]).
+///
 /// # Errors
-/// [`LyapunovError::TangentCount`] / [`LyapunovError::Dimension`] for mismatched `K`, `M`;
+/// [`LyapunovError::TangentCount`] unless `1 ≤ K ≤ N`;
 /// [`ParameterError`](crate::ParameterError) unless both tangent tolerances are finite and
 /// > 0.
 pub fn tangent_tolerances<T: Real, const N: usize, const K: usize, const M: usize>(
     tol: &Tolerances<T, N>,
     tangent_rtol: T,
     tangent_atol: T,
-) -> Result<Tolerances<T, M>> {
+) -> Result<Tolerances<T, M>>
+where
+    Dims<N>: TangentDimension<K, M>,
+{
     check_tangent_dims::<N, K, M>()?;
     crate::validate::positive("tangent_rtol", tangent_rtol)?;
     crate::validate::positive("tangent_atol", tangent_atol)?;
@@ -240,37 +260,98 @@ impl<T: Real, const K: usize> Spectrum<T, K> {
     }
 }
 
+impl<T: Real, const K: usize> Record<T, K> {
+    /// As a [`Spectrum`] of `K` exponents.
+    pub(crate) fn spectrum(self) -> Spectrum<T, K> {
+        Spectrum {
+            exponents: self.exponents,
+            spread: self.spread,
+            history: self.history,
+            local: self.local,
+            interval: self.interval,
+            blocks: self.blocks,
+            stats: self.stats,
+        }
+    }
+}
+
 /// The tangent-space (QR) estimator of the `K` leading Lyapunov exponents.
 ///
 /// Owns the [`Variational`] system and a stepper for it (`St: Stepper<T, M>`,
 /// `M = N + N·K`); used like [`TwoTrajectory`](super::TwoTrajectory):
 /// [`start`](Self::start), [`transient`](Self::transient), [`estimate`](Self::estimate).
-/// The tangent vectors start as the first `K` scaled unit vectors.
+/// The tangent vectors start as the first `K` scaled unit vectors. For the whole spectrum
+/// (`K = N`), [`from_tolerances`](Self::from_tolerances) infers every size:
 ///
 /// ```
 /// use nalgebra::Vector2;
 /// use nonsmooth::integrate::{Dopri5, Tolerances};
-/// use nonsmooth::lyapunov::{Norm, TangentSpace, tangent_tolerances};
+/// use nonsmooth::lyapunov::{Norm, TangentSpace};
 /// use nonsmooth::testing::DampedOscillator;
 ///
 /// // ẍ + 2ζω₀ẋ + ω₀²x = 0: both exponents are −ζω₀ = −0.3.
 /// let osc = DampedOscillator::new(2.0, 0.15)?;
-/// let tol = tangent_tolerances::<f64, 2, 2, 6>(&Tolerances::new(1e-10, 1e-12)?, 1e-10, 1e-10)?;
-/// let mut qr = TangentSpace::<f64, 2, 2, 6, _, _>::new(osc, Dopri5::new(tol), Norm::Euclidean)?;
+/// let tol = Tolerances::new(1e-10, 1e-12)?;
+/// let mut qr = TangentSpace::from_tolerances(osc, &tol, Dopri5::new, (1e-10, 1e-10), Norm::Euclidean)?;
 /// qr.start(0.0, Vector2::new(1.0, 0.0))?;
 /// let s = qr.estimate(std::f64::consts::PI, 200)?;
 /// assert!((s.exponents[0] + 0.3).abs() < 1e-2 && (s.exponents[1] + 0.3).abs() < 1e-2);
 /// assert!((s.sum() + 0.6).abs() < 1e-8); // tr J = −2ζω₀, exactly, at every interval
 /// # Ok::<(), nonsmooth::Error>(())
 /// ```
+///
+/// With fewer tangent vectors, `K` is the one size to write (`N` comes from the system,
+/// `M` follows):
+/// ```
+/// # use nalgebra::Vector2;
+/// # use nonsmooth::integrate::{Dopri5, Tolerances};
+/// # use nonsmooth::lyapunov::{Norm, TangentSpace};
+/// # use nonsmooth::testing::DampedOscillator;
+/// let osc = DampedOscillator::new(2.0, 0.15)?;
+/// let tol = Tolerances::new(1e-10, 1e-12)?;
+/// let mut top = TangentSpace::<_, _, 1, _, _, _>::with_tolerances(
+///     osc, Dopri5::new, &tol, (1e-10, 1e-10), Norm::Euclidean,
+/// )?;
+/// top.start(0.0, Vector2::new(1.0, 0.0))?;
+/// assert_eq!(top.estimate(1.0, 10)?.exponents.len(), 1);
+/// # Ok::<(), nonsmooth::Error>(())
+/// ```
 #[derive(Debug, Clone)]
 pub struct TangentSpace<T: Real, const N: usize, const K: usize, const M: usize, S, St> {
-    var: Variational<T, S, N, K, M>,
-    stepper: St,
+    flow: Stepped<Variational<T, S, N, K, M>, St, M>,
+    runner: Runner<T, Frame<T, N, K>>,
     norm: Norm<T, N>,
-    blocks: usize,
-    max_steps: usize,
-    started: bool,
+}
+
+impl<T, const N: usize, const M: usize, S, St> TangentSpace<T, N, N, M, S, St>
+where
+    T: Real,
+    S: Dynamics<T, N>,
+    St: Stepper<T, M>,
+    Dims<N>: TangentDimension<N, M>,
+{
+    /// The whole spectrum (`K = N`), the stepper built from the system's tolerances `tol`
+    /// (extended by [`tangent_tolerances`] with `tangent_rtol`, `tangent_atol`), the size
+    /// `M = N + N²` inferred: no size is written, and a wrong `M` does not compile
+    /// ([`TangentDimension`]).
+    ///
+    /// # Errors
+    /// As [`tangent_tolerances`] and [`new`](Self::new).
+    pub fn from_tolerances(
+        system: S,
+        tol: &Tolerances<T, N>,
+        make_stepper: impl FnOnce(Tolerances<T, M>) -> St,
+        (tangent_rtol, tangent_atol): (T, T),
+        norm: Norm<T, N>,
+    ) -> Result<Self> {
+        Self::with_tolerances(
+            system,
+            make_stepper,
+            tol,
+            (tangent_rtol, tangent_atol),
+            norm,
+        )
+    }
 }
 
 impl<T, const N: usize, const K: usize, const M: usize, S, St> TangentSpace<T, N, K, M, S, St>
@@ -286,18 +367,21 @@ where
     /// As [`Variational::new`].
     pub fn new(system: S, stepper: St, norm: Norm<T, N>) -> Result<Self> {
         Ok(Self {
-            var: Variational::new(system, norm)?,
-            stepper,
+            flow: Stepped {
+                system: Variational::new(system, norm)?,
+                stepper,
+                max_steps: DEFAULT_MAX_STEPS_PER_INTERVAL,
+            },
+            runner: Runner::new(Frame::at(SVector::zeros())),
             norm,
-            blocks: DEFAULT_BLOCKS,
-            max_steps: DEFAULT_MAX_STEPS_PER_INTERVAL,
-            started: false,
         })
     }
 
     /// An estimator whose stepper is built from the system's tolerances: `make_stepper`
     /// receives them extended by [`tangent_tolerances`] with `tangent_rtol`,
-    /// `tangent_atol`, so the sizes are spelled once, on the estimator.
+    /// `tangent_atol`. `M = N + N·K` is inferred (and a wrong one does not compile,
+    /// [`TangentDimension`]); for `K = N`, [`from_tolerances`](TangentSpace::from_tolerances)
+    /// infers `K` too.
     ///
     /// ```
     /// use nonsmooth::integrate::{Dopri5, Tolerances};
@@ -323,7 +407,10 @@ where
         tol: &Tolerances<T, N>,
         (tangent_rtol, tangent_atol): (T, T),
         norm: Norm<T, N>,
-    ) -> Result<Self> {
+    ) -> Result<Self>
+    where
+        Dims<N>: TangentDimension<K, M>,
+    {
         let t = tangent_tolerances::<T, N, K, M>(tol, tangent_rtol, tangent_atol)?;
         Self::new(system, make_stepper(t), norm)
     }
@@ -333,7 +420,7 @@ where
     /// # Errors
     /// [`LyapunovError::InvalidBlocks`] if `blocks < 2`.
     pub fn with_blocks(mut self, blocks: usize) -> Result<Self> {
-        self.blocks = check_blocks(blocks)?;
+        self.runner.blocks = check_blocks(blocks)?;
         Ok(self)
     }
 
@@ -342,7 +429,7 @@ where
     /// # Errors
     /// [`ParameterError`](crate::ParameterError) if `max_steps == 0`.
     pub fn with_max_steps_per_interval(mut self, max_steps: usize) -> Result<Self> {
-        self.max_steps = super::check_max_steps(max_steps)?;
+        self.flow.max_steps = super::check_max_steps(max_steps)?;
         Ok(self)
     }
 
@@ -353,21 +440,16 @@ where
     /// [`LyapunovError::NonFinite`] for a non-finite `t0` or `y0`;
     /// [`LyapunovError::NoJacobian`] if the system has no Jacobian at `(t0, y0)`.
     pub fn start(&mut self, t0: T, y0: SVector<T, N>) -> Result<()> {
-        check_state(t0, &y0)?;
-        if self.var.system().jacobian(t0, &y0).is_none() {
-            return Err(LyapunovError::NoJacobian { t: to_f64(t0) });
-        }
-        let psi = SMatrix::<T, N, K>::identity();
-        self.stepper.reset_state(t0, self.var.join(&y0, &psi));
-        self.started = true;
+        check_jacobian_at(self.flow.system.system(), t0, &y0)?;
+        self.runner.start(&mut self.flow, t0, Frame::at(y0));
         Ok(())
     }
 
     /// Replaces the system, keeping the state and the tangent vectors.
     pub fn set_system(&mut self, system: S) {
-        self.var.set_system(system);
-        if self.started {
-            super::refresh_cache(&mut self.stepper);
+        self.flow.system.set_system(system);
+        if let Some((t, state)) = self.runner.current() {
+            self.flow.restart(state, t);
         }
     }
 
@@ -376,14 +458,14 @@ where
     /// # Errors
     /// [`LyapunovError::NonFinite`] if `t0` is not finite; [`LyapunovError::NotStarted`].
     pub fn set_time(&mut self, t0: T) -> Result<()> {
-        super::set_clock(&mut self.stepper, self.started, t0)
+        self.runner.set_time(&mut self.flow, t0)
     }
 
     /// Runs `intervals` re-orthonormalization intervals of length `tau`, discarding them.
     ///
     /// A tangent vector that collapses onto the span of the previous ones within an
     /// interval (`R_jj = 0` in floating point: its contraction relative to them exceeds the
-    /// range of `T`, as happens to the paper's cart resting against the stop, where velocity
+    /// range of `T`, as happens to a cart resting against a stop, where velocity
     /// perturbations decay at `~10⁶ s⁻¹`) is replaced by a unit vector orthogonal to them:
     /// transients only have to bring the state onto the attractor. In
     /// [`estimate`](Self::estimate) the same event is an error.
@@ -391,8 +473,8 @@ where
     /// # Errors
     /// As [`estimate`](Self::estimate), except that 0 intervals are allowed (a no-op).
     pub fn transient(&mut self, tau: T, intervals: usize) -> Result<()> {
-        check_interval_at(self.stepper.current().0, tau)?;
-        self.run(tau, intervals, true, |_, _| {})
+        self.runner
+            .transient::<_, K>(&mut self.flow, tau, intervals)
     }
 
     /// Runs `intervals` intervals of length `tau` and returns the spectrum estimate.
@@ -403,53 +485,22 @@ where
     /// vector degenerates within an interval (shorten `tau`), and integration errors (a
     /// non-finite right-hand side where the Jacobian is missing or infinite).
     pub fn estimate(&mut self, tau: T, intervals: usize) -> Result<Spectrum<T, K>> {
-        check_interval_at(self.stepper.current().0, tau)?;
-        check_intervals(intervals, 2)?;
-        let blocks = self.blocks.min(intervals);
-        let s0 = *self.stepper.stats();
-        let mut local = Vec::with_capacity(intervals.min(1 << 16));
-        let mut history = Vec::with_capacity(intervals.min(1 << 16));
-        let mut sum = [T::zero(); K];
-        self.run(tau, intervals, false, |k, s| {
-            local.push(s);
-            let n = lit::<T>((k + 1) as f64);
-            let mut h = [T::zero(); K];
-            for j in 0..K {
-                sum[j] += s[j];
-                h[j] = sum[j] / n;
-            }
-            history.push(h);
-        })?;
-        let nf = lit::<T>(intervals as f64);
-        let mut exponents = [T::zero(); K];
-        let mut spread = [T::zero(); K];
-        for j in 0..K {
-            exponents[j] = sum[j] / nf;
-            spread[j] = block_standard_error(intervals, blocks, |k| local[k][j]);
-        }
-        Ok(Spectrum {
-            exponents,
-            spread,
-            history,
-            local,
-            interval: tau,
-            blocks,
-            stats: self.stepper.stats().since(&s0),
-        })
+        Ok(self
+            .runner
+            .estimate::<_, K>(&mut self.flow, tau, intervals)?
+            .spectrum())
     }
 
     /// The state `(t, y)`.
     pub fn state(&self) -> (T, SVector<T, N>) {
-        let (t, z) = self.stepper.current();
-        (t, self.var.split(z).0)
+        (self.runner.t, self.runner.state.y)
     }
 
     /// The current tangent vectors in physical units (`Dψ_j`, orthonormal in the norm
     /// right after a re-orthonormalization).
     pub fn tangent_vectors(&self) -> SMatrix<T, N, K> {
-        let (_, psi) = self.var.split(self.stepper.current().1);
         let w = self.norm.scales();
-        let mut out = psi;
+        let mut out = self.runner.state.psi;
         for c in 0..K {
             for i in 0..N {
                 out[(i, c)] *= w[i];
@@ -460,83 +511,29 @@ where
 
     /// The system.
     pub fn system(&self) -> &S {
-        self.var.system()
+        self.flow.system.system()
     }
 
     /// The stepper.
     pub fn stepper(&self) -> &St {
-        &self.stepper
-    }
-
-    /// The core loop: `intervals` intervals, `sink(k, [ln(R_jj)/τ])` after each;
-    /// `reseed`: replace collapsed tangent vectors instead of failing.
-    fn run(
-        &mut self,
-        tau: T,
-        intervals: usize,
-        reseed: bool,
-        mut sink: impl FnMut(usize, [T; K]),
-    ) -> Result<()> {
-        if !self.started {
-            return Err(LyapunovError::NotStarted);
-        }
-        let t_start = self.stepper.current().0;
-        for k in 0..intervals {
-            let t_k = grid_time(t_start, tau, k + 1);
-            integrate_to(&mut self.stepper, &self.var, t_k, self.max_steps)?;
-            let (y, mut psi) = self.var.split(self.stepper.current().1);
-            let r = gram_schmidt(&mut psi);
-            if reseed && r.iter().all(|v| v.is_finite()) && r.iter().any(|&v| v == T::zero()) {
-                reseed_columns(&mut psi, &r);
-                self.stepper.reset_state(t_k, self.var.join(&y, &psi));
-                continue;
-            }
-            let mut s = [T::zero(); K];
-            for j in 0..K {
-                if !(r[j].is_finite() && r[j] > T::zero()) {
-                    return Err(LyapunovError::TangentCollapse {
-                        t: to_f64(t_k),
-                        index: j,
-                        value: to_f64(r[j]),
-                    });
-                }
-                s[j] = r[j].ln() / tau;
-            }
-            sink(k, s);
-            self.stepper.reset_state(t_k, self.var.join(&y, &psi));
-        }
-        Ok(())
+        &self.flow.stepper
     }
 }
 
-/// Replaces the zero columns `j` (`r[j] == 0`) of `psi` (orthonormal otherwise) by unit
-/// vectors orthogonal to all other columns.
-fn reseed_columns<T: Real, const N: usize, const K: usize>(psi: &mut SMatrix<T, N, K>, r: &[T; K]) {
-    for (j, &rj) in r.iter().enumerate() {
-        if rj != T::zero() {
-            continue;
-        }
-        // The unit vector e_i with the largest component outside the other columns' span.
-        let mut best = SVector::<T, N>::zeros();
-        let mut best_norm = T::zero();
-        for i in 0..N {
-            let mut v = SVector::<T, N>::zeros();
-            v[i] = T::one();
-            // Zero columns (not yet re-seeded) contribute nothing.
-            for c in (0..K).filter(|&c| c != j) {
-                let col = psi.column(c).into_owned();
-                v -= col * col.dot(&v);
-            }
-            let n = v.norm();
-            if n > best_norm {
-                best_norm = n;
-                best = v;
-            }
-        }
-        if best_norm > T::zero() {
-            psi.set_column(j, &(best / best_norm));
-        }
+/// Checks `(t0, y0)` and that the system has a Jacobian there.
+///
+/// # Errors
+/// [`LyapunovError::NonFinite`], [`LyapunovError::NoJacobian`].
+pub(crate) fn check_jacobian_at<T: Real, const N: usize, S: Dynamics<T, N>>(
+    system: &S,
+    t0: T,
+    y0: &SVector<T, N>,
+) -> Result<()> {
+    check_state(t0, y0)?;
+    if system.jacobian(t0, y0).is_none() {
+        return Err(LyapunovError::NoJacobian { t: to_f64(t0) });
     }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -611,6 +608,7 @@ mod tests {
 
     #[test]
     fn collapsed_columns_are_reseeded_orthonormal() {
+        use super::super::runner::reseed_columns;
         let mut psi = SMatrix::<f64, 3, 3>::new(1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
         reseed_columns(&mut psi, &[1.0, 0.0, 0.0]);
         assert!((psi.transpose() * psi - SMatrix::<f64, 3, 3>::identity()).norm() < 1e-15);

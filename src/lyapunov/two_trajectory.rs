@@ -3,10 +3,11 @@
 use nalgebra::{SMatrix, SVector};
 
 use super::Result;
+use super::runner::{Augmented, Flow, Runner, Separation, Stepped};
+use super::sizes::{Dims, PairDimension};
 use super::{
-    DEFAULT_BLOCKS, DEFAULT_MAX_STEPS_PER_INTERVAL, Estimate, LyapunovError, Norm,
-    block_standard_error, check_blocks, check_interval, check_interval_at, check_intervals,
-    check_state, grid_time, integrate_to,
+    DEFAULT_MAX_STEPS_PER_INTERVAL, Estimate, LyapunovError, Norm, check_blocks, check_interval,
+    check_intervals, check_state,
 };
 use crate::integrate::{Stepper, Tolerances};
 use crate::scalar::{lit, to_f64};
@@ -15,8 +16,9 @@ use crate::{Dynamics, Real};
 /// A reference trajectory and a perturbed copy as one system of dimension `M = 2N`: the
 /// state is `(y, ỹ)` with `y` in components `0..N` and `ỹ` in `N..2N`.
 ///
-/// Const-generic arithmetic (`M = 2 * N`) is not stable, so `M` is a separate parameter and
-/// [`new`](Self::new) checks it. The Jacobian (block diagonal) and the time derivative are
+/// Const-generic arithmetic (`M = 2 * N`) is not stable, so `M` is a separate parameter:
+/// [`new`](Self::new) checks it, and the estimator's
+/// [`from_tolerances`](TwoTrajectory::from_tolerances) infers it ([`PairDimension`]). The Jacobian (block diagonal) and the time derivative are
 /// forwarded when the system has them, so implicit steppers work on the pair too.
 ///
 /// ```
@@ -43,14 +45,7 @@ impl<S, const N: usize, const M: usize> PerturbedPair<S, N, M> {
     /// # Errors
     /// [`LyapunovError::Dimension`] unless `M == 2·N` and `N ≥ 1`.
     pub fn new(system: S) -> Result<Self, LyapunovError> {
-        if N == 0 || M != 2 * N {
-            return Err(LyapunovError::Dimension {
-                what: "two trajectories (M = 2N)",
-                n: N,
-                expected: 2 * N,
-                found: M,
-            });
-        }
+        check_pair_dims::<N, M>()?;
         Ok(Self { system })
     }
 
@@ -136,27 +131,52 @@ pub(crate) fn check_pair_settings<T: Real, const N: usize, const M: usize>(
     d0: T,
     norm: &Norm<T, N>,
 ) -> Result<(), LyapunovError> {
-    if N == 0 || M != 2 * N {
-        return Err(LyapunovError::Dimension {
-            what: "two trajectories (M = 2N)",
-            n: N,
-            expected: 2 * N,
-            found: M,
-        });
-    }
+    check_pair_dims::<N, M>()?;
     if !(d0.is_finite() && d0 > T::zero()) {
         return Err(LyapunovError::InvalidSeparation { d0: to_f64(d0) });
     }
     norm.validate()
 }
 
+impl<T: Real, S, const N: usize, const M: usize> Augmented<T, M, Separation<T, N>>
+    for PerturbedPair<S, N, M>
+{
+    #[inline]
+    fn pack(&self, state: &Separation<T, N>) -> SVector<T, M> {
+        self.join(&state.reference, &state.perturbed)
+    }
+
+    #[inline]
+    fn unpack(&self, z: &SVector<T, M>, state: &mut Separation<T, N>) {
+        (state.reference, state.perturbed) = self.split(z);
+    }
+}
+
 /// The tolerances of a [`PerturbedPair`]: the system's tolerances for both copies.
 ///
+/// The pair's dimension `M = 2N` is inferred (a wrong `M` does not compile, see
+/// [`PairDimension`]):
+/// ```
+/// use nonsmooth::integrate::{Dopri5, Tolerances};
+/// use nonsmooth::lyapunov::pair_tolerances;
+/// let pair = Dopri5::new(pair_tolerances(&Tolerances::per_component(1e-9, [1e-12, 1e-10])?)?);
+/// assert_eq!(pair.tolerances().atol.len(), 4);
+/// # Ok::<(), nonsmooth::Error>(())
+/// ```
+///
 /// # Errors
-/// [`LyapunovError::Dimension`] unless `M == 2·N`.
+/// [`LyapunovError::Dimension`] for `N = 0`.
 pub fn pair_tolerances<T: Real, const N: usize, const M: usize>(
     tol: &Tolerances<T, N>,
-) -> Result<Tolerances<T, M>, LyapunovError> {
+) -> Result<Tolerances<T, M>, LyapunovError>
+where
+    Dims<N>: PairDimension<M>,
+{
+    check_pair_dims::<N, M>()?;
+    Ok(doubled(tol))
+}
+
+fn check_pair_dims<const N: usize, const M: usize>() -> Result<(), LyapunovError> {
     if N == 0 || M != 2 * N {
         return Err(LyapunovError::Dimension {
             what: "two trajectories (M = 2N)",
@@ -165,6 +185,11 @@ pub fn pair_tolerances<T: Real, const N: usize, const M: usize>(
             found: M,
         });
     }
+    Ok(())
+}
+
+/// `tol` for both copies (`M = 2N`, checked by the caller).
+fn doubled<T: Real, const N: usize, const M: usize>(tol: &Tolerances<T, N>) -> Tolerances<T, M> {
     let mut rtol = SVector::<T, M>::zeros();
     let mut atol = SVector::<T, M>::zeros();
     for i in 0..N {
@@ -173,7 +198,7 @@ pub fn pair_tolerances<T: Real, const N: usize, const M: usize>(
         atol[i] = tol.atol[i];
         atol[N + i] = tol.atol[i];
     }
-    Ok(Tolerances { rtol, atol })
+    Tolerances { rtol, atol }
 }
 
 /// The two-trajectory (Benettin) estimator of the top Lyapunov exponent.
@@ -185,17 +210,14 @@ pub fn pair_tolerances<T: Real, const N: usize, const M: usize>(
 /// For continuation in a parameter, [`set_system`](Self::set_system) and
 /// [`set_time`](Self::set_time) keep the state (and the separation) of the pair.
 ///
+/// Build it from the system's tolerances with [`from_tolerances`](Self::from_tolerances):
+/// the pair's size `M = 2N` is then inferred, no size is written.
+///
 /// See the [module docs](super) for the formula and an example.
 #[derive(Debug, Clone)]
 pub struct TwoTrajectory<T: Real, const N: usize, const M: usize, S, St> {
-    pair: PerturbedPair<S, N, M>,
-    stepper: St,
-    d0: T,
-    norm: Norm<T, N>,
-    direction: SVector<T, N>,
-    blocks: usize,
-    max_steps: usize,
-    started: bool,
+    flow: Stepped<PerturbedPair<S, N, M>, St, M>,
+    runner: Runner<T, Separation<T, N>>,
 }
 
 impl<T, const N: usize, const M: usize, S, St> TwoTrajectory<T, N, M, S, St>
@@ -213,24 +235,20 @@ where
     /// unless `d0` is finite and > 0; [`LyapunovError::InvalidWeight`] for a bad norm.
     pub fn new(system: S, stepper: St, d0: T, norm: Norm<T, N>) -> Result<Self> {
         check_pair_settings::<T, N, M>(d0, &norm)?;
-        let pair = PerturbedPair::new(system)?;
-        let w = norm.scales();
-        let direction = w / norm.norm(&w);
         Ok(Self {
-            pair,
-            stepper,
-            d0,
-            norm,
-            direction,
-            blocks: DEFAULT_BLOCKS,
-            max_steps: DEFAULT_MAX_STEPS_PER_INTERVAL,
-            started: false,
+            flow: Stepped {
+                system: PerturbedPair::new(system)?,
+                stepper,
+                max_steps: DEFAULT_MAX_STEPS_PER_INTERVAL,
+            },
+            runner: Runner::new(Separation::new(d0, norm)?),
         })
     }
 
     /// An estimator whose stepper is built from the system's tolerances: `make_stepper`
-    /// receives them doubled for the pair ([`pair_tolerances`]), so the sizes are spelled
-    /// once, on the estimator.
+    /// receives them doubled for the pair ([`pair_tolerances`]); the sizes are written
+    /// (for code generic in them, where [`from_tolerances`](Self::from_tolerances) would
+    /// need the bound `Dims<N>: PairDimension<M>`) and `M` is checked when called.
     ///
     /// ```
     /// use nonsmooth::integrate::{Dopri5, Tolerances};
@@ -257,8 +275,44 @@ where
         d0: T,
         norm: Norm<T, N>,
     ) -> Result<Self> {
-        let pair_tol = pair_tolerances::<T, N, M>(tol)?;
-        Self::new(system, make_stepper(pair_tol), d0, norm)
+        check_pair_dims::<N, M>()?;
+        Self::new(system, make_stepper(doubled(tol)), d0, norm)
+    }
+
+    /// An estimator whose stepper is built from the system's tolerances `tol`
+    /// (`make_stepper`, e.g. `Dopri5::new`, receives them doubled for the pair), with the pair's size
+    /// `M = 2N` inferred: no size is written, and a wrong `M` does not compile
+    /// ([`PairDimension`]).
+    ///
+    /// ```
+    /// use nalgebra::Vector3;
+    /// use nonsmooth::integrate::{Dopri5, Tolerances};
+    /// use nonsmooth::lyapunov::{Norm, TwoTrajectory};
+    /// use nonsmooth::testing::Lorenz;
+    ///
+    /// let lorenz = Lorenz::new(10.0, 28.0, 8.0 / 3.0)?;
+    /// let tol = Tolerances::new(1e-9, 1e-9)?;
+    /// let mut est = TwoTrajectory::from_tolerances(lorenz, &tol, Dopri5::new, 1e-8, Norm::Euclidean)?;
+    /// est.start(0.0, Vector3::new(1.0, 1.0, 20.0))?;
+    /// est.transient(1.0, 5)?;
+    /// let e = est.estimate(1.0, 20)?;
+    /// assert!(e.exponent > 0.0);
+    /// # Ok::<(), nonsmooth::Error>(())
+    /// ```
+    ///
+    /// # Errors
+    /// As [`new`](Self::new).
+    pub fn from_tolerances(
+        system: S,
+        tol: &Tolerances<T, N>,
+        make_stepper: impl FnOnce(Tolerances<T, M>) -> St,
+        d0: T,
+        norm: Norm<T, N>,
+    ) -> Result<Self>
+    where
+        Dims<N>: PairDimension<M>,
+    {
+        Self::with_tolerances(system, make_stepper, tol, d0, norm)
     }
 
     /// Sets the direction of the initial perturbation (any non-zero finite vector; it is
@@ -267,7 +321,7 @@ where
     /// # Errors
     /// [`LyapunovError::InvalidDirection`] if it is zero or not finite.
     pub fn with_direction(mut self, direction: SVector<T, N>) -> Result<Self> {
-        self.direction = super::unit_direction(&self.norm, direction)?;
+        self.runner.state.set_direction(direction)?;
         Ok(self)
     }
 
@@ -276,7 +330,7 @@ where
     /// # Errors
     /// [`LyapunovError::InvalidBlocks`] if `blocks < 2`.
     pub fn with_blocks(mut self, blocks: usize) -> Result<Self> {
-        self.blocks = check_blocks(blocks)?;
+        self.runner.blocks = check_blocks(blocks)?;
         Ok(self)
     }
 
@@ -285,7 +339,7 @@ where
     /// # Errors
     /// [`ParameterError`](crate::ParameterError) if `max_steps == 0`.
     pub fn with_max_steps_per_interval(mut self, max_steps: usize) -> Result<Self> {
-        self.max_steps = super::check_max_steps(max_steps)?;
+        self.flow.max_steps = super::check_max_steps(max_steps)?;
         Ok(self)
     }
 
@@ -297,25 +351,17 @@ where
     /// [`LyapunovError::UnresolvedSeparation`] if `d0` is lost to rounding at `y0`.
     pub fn start(&mut self, t0: T, y0: SVector<T, N>) -> Result<()> {
         check_state(t0, &y0)?;
-        let y1 = y0 + self.direction * self.d0;
-        let realized = self.norm.norm(&(y1 - y0));
-        if !((realized - self.d0).abs() <= lit::<T>(1e-3) * self.d0) {
-            return Err(LyapunovError::UnresolvedSeparation {
-                d0: to_f64(self.d0),
-                realized: to_f64(realized),
-            });
-        }
-        self.stepper.reset_state(t0, self.pair.join(&y0, &y1));
-        self.started = true;
+        let placed = self.runner.state.placed(y0)?;
+        self.runner.start(&mut self.flow, t0, placed);
         Ok(())
     }
 
     /// Replaces the system (e.g. the next parameter value of a continuation); the pair's
     /// state is kept.
     pub fn set_system(&mut self, system: S) {
-        self.pair.set_system(system);
-        if self.started {
-            super::refresh_cache(&mut self.stepper);
+        self.flow.system.set_system(system);
+        if let Some((t, state)) = self.runner.current() {
+            self.flow.restart(state, t);
         }
     }
 
@@ -325,132 +371,65 @@ where
     /// # Errors
     /// [`LyapunovError::NonFinite`] if `t0` is not finite; [`LyapunovError::NotStarted`].
     pub fn set_time(&mut self, t0: T) -> Result<()> {
-        super::set_clock(&mut self.stepper, self.started, t0)
+        self.runner.set_time(&mut self.flow, t0)
     }
 
     /// Runs `intervals` renormalization intervals of length `tau` and discards them.
     ///
     /// A separation that collapses to exactly zero within an interval (lost to rounding in
-    /// a strongly contracting phase — e.g. the paper's cart resting against the stop, where
-    /// the contact damping contracts velocity differences at `~10⁶ s⁻¹`) is re-seeded
-    /// along the initial direction: transients only have to bring the pair onto the
-    /// attractor. In [`estimate`](Self::estimate) the same event is an error.
+    /// a strongly contracting phase — e.g. a cart resting against a stop, where a contact
+    /// damping contracts velocity differences at `~10⁶ s⁻¹`) is re-seeded along the initial
+    /// direction: transients only have to bring the pair onto the attractor. In
+    /// [`estimate`](Self::estimate) the same event is an error.
     ///
     /// # Errors
     /// As [`estimate`](Self::estimate), except that 0 intervals are allowed (a no-op).
     pub fn transient(&mut self, tau: T, intervals: usize) -> Result<()> {
-        check_interval_at(self.stepper.current().0, tau)?;
-        self.run(tau, intervals, true, |_, _| {})
+        self.runner
+            .transient::<_, 1>(&mut self.flow, tau, intervals)
     }
 
     /// Runs `intervals` renormalization intervals of length `tau` and returns the estimate.
     ///
     /// # Errors
     /// [`LyapunovError::InvalidInterval`], [`LyapunovError::TooFewIntervals`] (fewer than
-    /// 2, or fewer than the blocks), [`LyapunovError::NotStarted`],
-    /// [`LyapunovError::SeparationLost`] if the separation collapses or overflows, and
-    /// integration errors.
+    /// 2), [`LyapunovError::NotStarted`], [`LyapunovError::SeparationLost`] if the
+    /// separation collapses or overflows, and integration errors.
     pub fn estimate(&mut self, tau: T, intervals: usize) -> Result<Estimate<T>> {
-        check_interval_at(self.stepper.current().0, tau)?;
-        check_intervals(intervals, 2)?;
-        let blocks = self.blocks.min(intervals);
-        let s0 = *self.stepper.stats();
-        let mut local = Vec::with_capacity(intervals.min(1 << 16));
-        let mut history = Vec::with_capacity(intervals.min(1 << 16));
-        let mut sum = T::zero();
-        self.run(tau, intervals, false, |k, s| {
-            local.push(s);
-            sum += s;
-            history.push(sum / lit::<T>((k + 1) as f64));
-        })?;
-        let exponent = sum / lit::<T>(intervals as f64);
-        let spread = block_standard_error(intervals, blocks, |k| local[k]);
-        Ok(Estimate {
-            exponent,
-            spread,
-            history,
-            local,
-            interval: tau,
-            blocks,
-            stats: self.stepper.stats().since(&s0),
-        })
+        Ok(self
+            .runner
+            .estimate::<_, 1>(&mut self.flow, tau, intervals)?
+            .estimate())
     }
 
     /// The reference state `(t, y)`.
     pub fn reference(&self) -> (T, SVector<T, N>) {
-        let (t, z) = self.stepper.current();
-        (t, self.pair.split(z).0)
+        (self.runner.t, self.runner.state.reference)
     }
 
     /// The current separation `ỹ − y` (length `d0` right after a renormalization).
     pub fn separation(&self) -> SVector<T, N> {
-        let (a, b) = self.pair.split(self.stepper.current().1);
-        b - a
+        self.runner.state.delta()
     }
 
     /// The separation `d0`.
     pub fn d0(&self) -> T {
-        self.d0
+        self.runner.state.d0
     }
 
     /// The norm.
     pub fn norm(&self) -> &Norm<T, N> {
-        &self.norm
+        &self.runner.state.norm
     }
 
     /// The system.
     pub fn system(&self) -> &S {
-        self.pair.system()
+        self.flow.system.system()
     }
 
     /// The stepper (its [`stats`](Stepper::stats) count all work so far).
     pub fn stepper(&self) -> &St {
-        &self.stepper
-    }
-
-    /// The core loop: `intervals` intervals, `sink(k, ln(d_k/d_start)/τ)` after each;
-    /// `reseed`: re-seed a separation that collapsed to zero instead of failing.
-    fn run(
-        &mut self,
-        tau: T,
-        intervals: usize,
-        reseed: bool,
-        mut sink: impl FnMut(usize, T),
-    ) -> Result<()> {
-        if !self.started {
-            return Err(LyapunovError::NotStarted);
-        }
-        let t_start = self.stepper.current().0;
-        // The separation at the start of the current interval (d0 up to rounding).
-        let mut d_start = self.norm.norm(&self.separation());
-        for k in 0..intervals {
-            let t_k = grid_time(t_start, tau, k + 1);
-            integrate_to(&mut self.stepper, &self.pair, t_k, self.max_steps)?;
-            let (a, b) = self.pair.split(self.stepper.current().1);
-            let mut delta = b - a;
-            let mut d = self.norm.norm(&delta);
-            if reseed && d == T::zero() {
-                delta = self.direction * self.d0;
-                d = self.norm.norm(&delta);
-            }
-            if !(d.is_finite() && d > T::zero()) {
-                return Err(LyapunovError::SeparationLost {
-                    t: to_f64(t_k),
-                    separation: to_f64(d),
-                });
-            }
-            sink(k, (d / d_start).ln() / tau);
-            let b_new = a + delta * (self.d0 / d);
-            d_start = self.norm.norm(&(b_new - a));
-            if !(d_start > T::zero()) {
-                return Err(LyapunovError::UnresolvedSeparation {
-                    d0: to_f64(self.d0),
-                    realized: to_f64(d_start),
-                });
-            }
-            self.stepper.reset_state(t_k, self.pair.join(&a, &b_new));
-        }
-        Ok(())
+        &self.flow.stepper
     }
 }
 
@@ -677,7 +656,7 @@ mod tests {
             )
             .is_err()
         );
-        assert!(pair_tolerances::<f64, 2, 3>(&Tolerances::new(1e-8, 1e-8).unwrap()).is_err());
+        // pair_tolerances::<f64, 2, 3> does not compile (Dims<2>: PairDimension<3> fails).
         assert!(mk(1e-6).unwrap().with_blocks(1).is_err());
         assert!(
             mk(1e-6)
