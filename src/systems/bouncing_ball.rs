@@ -13,7 +13,7 @@
 //! P. J. Holmes, *J. Sound Vib.* 84 (1982) 173–189; A. Mehta, J. M. Luck, *Phys. Rev. Lett.*
 //! 65 (1990) 393–396; the chattering/sticking terminology of C. Budd, F. Dux, *Phil. Trans.
 //! R. Soc. A* 347 (1994) 365–389. The exact impact map (parabolic flights, roots of
-//! `y(t) = s(t)`) is [`testing::BallOnTableExact`](crate::testing) (feature `testing`).
+//! `y(t) = s(t)`) is `testing::BallOnTableExact` (feature `testing`).
 
 use crate::Real;
 use crate::event::{Gap, NewtonImpact};
