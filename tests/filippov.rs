@@ -7,8 +7,8 @@ use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 use nonsmooth::drive::{Coulomb, SlipMode, StepView, StickSlip, run_modes};
 use nonsmooth::excite::{Constant, Harmonic};
 use nonsmooth::filippov::{
-    Filippov, FilippovError, FilippovSimulation, Mode, Side, SlidingObserver, Switched, Transition,
-    TransitionKind,
+    Filippov, FilippovError, FilippovSimulation, Mode, ModeTransition, Region, SlidingObserver,
+    Switched, TransitionKind,
 };
 use nonsmooth::force::LinearSpring;
 use nonsmooth::integrate::{DenseOutput, Dopri5, Tolerances};
@@ -52,14 +52,14 @@ impl Filippov<f64, 3, 1> for Relay {
     fn gradient(&self, _i: usize, _t: f64, _x: &SVector<f64, 3>) -> SVector<f64, 3> {
         SVector::from([1.0, 0.0, 0.0])
     }
-    fn field(&self, sides: &[Side; 1], _t: f64, x: &SVector<f64, 3>, dx: &mut SVector<f64, 3>) {
+    fn field(&self, sides: &[Region; 1], _t: f64, x: &SVector<f64, 3>, dx: &mut SVector<f64, 3>) {
         // u = −sgn(x₁): +1 below the surface, −1 above.
         let u = -sides[0].sign::<f64>();
         *dx = self.a * x + self.b * u;
     }
     fn field_jacobian(
         &self,
-        _sides: &[Side; 1],
+        _sides: &[Region; 1],
         _t: f64,
         _x: &SVector<f64, 3>,
     ) -> Option<SMatrix<f64, 3, 3>> {
@@ -278,8 +278,8 @@ impl ExactRelay {
 fn piece_of(mode: &Mode<1>) -> Piece {
     match (mode.sliding, mode.sides[0]) {
         (Some(_), _) => Piece::Slide,
-        (None, Side::Minus) => Piece::Minus,
-        (None, Side::Plus) => Piece::Plus,
+        (None, Region::Minus) => Piece::Minus,
+        (None, Region::Plus) => Piece::Plus,
     }
 }
 
@@ -293,7 +293,7 @@ fn relay_feedback_converges_to_its_sliding_orbit_with_the_exact_period_and_multi
     let exact = ExactRelay::new();
     let start = piece_of(&run.start_mode);
     let want = exact.switchings(start, Vector3::from(X0), t_end);
-    let got: Vec<&Transition<f64, 3, 1>> = run
+    let got: Vec<&ModeTransition<f64, 3, 1>> = run
         .transitions
         .iter()
         .filter(|tr| tr.kind != TransitionKind::Graze)
@@ -492,7 +492,7 @@ impl Filippov<f64, 2, 1> for DenHartog {
     fn gradient(&self, _i: usize, _t: f64, _x: &SVector<f64, 2>) -> SVector<f64, 2> {
         SVector::from([0.0, 1.0])
     }
-    fn field(&self, sides: &[Side; 1], t: f64, x: &SVector<f64, 2>, dx: &mut SVector<f64, 2>) {
+    fn field(&self, sides: &[Region; 1], t: f64, x: &SVector<f64, 2>, dx: &mut SVector<f64, 2>) {
         let friction = -sides[0].sign::<f64>() * self.friction;
         *dx = SVector::from([x[1], -x[0] + (self.w * t).cos() + friction]);
     }
@@ -575,7 +575,7 @@ fn den_hartog_non_sticking_amplitude_matches_the_closed_form() {
             )
             .unwrap();
         // Two velocity reversals per period, each at |x| = X, never sliding (no stops).
-        let reversals: Vec<&Transition<f64, 2, 1>> = run
+        let reversals: Vec<&ModeTransition<f64, 2, 1>> = run
             .transitions
             .iter()
             .filter(|tr| tr.kind == TransitionKind::Crossing)
@@ -693,8 +693,8 @@ const BELT_W: f64 = 1.3;
 fn slip_mode(mode: &Mode<1>) -> SlipMode {
     match (mode.sliding, mode.sides[0]) {
         (Some(_), _) => SlipMode::Stick,
-        (None, Side::Plus) => SlipMode::Forward,
-        (None, Side::Minus) => SlipMode::Backward,
+        (None, Region::Plus) => SlipMode::Forward,
+        (None, Region::Minus) => SlipMode::Backward,
     }
 }
 
@@ -749,7 +749,7 @@ fn belt_oscillator_filippov_path_equals_stick_slip() {
     }
     // The same system built from the parts (the Mechanical model and the Coulomb contact
     // StickSlip runs): the same modes at the same times.
-    let parts = nonsmooth::filippov::DryFriction::new(&model, friction).unwrap();
+    let parts = nonsmooth::filippov::CoulombFriction::new(&model, friction).unwrap();
     let mut sim = FilippovSimulation::new(parts, Dopri5::new(tol2()));
     let from_parts = sim.run(0.0, y0, t_end, &mut ()).unwrap();
     let parts_modes: Vec<(f64, SlipMode)> = from_parts
@@ -766,7 +766,7 @@ fn belt_oscillator_filippov_path_equals_stick_slip() {
     }
     assert!(
         worst_parts < 1e-10,
-        "DryFriction vs StickSlip {worst_parts:e}"
+        "CoulombFriction vs StickSlip {worst_parts:e}"
     );
     // A static limit above the kinetic force is not a Filippov system.
     let stiction = Coulomb::new(
@@ -776,10 +776,10 @@ fn belt_oscillator_filippov_path_equals_stick_slip() {
         1.0,
     )
     .unwrap();
-    let err = nonsmooth::filippov::DryFriction::new(&model, stiction).unwrap_err();
+    let err = nonsmooth::filippov::CoulombFriction::new(&model, stiction).unwrap_err();
     assert!(err.to_string().contains("1.2"), "{err}");
     println!(
-        "belt: {} transitions ({sticks} sticks), worst |Δt| Filippov vs StickSlip {worst:.2e} (closures), {worst_parts:.2e} (DryFriction)",
+        "belt: {} transitions ({sticks} sticks), worst |Δt| Filippov vs StickSlip {worst:.2e} (closures), {worst_parts:.2e} (CoulombFriction)",
         got.len()
     );
     assert!(worst < 1e-10, "stick/slip times differ by {worst:e}");
@@ -801,7 +801,7 @@ impl Filippov<f64, 2, 2> for Corner {
         g[i] = 1.0;
         g
     }
-    fn field(&self, _sides: &[Side; 2], _t: f64, _x: &SVector<f64, 2>, dx: &mut SVector<f64, 2>) {
+    fn field(&self, _sides: &[Region; 2], _t: f64, _x: &SVector<f64, 2>, dx: &mut SVector<f64, 2>) {
         *dx = SVector::from([1.0, 1.0]);
     }
 }
@@ -818,7 +818,7 @@ impl Filippov<f64, 2, 2> for SlideIntoCorner {
         g[i] = 1.0;
         g
     }
-    fn field(&self, sides: &[Side; 2], _t: f64, _x: &SVector<f64, 2>, dx: &mut SVector<f64, 2>) {
+    fn field(&self, sides: &[Region; 2], _t: f64, _x: &SVector<f64, 2>, dx: &mut SVector<f64, 2>) {
         *dx = SVector::from([-sides[0].sign::<f64>(), 1.0]);
     }
 }
@@ -849,7 +849,7 @@ fn two_surfaces_met_at_once_are_a_codimension_2_error() {
     assert_eq!(times.len(), 2, "{times:?}");
     assert!((times[0].0 - 1.0).abs() < 1e-10 && times[0].1 == 0);
     assert!((times[1].0 - 1.5).abs() < 1e-10 && times[1].1 == 1);
-    assert_eq!(run.mode.sides, [Side::Plus, Side::Plus]);
+    assert_eq!(run.mode.sides, [Region::Plus, Region::Plus]);
     // Sliding on x₀ = 0 (both sides push into it) until x₁ = 0 is met at t = 2.
     let mut sim = FilippovSimulation::new(SlideIntoCorner, Dopri5::new(tol2()));
     match sim.run(0.0, SVector::from([-1.0, -2.0]), 3.0, &mut ()) {
@@ -1056,7 +1056,7 @@ fn a_grazing_arrival_stays_in_its_region() {
         (graze.t - 1.0).abs() < 1e-4 && !graze.to.is_sliding(),
         "{graze:?}"
     );
-    assert_eq!(run.mode.sides, [Side::Minus]);
+    assert_eq!(run.mode.sides, [Region::Minus]);
     // x₀ = −0.5 + δ + t − t²/2, x₁ = 1 − t.
     assert!(
         (run.x[0] + 0.5 - delta).abs() < 1e-12 && (run.x[1] + 1.0).abs() < 1e-12,
@@ -1120,8 +1120,8 @@ fn public_types_are_send_sync_clone() {
     check::<FilippovError>();
     check::<nonsmooth::filippov::Settings<f64>>();
     check::<Mode<2>>();
-    check::<Side>();
-    check::<Transition<f64, 3, 1>>();
+    check::<Region>();
+    check::<ModeTransition<f64, 3, 1>>();
     check::<nonsmooth::filippov::FilippovRun<f64, 3, 1>>();
     check::<nonsmooth::filippov::Monodromy<f64, 3, 1>>();
     check::<nonsmooth::filippov::SlidingOrbit<f64, 3, 1>>();
@@ -1198,7 +1198,7 @@ impl Filippov<f64, 2, 1> for Stribeck {
     fn gradient(&self, _i: usize, _t: f64, _x: &SVector<f64, 2>) -> SVector<f64, 2> {
         SVector::from([0.0, 1.0])
     }
-    fn field(&self, sides: &[Side; 1], t: f64, x: &SVector<f64, 2>, dx: &mut SVector<f64, 2>) {
+    fn field(&self, sides: &[Region; 1], t: f64, x: &SVector<f64, 2>, dx: &mut SVector<f64, 2>) {
         let v = x[1] - STRIBECK_VB;
         let s = sides[0].sign::<f64>();
         let mu = 1.0 - STRIBECK_DROP + STRIBECK_DROP / (1.0 + STRIBECK_GAMMA * s * v);
@@ -1206,7 +1206,7 @@ impl Filippov<f64, 2, 1> for Stribeck {
     }
     fn field_jacobian(
         &self,
-        sides: &[Side; 1],
+        sides: &[Region; 1],
         _t: f64,
         x: &SVector<f64, 2>,
     ) -> Option<SMatrix<f64, 2, 2>> {
@@ -1647,7 +1647,7 @@ fn relay_load_on_a_mechanical_model_equals_the_linear_relay() {
             (0.4 * s).cos(),
             (2.1 * s).sin(),
         ]);
-        for side in [Side::Minus, Side::Plus] {
+        for side in [Region::Minus, Region::Plus] {
             let (mut fa, mut fb) = (SVector::zeros(), SVector::zeros());
             relay.field(&[side], 0.0, &x, &mut fa);
             linear.field(&[side], 0.0, &x, &mut fb);

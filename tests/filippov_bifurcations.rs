@@ -10,7 +10,9 @@
 //! piecewise-linear flow).
 
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
-use nonsmooth::filippov::{Filippov, FilippovSimulation, Settings, Side, Switched, TransitionKind};
+use nonsmooth::filippov::{
+    Filippov, FilippovSimulation, Region, Settings, Switched, TransitionKind,
+};
 use nonsmooth::integrate::{Dopri5, Tolerances};
 use nonsmooth::orbit::sliding::{
     SlidingBifurcationKind, SlidingContinuation, follow_sliding, follow_sliding_arclength,
@@ -50,7 +52,7 @@ impl<F: Filippov<f64, 2, 1>> Filippov<f64, 2, 1> for Timed<F> {
     fn gradient(&self, i: usize, t: f64, x: &SVector<f64, 2>) -> SVector<f64, 2> {
         self.0.gradient(i, t, x)
     }
-    fn field(&self, sides: &[Side; 1], t: f64, x: &SVector<f64, 2>, dx: &mut SVector<f64, 2>) {
+    fn field(&self, sides: &[Region; 1], t: f64, x: &SVector<f64, 2>, dx: &mut SVector<f64, 2>) {
         self.0.field(sides, t, x, dx)
     }
     fn time_scale(&self, _t: f64) -> Option<f64> {
@@ -61,7 +63,7 @@ impl<F: Filippov<f64, 2, 1>> Filippov<f64, 2, 1> for Timed<F> {
 /// One forcing period of the belt oscillator's attractor at `f0` after 80 periods from
 /// `x0`, by plain simulation (no shooting): `(t, kind, side left)` of each transition and
 /// the period's start.
-fn belt_period(f0: f64, w: f64, u: f64, x0: SVector<f64, 2>) -> Vec<(f64, TransitionKind, Side)> {
+fn belt_period(f0: f64, w: f64, u: f64, x0: SVector<f64, 2>) -> Vec<(f64, TransitionKind, Region)> {
     let period = 2.0 * PI / w;
     let mut settings = Settings::default();
     settings.exit_samples = 32;
@@ -87,7 +89,7 @@ fn settled(f0: f64, w: f64, u: f64) -> SVector<f64, 2> {
 }
 
 /// The counts of crossings and sliding entries over a period.
-fn signature(period: &[(f64, TransitionKind, Side)]) -> (usize, usize) {
+fn signature(period: &[(f64, TransitionKind, Region)]) -> (usize, usize) {
     let count = |k: TransitionKind| period.iter().filter(|tr| tr.1 == k).count();
     (
         count(TransitionKind::Crossing),
@@ -123,7 +125,7 @@ fn bisect_by_simulation(
 /// The durations of the excursions into a region between leaving the surface and
 /// arriving back at it into sliding (a crossing or an exit, then a sliding entry), over one
 /// period (wrapping around).
-fn excursions(period: &[(f64, TransitionKind, Side)], length: f64) -> Vec<f64> {
+fn excursions(period: &[(f64, TransitionKind, Region)], length: f64) -> Vec<f64> {
     let n = period.len();
     (0..n)
         .filter(|&k| period[(k + 1) % n].1 == TransitionKind::SlidingEntry)
@@ -326,7 +328,7 @@ impl Filippov<f64, 2, 1> for DuffingBelt {
     fn gradient(&self, _i: usize, _t: f64, _x: &SVector<f64, 2>) -> SVector<f64, 2> {
         SVector::from([0.0, 1.0])
     }
-    fn field(&self, sides: &[Side; 1], t: f64, x: &SVector<f64, 2>, dx: &mut SVector<f64, 2>) {
+    fn field(&self, sides: &[Region; 1], t: f64, x: &SVector<f64, 2>, dx: &mut SVector<f64, 2>) {
         let friction = -Self::MU * sides[0].sign::<f64>();
         *dx = SVector::from([
             x[1],
@@ -337,7 +339,7 @@ impl Filippov<f64, 2, 1> for DuffingBelt {
     }
     fn field_jacobian(
         &self,
-        _s: &[Side; 1],
+        _s: &[Region; 1],
         _t: f64,
         x: &SVector<f64, 2>,
     ) -> Option<SMatrix<f64, 2, 2>> {

@@ -7,7 +7,7 @@ use nalgebra::SVector;
 use super::error::Result;
 use super::field::{ModeField, rates};
 use super::run::FilippovSimulation;
-use super::system::{Filippov, Mode, Side};
+use super::system::{Filippov, Mode, Region};
 use crate::Real;
 use crate::drive::modes::rate_along_flow;
 use crate::drive::{Control, EventRecord, Observer, Simulation};
@@ -23,7 +23,7 @@ use crate::validate::ParameterError;
 pub fn second_rate<T, const N: usize, const S: usize, Sys>(
     system: &Sys,
     surface: usize,
-    sides: &[Side; S],
+    sides: &[Region; S],
     t: T,
     x: &SVector<T, N>,
 ) -> T
@@ -81,7 +81,7 @@ impl<T: Real, const N: usize, const S: usize, Sys: Filippov<T, N, S>> EventFunct
 struct Collect<'a, Sys, T, const S: usize> {
     sys: &'a Sys,
     surface: usize,
-    sides: [Side; S],
+    sides: [Region; S],
     found: Vec<ControlExtremum<T>>,
 }
 
@@ -122,7 +122,7 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
     pub fn control_extrema<const N: usize, const S: usize>(
         &self,
         surface: usize,
-        sides: [Side; S],
+        sides: [Region; S],
         t0: T,
         x0: SVector<T, N>,
         t1: T,

@@ -4,7 +4,7 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use super::system::{Filippov, Mode, Side};
+use super::system::{Filippov, Mode, Region};
 use crate::drive::modes::rate_along_flow;
 use crate::event::{Direction, EventSet};
 use crate::scalar::lit;
@@ -63,24 +63,28 @@ impl<T: Real, const N: usize> Rates<T, N> {
     }
 
     /// The field of `side`.
-    pub(crate) fn field(&self, side: Side) -> &SVector<T, N> {
+    pub(crate) fn field(&self, side: Region) -> &SVector<T, N> {
         match side {
-            Side::Minus => &self.f_minus,
-            Side::Plus => &self.f_plus,
+            Region::Minus => &self.f_minus,
+            Region::Plus => &self.f_plus,
         }
     }
 
     /// The normal rate of `side`.
-    pub(crate) fn rate(&self, side: Side) -> T {
+    pub(crate) fn rate(&self, side: Region) -> T {
         match side {
-            Side::Minus => self.h_minus,
-            Side::Plus => self.h_plus,
+            Region::Minus => self.h_minus,
+            Region::Plus => self.h_plus,
         }
     }
 }
 
 /// `sides` with surface `i` on `side`.
-pub(crate) fn with_side<const S: usize>(sides: &[Side; S], i: usize, side: Side) -> [Side; S] {
+pub(crate) fn with_side<const S: usize>(
+    sides: &[Region; S],
+    i: usize,
+    side: Region,
+) -> [Region; S] {
     let mut s = *sides;
     s[i] = side;
     s
@@ -91,7 +95,7 @@ pub(crate) fn with_side<const S: usize>(sides: &[Side; S], i: usize, side: Side)
 pub(crate) fn rates<T, const N: usize, const S: usize, Sys>(
     sys: &Sys,
     i: usize,
-    sides: &[Side; S],
+    sides: &[Region; S],
     t: T,
     x: &SVector<T, N>,
 ) -> Rates<T, N>
@@ -103,8 +107,8 @@ where
     let h_t = sys.surface_time_rate(i, t, x);
     let mut f_minus = SVector::zeros();
     let mut f_plus = SVector::zeros();
-    sys.field(&with_side(sides, i, Side::Minus), t, x, &mut f_minus);
-    sys.field(&with_side(sides, i, Side::Plus), t, x, &mut f_plus);
+    sys.field(&with_side(sides, i, Region::Minus), t, x, &mut f_minus);
+    sys.field(&with_side(sides, i, Region::Plus), t, x, &mut f_plus);
     Rates {
         grad,
         h_minus: grad.dot(&f_minus) + h_t,
@@ -121,8 +125,8 @@ where
 pub(crate) fn departure<T, const N: usize, const S: usize, Sys>(
     sys: &Sys,
     i: usize,
-    sides: &[Side; S],
-    side: Side,
+    sides: &[Region; S],
+    side: Region,
     (t, x): (T, &SVector<T, N>),
     rates: &Rates<T, N>,
     tangency: T,
@@ -215,8 +219,8 @@ impl<Sys, const S: usize> ModeField<'_, Sys, S> {
             Some(i) => {
                 let sides = &self.mode.sides;
                 let r = rates(self.sys, i, sides, t, x);
-                let jm = region_jacobian(self.sys, &with_side(sides, i, Side::Minus), t, x);
-                let jp = region_jacobian(self.sys, &with_side(sides, i, Side::Plus), t, x);
+                let jm = region_jacobian(self.sys, &with_side(sides, i, Region::Minus), t, x);
+                let jp = region_jacobian(self.sys, &with_side(sides, i, Region::Plus), t, x);
                 let curv = |f: &SVector<T, N>| {
                     let (up, down) = crate::excite::difference_points(t, self.sys.time_scale(t));
                     let (hu, hd) = (up - t, t - down);
@@ -238,7 +242,7 @@ impl<Sys, const S: usize> ModeField<'_, Sys, S> {
 /// `∂F_σ/∂x` of a region: given by the system, else by central differences.
 pub(crate) fn region_jacobian<T, const N: usize, const S: usize, Sys>(
     sys: &Sys,
-    sides: &[Side; S],
+    sides: &[Region; S],
     t: T,
     x: &SVector<T, N>,
 ) -> SMatrix<T, N, N>
@@ -328,8 +332,8 @@ impl<T: Real, const N: usize, const S: usize, Sys: Filippov<T, N, S>> EventSet<T
             Direction::Falling
         } else {
             match self.mode.sides[i] {
-                Side::Minus => Direction::Rising,
-                Side::Plus => Direction::Falling,
+                Region::Minus => Direction::Rising,
+                Region::Plus => Direction::Falling,
             }
         }
     }

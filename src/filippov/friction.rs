@@ -3,7 +3,7 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use super::system::{Filippov, Side};
+use super::system::{Filippov, Region};
 use crate::drive::Coulomb;
 use crate::excite::Excitation;
 use crate::model::{Elements, Loads, Mechanical};
@@ -24,7 +24,7 @@ use crate::{Dynamics, Real};
 /// use nalgebra::SVector;
 /// use nonsmooth::drive::Coulomb;
 /// use nonsmooth::excite::Constant;
-/// use nonsmooth::filippov::{DryFriction, FilippovSimulation, TransitionKind};
+/// use nonsmooth::filippov::{CoulombFriction, FilippovSimulation, TransitionKind};
 /// use nonsmooth::force::LinearSpring;
 /// use nonsmooth::integrate::{Dopri5, Tolerances};
 /// use nonsmooth::model::{Coordinate, Element, Mechanical};
@@ -33,7 +33,7 @@ use crate::{Dynamics, Real};
 /// let model = Mechanical::with_masses([1.0_f64])?
 ///     .with_elements(Element::on_dof(0, LinearSpring::new(1.0)?)?);
 /// let friction = Coulomb::new(Coordinate::dof(0)?, Constant::new(0.5)?, 1.0, 1.0)?;
-/// let system = DryFriction::new(&model, friction)?;
+/// let system = CoulombFriction::new(&model, friction)?;
 /// let mut sim = FilippovSimulation::new(system, Dopri5::new(Tolerances::new(1e-10, 1e-12)?));
 /// let run = sim.run(0.0, SVector::from([0.0, 0.5]), 3.0, &mut ())?;
 /// assert_eq!(run.transitions[0].kind, TransitionKind::SlidingExit);
@@ -41,14 +41,14 @@ use crate::{Dynamics, Real};
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 #[derive(Debug, Clone, Copy)]
-pub struct DryFriction<'a, T: Real, const N: usize, El, Ld, U> {
+pub struct CoulombFriction<'a, T: Real, const N: usize, El, Ld, U> {
     model: &'a Mechanical<T, N, El, Ld>,
     friction: Coulomb<T, N, U>,
     /// `M⁻¹w`.
     m_w: SVector<T, N>,
 }
 
-impl<'a, T, const N: usize, El, Ld, U> DryFriction<'a, T, N, El, Ld, U>
+impl<'a, T, const N: usize, El, Ld, U> CoulombFriction<'a, T, N, El, Ld, U>
 where
     T: Real,
     El: Elements<T, N>,
@@ -82,7 +82,7 @@ where
 }
 
 impl<T, const N: usize, const M: usize, El, Ld, U> Filippov<T, M, 1>
-    for DryFriction<'_, T, N, El, Ld, U>
+    for CoulombFriction<'_, T, N, El, Ld, U>
 where
     T: Real,
     El: Elements<T, N>,
@@ -108,7 +108,7 @@ where
     }
 
     #[inline(always)]
-    fn field(&self, sides: &[Side; 1], t: T, y: &SVector<T, M>, dy: &mut SVector<T, M>) {
+    fn field(&self, sides: &[Region; 1], t: T, y: &SVector<T, M>, dy: &mut SVector<T, M>) {
         // Friction opposes the slip: −F_k above the surface (slipping forward), +F_k below.
         let force = -sides[0].sign::<T>() * self.friction.kinetic();
         super::load::sided_field(self.model, &self.m_w, force, t, y, dy);
@@ -116,7 +116,7 @@ where
 
     fn field_jacobian(
         &self,
-        _sides: &[Side; 1],
+        _sides: &[Region; 1],
         t: T,
         y: &SVector<T, M>,
     ) -> Option<SMatrix<T, M, M>> {

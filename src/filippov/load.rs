@@ -3,7 +3,7 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use super::system::{Filippov, Side};
+use super::system::{Filippov, Region};
 use crate::model::{Elements, Loads, Mechanical};
 use crate::scalar::to_f64;
 use crate::validate::ParameterError;
@@ -125,14 +125,14 @@ where
     }
 
     #[inline(always)]
-    fn field(&self, sides: &[Side; 1], t: T, y: &SVector<T, M>, dy: &mut SVector<T, M>) {
+    fn field(&self, sides: &[Region; 1], t: T, y: &SVector<T, M>, dy: &mut SVector<T, M>) {
         // u = −U sgn σ: +U below the surface, −U above.
         sided_field(self.model, &self.m_b, -sides[0].sign::<T>(), t, y, dy);
     }
 
     fn field_jacobian(
         &self,
-        _sides: &[Side; 1],
+        _sides: &[Region; 1],
         t: T,
         y: &SVector<T, M>,
     ) -> Option<SMatrix<T, M, M>> {

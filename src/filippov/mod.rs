@@ -4,7 +4,7 @@
 //!
 //! # Model
 //! A [`Filippov`] system has codimension-1 surfaces `H_i(t, x) = 0`, `i < S`, and a smooth
-//! field in each region, the region given by the side of every surface ([`Side`]):
+//! field in each region, the region given by the side of every surface ([`Region`]: which side of one surface):
 //! $$ \dot x = F_\sigma(t, x), \qquad \sigma = (\operatorname{sgn} H_0, \dots, \operatorname{sgn} H_{S-1}). $$
 //! On surface `i`, with the other surfaces' sides fixed, let `F₋`, `F₊` be the fields of the
 //! two regions it separates and
@@ -44,7 +44,7 @@
 //! [`FilippovError::Codimension2`] (time and both surfaces) instead of a wrong answer.
 //!
 //! **Observers** ([`SlidingObserver`]) get every step with its mode and every
-//! [`Transition`]; [`Plain`] passes them to any [`Observer`](crate::drive::Observer) of
+//! [`ModeTransition`]; [`Plain`] passes them to any [`Observer`](crate::drive::Observer) of
 //! the driver (modes by [`Observer::on_mode`](crate::drive::Observer::on_mode)).
 //!
 //! # Tangent dynamics
@@ -84,7 +84,7 @@
 //! `H = w·q̇ − u` and the fields of slip with the friction force `∓F_k`: sticking is
 //! sliding on `H = 0`, the stick force is the equivalent control
 //! (`F = F_k(1 − 2α)`), and a stick ends where `α` reaches 0 or 1, i.e. where the force
-//! needed to hold reaches `F_k`. [`DryFriction`] builds this system from a
+//! needed to hold reaches `F_k`. [`CoulombFriction`] builds this system from a
 //! [`Mechanical`](crate::model::Mechanical) model and a
 //! [`Coulomb`](crate::drive::Coulomb) contact. [`StickSlip`](crate::drive::StickSlip) with
 //! `F_s = F_k` gives the same modes at the same times (checked in the tests on a forced
@@ -148,11 +148,12 @@ mod tangent;
 pub use approach::Approach;
 pub use error::FilippovError;
 pub use extrema::{ControlExtremum, second_rate};
-pub use friction::DryFriction;
+pub use friction::CoulombFriction;
 pub use load::RelayLoad;
 pub use relay::LinearRelay;
 pub use run::{
-    FilippovRun, FilippovSimulation, Plain, Settings, SlidingObserver, Transition, TransitionKind,
+    FilippovRun, FilippovSimulation, ModeTransition, Plain, Settings, SlidingObserver,
+    TransitionKind,
 };
-pub use system::{Filippov, Mode, Side, Switched};
+pub use system::{Filippov, Mode, Region, Switched};
 pub use tangent::{Exponents, Monodromy, SlidingOrbit, saltation};

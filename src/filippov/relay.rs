@@ -2,7 +2,7 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use super::system::{Filippov, Side};
+use super::system::{Filippov, Region};
 use crate::Real;
 use crate::scalar::to_f64;
 use crate::validate::ParameterError;
@@ -83,13 +83,13 @@ impl<T: Real, const N: usize> Filippov<T, N, 1> for LinearRelay<T, N> {
         self.c
     }
     #[inline(always)]
-    fn field(&self, sides: &[Side; 1], _t: T, x: &SVector<T, N>, dx: &mut SVector<T, N>) {
+    fn field(&self, sides: &[Region; 1], _t: T, x: &SVector<T, N>, dx: &mut SVector<T, N>) {
         // u = −sgn(c·x): +1 below the surface, −1 above.
         *dx = self.a * x - self.b * sides[0].sign::<T>();
     }
     fn field_jacobian(
         &self,
-        _s: &[Side; 1],
+        _s: &[Region; 1],
         _t: T,
         _x: &SVector<T, N>,
     ) -> Option<SMatrix<T, N, N>> {

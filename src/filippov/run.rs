@@ -1,12 +1,12 @@
 //! The event-driven run through regions and sliding: [`FilippovSimulation`], its
 //! [`Settings`], the mode-aware observer ([`SlidingObserver`], [`Plain`]) and the records
-//! ([`Transition`], [`FilippovRun`]).
+//! ([`ModeTransition`], [`FilippovRun`]).
 
 use nalgebra::SVector;
 
 use super::error::{FilippovError, Result};
 use super::field::{ModeField, band, departure, project, rates, scale, with_side};
-use super::system::{Filippov, Mode, Side};
+use super::system::{Filippov, Mode, Region};
 use crate::Real;
 use crate::drive::{Control, EventRecord, Observer, Scan, StepView, Termination};
 use crate::event::{EventHistory, ZenoGuard};
@@ -33,7 +33,7 @@ pub enum TransitionKind {
 
 /// One transition of a Filippov run.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Transition<T: Real, const N: usize, const S: usize> {
+pub struct ModeTransition<T: Real, const N: usize, const S: usize> {
     /// Time.
     pub t: T,
     /// The state the next mode starts from (on the surface for sliding entries and exits).
@@ -60,7 +60,7 @@ pub struct FilippovRun<T: Real, const N: usize, const S: usize> {
     /// The start mode (decided from the start state, see [`FilippovSimulation::mode_at`]).
     pub start_mode: Mode<S>,
     /// Every transition, in time order.
-    pub transitions: Vec<Transition<T, N, S>>,
+    pub transitions: Vec<ModeTransition<T, N, S>>,
     /// Whether an observer stopped the run.
     pub stopped: bool,
     /// The largest `|H|/scale` seen while sliding, at step ends and at the interior
@@ -85,7 +85,7 @@ pub trait SlidingObserver<T: Real, const N: usize, const S: usize> {
         Control::Continue
     }
     /// Called at each transition, after the step part that leads to it.
-    fn on_transition(&mut self, _transition: &Transition<T, N, S>) -> Control {
+    fn on_transition(&mut self, _transition: &ModeTransition<T, N, S>) -> Control {
         Control::Continue
     }
     /// Called once at the end of a successful run.
@@ -107,7 +107,7 @@ impl<T: Real, const N: usize, const S: usize, O: SlidingObserver<T, N, S> + ?Siz
     ) -> Control {
         (**self).on_step(mode, step)
     }
-    fn on_transition(&mut self, transition: &Transition<T, N, S>) -> Control {
+    fn on_transition(&mut self, transition: &ModeTransition<T, N, S>) -> Control {
         (**self).on_transition(transition)
     }
     fn on_finish(&mut self, run: &FilippovRun<T, N, S>) {
@@ -135,7 +135,7 @@ impl<T: Real, const N: usize, const S: usize, O: Observer<T, N>> SlidingObserver
     ) -> Control {
         self.0.on_step(step)
     }
-    fn on_transition(&mut self, tr: &Transition<T, N, S>) -> Control {
+    fn on_transition(&mut self, tr: &ModeTransition<T, N, S>) -> Control {
         let record = EventRecord {
             index: tr.surface,
             t: tr.t,
@@ -317,8 +317,8 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
     fn arrival<const N: usize, const S: usize>(
         &self,
         i: usize,
-        sides: &[Side; S],
-        from: Option<Side>,
+        sides: &[Region; S],
+        from: Option<Region>,
         t: T,
         x: &SVector<T, N>,
     ) -> Result<Arrival>
@@ -327,8 +327,8 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
     {
         let r = rates(&self.system, i, sides, t, x);
         let tang = self.settings.tangency;
-        let sm = departure(&self.system, i, sides, Side::Minus, (t, x), &r, tang);
-        let sp = departure(&self.system, i, sides, Side::Plus, (t, x), &r, tang);
+        let sm = departure(&self.system, i, sides, Region::Minus, (t, x), &r, tang);
+        let sp = departure(&self.system, i, sides, Region::Plus, (t, x), &r, tang);
         let repelling = || FilippovError::Repelling {
             t: to_f64(t),
             surface: i,
@@ -338,12 +338,12 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
         Ok(match from {
             // Arriving from H < 0: the minus field moves the state up (else it only
             // touched the surface and stays), the plus field decides cross or slide.
-            Some(Side::Minus) => match (sm, sp) {
+            Some(Region::Minus) => match (sm, sp) {
                 (s, _) if s <= 0 => Arrival::Stay,
                 (_, p) if p >= 0 => Arrival::Cross,
                 _ => Arrival::Slide,
             },
-            Some(Side::Plus) => match (sp, sm) {
+            Some(Region::Plus) => match (sp, sm) {
                 (s, _) if s >= 0 => Arrival::Stay,
                 (_, m) if m <= 0 => Arrival::Cross,
                 _ => Arrival::Slide,
@@ -380,7 +380,7 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
     where
         Sys: Filippov<T, N, S>,
     {
-        let mut sides = [Side::Plus; S];
+        let mut sides = [Region::Plus; S];
         let mut on: Option<usize> = None;
         for (i, side) in sides.iter_mut().enumerate() {
             let h = self.surface_checked(i, t, x)?;
@@ -398,16 +398,16 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
                 }
                 on = Some(i);
             } else {
-                *side = Side::of(h);
+                *side = Region::of(h);
             }
         }
         let Some(i) = on else {
             return Ok(Mode::region(sides));
         };
         Ok(match self.arrival(i, &sides, None, t, x)? {
-            Arrival::Slide => Mode::sliding_on(i, with_side(&sides, i, Side::Minus)),
-            Arrival::Cross => Mode::region(with_side(&sides, i, Side::Plus)),
-            Arrival::Stay => Mode::region(with_side(&sides, i, Side::Minus)),
+            Arrival::Slide => Mode::sliding_on(i, with_side(&sides, i, Region::Minus)),
+            Arrival::Cross => Mode::region(with_side(&sides, i, Region::Plus)),
+            Arrival::Stay => Mode::region(with_side(&sides, i, Region::Minus)),
         })
     }
 
@@ -462,9 +462,9 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
             let slack = lit::<T>(1e3) * self.settings.tangency;
             let clearly_out = a < -slack || a > T::one() + slack;
             let target = if a < lit(0.5) {
-                Side::Minus
+                Region::Minus
             } else {
-                Side::Plus
+                Region::Plus
             };
             project(&self.system, i, t, x);
             let r2 = rates(&self.system, i, &mode.sides, t, x);
@@ -477,7 +477,7 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
                 &r2,
                 self.settings.tangency,
             );
-            if !clearly_out && (s == 0 || (s > 0) != (target == Side::Plus)) {
+            if !clearly_out && (s == 0 || (s > 0) != (target == Region::Plus)) {
                 return Ok((mode, i, TransitionKind::Graze));
             }
             return Ok((
@@ -666,7 +666,7 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
                     let (t, y) = self.stepper.current();
                     let mut y = *y;
                     let (next, surface, kind) = self.next_mode(mode, k, t, &mut y)?;
-                    let last_t = transitions.last().map(|tr: &Transition<T, N, S>| tr.t);
+                    let last_t = transitions.last().map(|tr: &ModeTransition<T, N, S>| tr.t);
                     let stall_tol =
                         self.settings.event_tol + lit::<T>(4.0) * T::default_epsilon() * t.abs();
                     if last_t.is_some_and(|lt| (t - lt).abs() <= stall_tol) {
@@ -681,7 +681,7 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
                     } else {
                         stalls = 0;
                     }
-                    let tr = Transition {
+                    let tr = ModeTransition {
                         t,
                         x: y,
                         surface,

@@ -1,5 +1,5 @@
 //! The description of a Filippov system ([`Filippov`]): switching surfaces, their
-//! gradients and the vector field in each region; the discrete state ([`Side`], [`Mode`]);
+//! gradients and the vector field in each region; the discrete state ([`Region`], [`Mode`]);
 //! a closure adapter for one surface ([`Switched`]).
 
 use nalgebra::{SMatrix, SVector};
@@ -8,36 +8,36 @@ use crate::Real;
 
 /// The side of a switching surface `H(x) = 0`: `Minus` where `H < 0`, `Plus` where `H > 0`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Side {
+pub enum Region {
     /// `H < 0`: the field `F₋`.
     Minus,
     /// `H > 0`: the field `F₊`.
     Plus,
 }
 
-impl Side {
+impl Region {
     /// The side of a value's sign (`Plus` for `h ≥ 0`).
     pub fn of<T: Real>(h: T) -> Self {
         if h < T::zero() {
-            Side::Minus
+            Region::Minus
         } else {
-            Side::Plus
+            Region::Plus
         }
     }
 
     /// The other side.
     pub fn flip(self) -> Self {
         match self {
-            Side::Minus => Side::Plus,
-            Side::Plus => Side::Minus,
+            Region::Minus => Region::Plus,
+            Region::Plus => Region::Minus,
         }
     }
 
     /// `−1` or `+1`.
     pub fn sign<T: Real>(self) -> T {
         match self {
-            Side::Minus => -T::one(),
-            Side::Plus => T::one(),
+            Region::Minus => -T::one(),
+            Region::Plus => T::one(),
         }
     }
 }
@@ -47,14 +47,14 @@ impl Side {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Mode<const S: usize> {
     /// The side of each surface.
-    pub sides: [Side; S],
+    pub sides: [Region; S],
     /// `Some(i)` while sliding on surface `i`.
     pub sliding: Option<usize>,
 }
 
 impl<const S: usize> Mode<S> {
     /// The region given by `sides` (no sliding).
-    pub fn region(sides: [Side; S]) -> Self {
+    pub fn region(sides: [Region; S]) -> Self {
         Self {
             sides,
             sliding: None,
@@ -62,7 +62,7 @@ impl<const S: usize> Mode<S> {
     }
 
     /// Sliding on surface `i`, the other surfaces on `sides`.
-    pub fn sliding_on(i: usize, sides: [Side; S]) -> Self {
+    pub fn sliding_on(i: usize, sides: [Region; S]) -> Self {
         Self {
             sides,
             sliding: Some(i),
@@ -97,7 +97,7 @@ impl<const S: usize> Mode<S> {
 /// A relay `ẍ = −x − sgn(ẋ)` (dry friction on a fixed surface) as one surface `H = ẋ`:
 /// ```
 /// use nalgebra::{SMatrix, SVector};
-/// use nonsmooth::filippov::{Filippov, Side};
+/// use nonsmooth::filippov::{Filippov, Region};
 ///
 /// struct Relay;
 /// impl Filippov<f64, 2, 1> for Relay {
@@ -107,12 +107,12 @@ impl<const S: usize> Mode<S> {
 ///     fn gradient(&self, _i: usize, _t: f64, _x: &SVector<f64, 2>) -> SVector<f64, 2> {
 ///         SVector::from([0.0, 1.0])
 ///     }
-///     fn field(&self, sides: &[Side; 1], _t: f64, x: &SVector<f64, 2>, dx: &mut SVector<f64, 2>) {
+///     fn field(&self, sides: &[Region; 1], _t: f64, x: &SVector<f64, 2>, dx: &mut SVector<f64, 2>) {
 ///         // Friction opposes the velocity: −1 for ẋ > 0 (Plus), +1 for ẋ < 0 (Minus).
 ///         let friction = -sides[0].sign::<f64>();
 ///         *dx = SVector::from([x[1], -x[0] + friction]);
 ///     }
-///     fn field_jacobian(&self, _s: &[Side; 1], _t: f64, _x: &SVector<f64, 2>) -> Option<SMatrix<f64, 2, 2>> {
+///     fn field_jacobian(&self, _s: &[Region; 1], _t: f64, _x: &SVector<f64, 2>) -> Option<SMatrix<f64, 2, 2>> {
 ///         Some(SMatrix::<f64, 2, 2>::new(0.0, 1.0, -1.0, 0.0))
 ///     }
 /// }
@@ -130,12 +130,12 @@ pub trait Filippov<T: Real, const N: usize, const S: usize> {
     }
 
     /// The field `F_σ(t, x)` of the region `σ = sides` into `dx`.
-    fn field(&self, sides: &[Side; S], t: T, x: &SVector<T, N>, dx: &mut SVector<T, N>);
+    fn field(&self, sides: &[Region; S], t: T, x: &SVector<T, N>, dx: &mut SVector<T, N>);
 
     /// `∂F_σ/∂x`, if known (else central differences are used for tangent dynamics).
     fn field_jacobian(
         &self,
-        _sides: &[Side; S],
+        _sides: &[Region; S],
         _t: T,
         _x: &SVector<T, N>,
     ) -> Option<SMatrix<T, N, N>> {
@@ -166,12 +166,12 @@ impl<T: Real, const N: usize, const S: usize, F: Filippov<T, N, S> + ?Sized> Fil
         (**self).surface_time_rate(i, t, x)
     }
     #[inline(always)]
-    fn field(&self, sides: &[Side; S], t: T, x: &SVector<T, N>, dx: &mut SVector<T, N>) {
+    fn field(&self, sides: &[Region; S], t: T, x: &SVector<T, N>, dx: &mut SVector<T, N>) {
         (**self).field(sides, t, x, dx)
     }
     fn field_jacobian(
         &self,
-        sides: &[Side; S],
+        sides: &[Region; S],
         t: T,
         x: &SVector<T, N>,
     ) -> Option<SMatrix<T, N, N>> {
@@ -242,10 +242,10 @@ where
         (self.grad)(x)
     }
     #[inline(always)]
-    fn field(&self, sides: &[Side; 1], t: T, x: &SVector<T, N>, dx: &mut SVector<T, N>) {
+    fn field(&self, sides: &[Region; 1], t: T, x: &SVector<T, N>, dx: &mut SVector<T, N>) {
         *dx = match sides[0] {
-            Side::Minus => (self.minus)(t, x),
-            Side::Plus => (self.plus)(t, x),
+            Region::Minus => (self.minus)(t, x),
+            Region::Plus => (self.plus)(t, x),
         };
     }
 }

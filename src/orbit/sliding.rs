@@ -92,7 +92,7 @@ use nalgebra::{Complex, SVector};
 
 use super::{BranchEnd, OrbitError, Result};
 use crate::filippov::{
-    Approach, Filippov, FilippovRun, FilippovSimulation, Side, SlidingOrbit, Transition,
+    Approach, Filippov, FilippovRun, FilippovSimulation, ModeTransition, Region, SlidingOrbit,
     TransitionKind, second_rate,
 };
 use crate::integrate::{Stepper, Tolerances};
@@ -345,7 +345,7 @@ where
 struct Window<const N: usize, const S: usize> {
     t: f64,
     x: SVector<f64, N>,
-    sides: [Side; S],
+    sides: [Region; S],
     end: f64,
 }
 
@@ -429,7 +429,7 @@ where
 fn tests_of_run<Sys, const N: usize, const S: usize>(
     system: &Sys,
     surface: usize,
-    transitions: &[Transition<f64, N, S>],
+    transitions: &[ModeTransition<f64, N, S>],
     starts_sliding: bool,
     (t0, t1): (f64, f64),
     closest: Option<f64>,

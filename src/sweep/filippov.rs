@@ -10,7 +10,7 @@ use nalgebra::SVector;
 
 use super::{SweepConfig, SweepError};
 use crate::drive::{Control, StepView};
-use crate::filippov::{Filippov, FilippovSimulation, Mode, Plain, SlidingObserver, Transition};
+use crate::filippov::{Filippov, FilippovSimulation, Mode, ModeTransition, Plain, SlidingObserver};
 use crate::integrate::{DenseOutput, Stepper};
 use crate::sample::{Regime, Stroboscopic, detect_period};
 
@@ -56,7 +56,7 @@ impl<const N: usize, const S: usize> SlidingObserver<f64, N, S> for Recorder<N> 
         }
         SlidingObserver::<f64, N, S>::on_step(&mut self.strobe, mode, step)
     }
-    fn on_transition(&mut self, tr: &Transition<f64, N, S>) -> Control {
+    fn on_transition(&mut self, tr: &ModeTransition<f64, N, S>) -> Control {
         if tr.t >= self.record_from && tr.to.is_sliding() && !tr.from.is_sliding() {
             self.entries += 1;
         }
