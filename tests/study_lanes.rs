@@ -15,7 +15,6 @@ name = "one_dof_laws"
 [system]
 model = "mechanical"
 masses = ["m"]
-parameters = { m = 1.0 }
 [[system.elements]]
 law = "cubic_spring"
 dof = 0
@@ -33,7 +32,6 @@ side = "lower"
 position = -0.8
 k = 200.0
 b = 0.5
-n3 = 0.5
 [[system.loads]]
 dof = 0
 amplitude = 1.2
@@ -59,7 +57,7 @@ name = "chain"
 [system]
 model = "mechanical"
 masses = [1.0, 0.5, 0.25]
-parameters = { gap = 0.2 }
+parameters = { gap = 0.05 }
 [[system.elements]]
 law = "linear_spring"
 dof = 0
