@@ -1306,10 +1306,7 @@ fn bad_descriptions_name_the_field() {
             "system.masses[1]",
         ),
         (
-            d.replace(
-                "masses = [1.0, 0.05]",
-                "masses = [1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0]",
-            ),
+            d.replace("masses = [1.0, 0.05]", "masses = [1.0, 1.0, 1.0, 1.0, 1.0]"),
             "system.masses",
         ),
         (

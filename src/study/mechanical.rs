@@ -5,7 +5,7 @@
 //! ```toml
 //! [system]
 //! model = "mechanical"
-//! masses = [1.0, 0.05]                    # one per degree of freedom (1 to 6)
+//! masses = [1.0, 0.05]                    # one per degree of freedom (1 to 4)
 //! parameters = { omega = 1.0, gap = 0.05 } # omega: the forcing frequency (required)
 //!
 //! [[system.elements]]                     # a law on q0: spring and damper
@@ -50,13 +50,6 @@
 //! and sticking ([`run_with_sticking`](crate::drive::run_with_sticking)), which drives one
 //! rigid contact: such a surface must be the only one.
 //!
-//! Without a rigid stop, a shard's points run together in SIMD lanes
-//! ([`lanes`](super::lanes)): the law enum has a lane form (`LawLanes`, each law's
-//! [`LaneLaw`] form, the kind of law shared by the lanes of one ensemble), and so do the
-//! elements and loads, in the scalar path's order, so each point's record is the scalar
-//! record to the bit. Points whose descriptions differ in structure (coordinates, kinds of
-//! law) run in separate ensembles. A rigid stop runs point by point.
-//!
 //! [`model::Mechanical`]: crate::model::Mechanical
 
 use std::collections::BTreeMap;
@@ -64,25 +57,20 @@ use std::collections::BTreeMap;
 use serde::{Deserialize, Serialize};
 
 use super::StudyError;
-use super::lanes;
 use super::scalar::{self, MAX_SURFACES};
 use super::system::{
-    ParameterDef, ParameterPoint, PointRun, PointStart, RunSettings, StudySystem, is_initial_name,
+    ParameterDef, ParameterPoint, PointRun, RunSettings, StudySystem, is_initial_name,
 };
 use crate::event::{Gap, NewtonImpact};
-use crate::excite::{Harmonic, LaneExcitation};
+use crate::excite::Harmonic;
 use crate::force::{
-    ContactOnset, CubicSpring, DryFriction, HertzContact, LaneLaw, LinearSpring, Side,
-    ViscousDamper,
+    ContactOnset, CubicSpring, DryFriction, HertzContact, LinearSpring, Side, ViscousDamper,
 };
-use crate::lanes::{LaneMath, Lanes};
-use crate::model::{
-    Coordinate, Element, Elements, LaneElements, LaneLoads, Load, Loads, Mechanical,
-};
-use crate::{Dynamics, ForceLaw, LaneDynamics, ParameterError};
+use crate::model::{Coordinate, Element, Elements, Load, Loads, Mechanical};
+use crate::{Dynamics, ForceLaw, ParameterError};
 
 /// The most degrees of freedom of a described system.
-pub const MAX_DESCRIBED_DOFS: usize = 6;
+pub const MAX_DESCRIBED_DOFS: usize = 4;
 
 /// A number of a described system, or the name of a parameter (`system.parameters` or a
 /// grid axis; `"-name"` for its negative).
@@ -258,54 +246,6 @@ impl ForceLaw<f64> for Law {
     }
 }
 
-/// The lane form of [`Law`]: the law's variant is the structure (every lane of a packed
-/// `LawLanes` holds the same variant: the ensemble runs together only points whose laws
-/// agree in kind, [`DescribedElements::same_coordinates`](LaneElements::same_coordinates)),
-/// its parameters are per lane.
-#[derive(Debug, Clone, Copy)]
-pub(crate) enum LawLanes<V: Lanes> {
-    Linear(<LinearSpring<f64> as LaneLaw>::Packed<V>),
-    Damper(<ViscousDamper<f64> as LaneLaw>::Packed<V>),
-    Cubic(<CubicSpring<f64> as LaneLaw>::Packed<V>),
-    Hertz(<HertzContact<f64> as LaneLaw>::Packed<V>),
-    Friction(<DryFriction<f64> as LaneLaw>::Packed<V>),
-}
-
-impl LaneLaw for Law {
-    type Packed<V: Lanes> = LawLanes<V>;
-    fn pack<V: Lanes>(&self) -> LawLanes<V> {
-        match self {
-            Law::Linear(l) => LawLanes::Linear(l.pack()),
-            Law::Damper(l) => LawLanes::Damper(l.pack()),
-            Law::Cubic(l) => LawLanes::Cubic(l.pack()),
-            Law::Hertz(l) => LawLanes::Hertz(l.pack()),
-            Law::Friction(l) => LawLanes::Friction(l.pack()),
-        }
-    }
-    /// A lane of the same variant; a law of another kind leaves `packed` unchanged (the
-    /// lanes of one ensemble share the kinds, see [`LawLanes`]).
-    fn pack_lane<V: Lanes>(&self, packed: &mut LawLanes<V>, lane: usize) {
-        match (self, packed) {
-            (Law::Linear(l), LawLanes::Linear(p)) => l.pack_lane(p, lane),
-            (Law::Damper(l), LawLanes::Damper(p)) => l.pack_lane(p, lane),
-            (Law::Cubic(l), LawLanes::Cubic(p)) => l.pack_lane(p, lane),
-            (Law::Hertz(l), LawLanes::Hertz(p)) => l.pack_lane(p, lane),
-            (Law::Friction(l), LawLanes::Friction(p)) => l.pack_lane(p, lane),
-            _ => debug_assert!(false, "a law of another kind packed into a lane"),
-        }
-    }
-    #[inline(always)]
-    fn force_lanes<V: Lanes>(packed: &LawLanes<V>, math: LaneMath, x: V, v: V) -> V {
-        match packed {
-            LawLanes::Linear(p) => LinearSpring::force_lanes(p, math, x, v),
-            LawLanes::Damper(p) => ViscousDamper::force_lanes(p, math, x, v),
-            LawLanes::Cubic(p) => CubicSpring::force_lanes(p, math, x, v),
-            LawLanes::Hertz(p) => HertzContact::force_lanes(p, math, x, v),
-            LawLanes::Friction(p) => DryFriction::force_lanes(p, math, x, v),
-        }
-    }
-}
-
 /// The elements of a described system.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct DescribedElements<const N: usize>(Vec<Element<f64, N, Law>>);
@@ -327,40 +267,6 @@ impl<const N: usize> Elements<f64, N> for DescribedElements<N> {
         for e in &self.0 {
             e.add_tangent(q, qd, k, c);
         }
-    }
-}
-
-/// The elements in lanes: each element's law in lanes ([`LawLanes`]), in the scalar order.
-impl<const N: usize> LaneElements<N> for DescribedElements<N> {
-    type Packed<V: Lanes> = Vec<LawLanes<V>>;
-    fn pack<V: Lanes>(&self) -> Vec<LawLanes<V>> {
-        self.0.iter().map(|e| e.law.pack()).collect()
-    }
-    fn pack_lane<V: Lanes>(&self, packed: &mut Vec<LawLanes<V>>, lane: usize) {
-        for (e, p) in self.0.iter().zip(packed.iter_mut()) {
-            e.law.pack_lane(p, lane);
-        }
-    }
-    #[inline(always)]
-    fn add_forces_lanes<V: Lanes>(
-        &self,
-        packed: &Vec<LawLanes<V>>,
-        math: LaneMath,
-        q: &[V],
-        qd: &[V],
-        out: &mut [V; N],
-    ) {
-        for (e, p) in self.0.iter().zip(packed) {
-            e.add_forces_lanes(p, math, q, qd, out);
-        }
-    }
-    /// The same coordinates and the same kind of law, element by element.
-    fn same_coordinates(&self, other: &Self) -> bool {
-        self.0.len() == other.0.len()
-            && self.0.iter().zip(&other.0).all(|(a, b)| {
-                a.coordinate == b.coordinate
-                    && std::mem::discriminant(&a.law) == std::mem::discriminant(&b.law)
-            })
     }
 }
 
@@ -387,39 +293,6 @@ impl<const N: usize> Loads<f64, N> for DescribedLoads<N> {
         self.0
             .iter()
             .fold(None, |m, l| crate::model::shorter(m, l.time_scale(t)))
-    }
-}
-
-/// The loads in lanes, in the scalar order.
-impl<const N: usize> LaneLoads<N> for DescribedLoads<N> {
-    type Packed<V: Lanes> = Vec<<Harmonic<f64> as LaneExcitation>::Packed<V>>;
-    fn pack<V: Lanes>(&self) -> Self::Packed<V> {
-        self.0.iter().map(|l| l.excitation.pack()).collect()
-    }
-    fn pack_lane<V: Lanes>(&self, packed: &mut Self::Packed<V>, lane: usize) {
-        for (l, p) in self.0.iter().zip(packed.iter_mut()) {
-            l.excitation.pack_lane(p, lane);
-        }
-    }
-    #[inline(always)]
-    fn add_forces_lanes<V: Lanes>(
-        &self,
-        packed: &Self::Packed<V>,
-        math: LaneMath,
-        t: V,
-        out: &mut [V; N],
-    ) {
-        for (l, p) in self.0.iter().zip(packed) {
-            l.add_forces_lanes(p, math, t, out);
-        }
-    }
-    fn same_coordinates(&self, other: &Self) -> bool {
-        self.0.len() == other.0.len()
-            && self
-                .0
-                .iter()
-                .zip(&other.0)
-                .all(|(a, b)| a.coordinate == b.coordinate)
     }
 }
 
@@ -781,42 +654,12 @@ impl Described {
             2 => self.check_n::<2>(p),
             3 => self.check_n::<3>(p),
             4 => self.check_n::<4>(p),
-            5 => self.check_n::<5>(p),
-            6 => self.check_n::<6>(p),
             n => Err(BuildError {
                 field: "system.masses".into(),
                 message: format!("{n} masses; at most {MAX_DESCRIBED_DOFS}"),
                 parameter: None,
             }),
         }
-    }
-
-    /// Whether a surface is a rigid stop (the run is [`scalar::run_rigid`]'s, one by one).
-    fn has_rigid(&self) -> bool {
-        self.surfaces.iter().any(|s| s.restitution.is_some())
-    }
-
-    /// The model at `p`, its forcing period, and its rigid stop or its counting surfaces.
-    #[allow(clippy::type_complexity)]
-    fn start_n<const N: usize>(
-        &self,
-        p: &ParameterPoint,
-    ) -> Result<
-        (
-            Model<N>,
-            f64,
-            Result<NewtonImpact<f64, N>, Vec<Gap<f64, N>>>,
-        ),
-        String,
-    > {
-        let e = |e: BuildError| e.to_string();
-        let model = self.model::<N>(p).map_err(e)?;
-        let period = std::f64::consts::TAU / p.get("omega");
-        let surfaces = match self.rigid::<N>(p, &model).map_err(e)? {
-            Some(impact) => Ok(impact),
-            None => Err(self.gaps::<N>(p).map_err(e)?),
-        };
-        Ok((model, period, surfaces))
     }
 
     /// Runs `p` with `N` degrees of freedom (state `M = 2N`, `M2 = 2M`).
@@ -829,35 +672,16 @@ impl Described {
     where
         Model<N>: Dynamics<f64, M>,
     {
-        match self.start_n::<N>(p)? {
-            (model, period, Ok(impact)) => {
-                scalar::run_rigid::<N, M, _, _, _>(s, model, impact, period, y0)
-            }
-            (model, period, Err(gaps)) => {
+        let e = |e: BuildError| e.to_string();
+        let model = self.model::<N>(p).map_err(e)?;
+        let period = std::f64::consts::TAU / p.get("omega");
+        match self.rigid::<N>(p, &model).map_err(e)? {
+            Some(impact) => scalar::run_rigid::<N, M, _, _, _>(s, model, impact, period, y0),
+            None => {
+                let gaps = self.gaps::<N>(p).map_err(e)?;
                 scalar::run_smooth::<M, M2, _, _>(s, model, gaps, period, y0)
             }
         }
-    }
-
-    /// Runs `points` with `N` degrees of freedom in SIMD lanes ([`lanes::run_smooth_batch`]):
-    /// for each, what [`run_n`](Self::run_n) gives, to the bit. Only for a description
-    /// without a rigid stop.
-    fn batch_n<const N: usize, const M: usize, const M2: usize>(
-        &self,
-        points: &[PointStart],
-        s: &RunSettings,
-    ) -> Vec<Result<PointRun, String>>
-    where
-        Model<N>: Dynamics<f64, M> + LaneDynamics<M>,
-    {
-        let starts = points.iter().map(|p| {
-            let (p, y0) = p.as_ref().map_err(Clone::clone)?;
-            match self.start_n::<N>(p)? {
-                (model, period, Err(gaps)) => Ok((model, gaps, period, y0.clone())),
-                (_, _, Ok(_)) => Err("internal: a rigid stop in lanes".to_string()),
-            }
-        });
-        lanes::run_smooth_batch::<M, M2, _, _>(s, starts.collect())
     }
 }
 
@@ -995,36 +819,7 @@ impl StudySystem for Described {
             2 => self.run_n::<2, 4, 8>(p, y0, s),
             3 => self.run_n::<3, 6, 12>(p, y0, s),
             4 => self.run_n::<4, 8, 16>(p, y0, s),
-            5 => self.run_n::<5, 10, 20>(p, y0, s),
-            6 => self.run_n::<6, 12, 24>(p, y0, s),
             n => Err(format!("{n} masses; at most {MAX_DESCRIBED_DOFS}")),
-        }
-    }
-    /// In lanes unless a surface is a rigid stop (the sticking drive runs one by one).
-    fn in_lanes(&self) -> bool {
-        !self.has_rigid()
-    }
-    fn run_batch(&self, points: &[PointStart], s: &RunSettings) -> Vec<Result<PointRun, String>> {
-        if self.has_rigid() {
-            return points
-                .iter()
-                .map(|p| match p {
-                    Ok((p, y0)) => self.run(p, y0, s),
-                    Err(m) => Err(m.clone()),
-                })
-                .collect();
-        }
-        match self.masses.len() {
-            1 => self.batch_n::<1, 2, 4>(points, s),
-            2 => self.batch_n::<2, 4, 8>(points, s),
-            3 => self.batch_n::<3, 6, 12>(points, s),
-            4 => self.batch_n::<4, 8, 16>(points, s),
-            5 => self.batch_n::<5, 10, 20>(points, s),
-            6 => self.batch_n::<6, 12, 24>(points, s),
-            n => {
-                let m = format!("{n} masses; at most {MAX_DESCRIBED_DOFS}");
-                points.iter().map(|_| Err(m.clone())).collect()
-            }
         }
     }
 }

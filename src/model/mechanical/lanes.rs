@@ -73,9 +73,8 @@ impl<const N: usize> Coordinate<f64, N> {
 /// The lane form of a set of [`Elements`](super::Elements): the elements' laws implement
 /// [`LaneLaw`]. Implemented for [`Element`], `()`, tuples and arrays, as `Elements` is.
 pub trait LaneElements<const N: usize>: super::Elements<f64, N> {
-    /// The laws' parameters in `L` lanes (`Clone`, not `Copy`: a set of elements whose
-    /// number is known at run time packs into a `Vec`, allocated once when packed).
-    type Packed<V: Lanes>: Clone + core::fmt::Debug + Send + Sync;
+    /// The laws' parameters in `L` lanes.
+    type Packed<V: Lanes>: Copy + core::fmt::Debug + Send + Sync;
     /// Every lane set to these elements.
     fn pack<V: Lanes>(&self) -> Self::Packed<V>;
     /// Lane `lane` set to these elements.
@@ -212,8 +211,8 @@ lane_element_tuple!(A 0, B 1, C 2, D 3, E 4, F 5, G 6, H 7, I 8, J 9, K 10, L 11
 /// The lane form of a set of [`Loads`](super::Loads): the loads' excitations implement
 /// [`LaneExcitation`].
 pub trait LaneLoads<const N: usize>: super::Loads<f64, N> {
-    /// The excitations' parameters in `L` lanes (`Clone`, as for [`LaneElements`]).
-    type Packed<V: Lanes>: Clone + core::fmt::Debug + Send + Sync;
+    /// The excitations' parameters in `L` lanes.
+    type Packed<V: Lanes>: Copy + core::fmt::Debug + Send + Sync;
     /// Every lane set to these loads.
     fn pack<V: Lanes>(&self) -> Self::Packed<V>;
     /// Lane `lane` set to these loads.
