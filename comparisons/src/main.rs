@@ -28,6 +28,17 @@ use ours::Ours;
 const OMEGA: f64 = 20.465;
 /// Reference tolerance (nonsmooth DOP853) and its self-check.
 const REF_RTOL: f64 = 1e-14;
+/// The tolerances tried, in order, for each segment of the `η = 1e-11` reference.
+const REF_LADDER: [f64; 3] = [1e-14, 1e-13, 1e-12];
+/// The exact law's own runs in the cross-checks of the `η = 0` reference: (method, rtol).
+/// DOP853 on the exact law stops with "step size too small" at rtol 1e-13 on some segments
+/// (h ≈ 1.7·10⁻¹³ s at t ≈ 55 s), so the reference is the regularized law at `η = 1e-11`
+/// ([`Ours::Dop853Eta11`]) at [`REF_RTOL`], and the exact law checks it where it runs.
+const EXACT_CHECKS: [(Ours, f64); 3] = [
+    (Ours::Dop853Exact, 1e-12),
+    (Ours::Dop853Exact, 1e-13),
+    (Ours::Dopri5Exact, 1e-13),
+];
 /// Accuracy starts: t = 2π(100 + 10k)/ω, k = 0..40 (the RMS error over 400 section
 /// samples is stable to ~20 % between runs; over the brief's 5 starts it scattered by 2–3×).
 const ACC_STARTS: [u64; 40] = {
@@ -66,6 +77,9 @@ impl Method {
             Method::Ours(Ours::Dopri5Grid),
             Method::Ours(Ours::Dopri5Pred),
             Method::Ours(Ours::Dopri5Turning),
+            Method::Ours(Ours::Dopri5Exact),
+            Method::Ours(Ours::CuspExact),
+            Method::Ours(Ours::TurningCuspExact),
             Method::Ours(Ours::Rosenbrock23),
             Method::De(DeMethod::Dopri5),
             Method::De(DeMethod::Dop853),
@@ -98,6 +112,11 @@ impl Method {
             Method::Ours(Ours::Dopri5Grid) => "Dopri5 + landing_grid",
             Method::Ours(Ours::Dopri5Pred) => "Dopri5 predictive",
             Method::Ours(Ours::Dopri5Turning) => "Dopri5 + TurningPoints",
+            Method::Ours(Ours::Dopri5Exact) => "Dopri5 (η = 0)",
+            Method::Ours(Ours::CuspExact) => "CuspSwitch (η = 0)",
+            Method::Ours(Ours::TurningCuspExact) => "TurningPoints + CuspSwitch (η = 0)",
+            Method::Ours(Ours::Dop853Exact) => "Dop853 (η = 0)",
+            Method::Ours(Ours::Dop853Eta11) => "Dop853 (η = 1e-11)",
             Method::Ours(Ours::Rosenbrock23) => "Rosenbrock23",
             Method::De(DeMethod::Dopri5) => "dopri5",
             Method::De(DeMethod::Dop853) => "dop853",
@@ -112,6 +131,12 @@ impl Method {
             Method::Os(OsMethod::Dopri5) => "Dopri5",
             Method::Os(OsMethod::Dop853) => "Dop853",
         }
+    }
+
+    /// Whether the method runs the exact contact law (`η = 0`): its accuracy is measured
+    /// against the `η = 0` reference.
+    fn exact_law(&self) -> bool {
+        matches!(self, Method::Ours(k) if k.exact_law())
     }
 
     fn label(&self) -> String {
@@ -220,6 +245,16 @@ struct Reference {
     w2_start: [f64; 2],
     /// Per accuracy start k: (t0, y0, end state, impacts).
     segs: Vec<Seg>,
+    /// The same segments with `η = 1e-11` (DOP853, [`REF_LADDER`]), from the same starts:
+    /// the reference of the exact-law rows.
+    segs_exact: Vec<Seg>,
+    /// The exact-law reference against the regularized one: (max |Δx| over the 400
+    /// sections, RMS Δx over them, max |Δt impact|, impact mismatches).
+    exact_vs_regularized: (f64, f64, f64, usize),
+    /// The exact-law reference's cross-checks, as [`checks`](Self::checks).
+    checks_exact: Vec<(String, f64, f64, usize)>,
+    /// How many segments of the exact-law reference ran at each rtol of [`REF_LADDER`].
+    exact_ladder: String,
     w1_impacts: usize,
     w2_impacts: usize,
     /// Cross-checks: (label, max |Δx_end|, max |Δt_impact|, impact count mismatch).
@@ -290,6 +325,7 @@ fn reference() -> Reference {
         }
         checks.push((format!("{} rtol {rtol:.0e}", m.label()), dx, dt, mism));
     }
+    let (segs_exact, exact_vs_regularized, checks_exact, exact_ladder) = exact_reference(&segs);
     let w1 = must(
         refm.run(&job(0, [x_rest, 0.0], W1_PERIODS, REF_RTOL, 1e9)),
         "reference W1",
@@ -302,10 +338,131 @@ fn reference() -> Reference {
         x_rest,
         w2_start: [w2[1], w2[2]],
         segs,
+        segs_exact,
+        exact_vs_regularized,
+        checks_exact,
+        exact_ladder,
         w1_impacts: w1.impacts.len(),
         w2_impacts: w2r.impacts.len(),
         checks,
     }
+}
+
+/// The exact-law reference: the segments of `segs` run again with `η = 1e-11` (nonsmooth
+/// DOP853 at [`REF_RTOL`], [`Ours::Dop853Eta11`]), their distance to the `η = 1e-8`
+/// reference (max and RMS |Δx| over all sections, max |Δt impact|, impact mismatches), and
+/// the exact law's own runs against it ([`EXACT_CHECKS`]; a run that fails counts 1000
+/// mismatches).
+#[allow(clippy::type_complexity)]
+fn exact_reference(
+    segs: &[Seg],
+) -> (
+    Vec<Seg>,
+    (f64, f64, f64, usize),
+    Vec<(String, f64, f64, usize)>,
+    String,
+) {
+    let run_all = |m: Method, rtol: f64| -> (Vec<Seg>, usize) {
+        let mut failed = 0;
+        let out = ACC_STARTS
+            .iter()
+            .zip(segs)
+            .map(|(&i, seg)| {
+                let s = seg.start;
+                let r = m.run(&job(i, [s[1], s[2]], ACC_PERIODS, rtol, 1e9));
+                if !r.status.is_ok() {
+                    eprintln!(
+                        "{} rtol {rtol:e} from period {i}: {}",
+                        m.label(),
+                        r.status.short()
+                    );
+                    failed += 1;
+                }
+                Seg {
+                    start: s,
+                    end: r.end,
+                    impacts: r.impacts,
+                    strobe: if r.status.is_ok() { r.strobe } else { vec![] },
+                }
+            })
+            .collect();
+        (out, failed)
+    };
+    // DOP853 at η = 1e-11 also stops with "step size too small" at rtol 1e-14 on some
+    // segments (h ≈ 4·10⁻¹³ s at t ≈ 120–150 s, ~15 ulps of t): each segment takes the
+    // tightest tolerance of `REF_LADDER` at which it runs.
+    let refm = Method::Ours(Ours::Dop853Eta11);
+    let mut exact = vec![];
+    let mut used = vec![];
+    for (&i, seg) in ACC_STARTS.iter().zip(segs) {
+        let s = seg.start;
+        let mut done = None;
+        for rtol in REF_LADDER {
+            let r = refm.run(&job(i, [s[1], s[2]], ACC_PERIODS, rtol, 1e9));
+            if r.status.is_ok() {
+                done = Some((r, rtol));
+                break;
+            }
+        }
+        let (r, rtol) = done.expect("the η = 1e-11 reference runs at some rtol of the ladder");
+        used.push(rtol);
+        exact.push(Seg {
+            start: s,
+            end: r.end,
+            impacts: r.impacts,
+            strobe: r.strobe,
+        });
+    }
+    let ladder: Vec<String> = REF_LADDER
+        .iter()
+        .map(|&t| {
+            format!(
+                "{} at rtol {t:.0e}",
+                used.iter().filter(|&&u| u == t).count()
+            )
+        })
+        .collect();
+    let ladder = format!("segments: {}", ladder.join(", "));
+    let distance = |a: &[Seg], b: &[Seg]| -> (f64, f64, f64, usize) {
+        let (mut worst, mut sq, mut n, mut dt, mut mism) = (0.0f64, 0.0, 0usize, 0.0f64, 0);
+        for (p, q) in a.iter().zip(b) {
+            if p.strobe.len() != q.strobe.len() {
+                mism += 1000;
+                continue;
+            }
+            for (u, w) in p.strobe.iter().zip(&q.strobe) {
+                let d = (u[1] - w[1]).abs();
+                worst = worst.max(d);
+                sq += d * d;
+                n += 1;
+            }
+            let (w, mi, ex) = impact_errors(&q.impacts, &p.impacts);
+            dt = dt.max(w);
+            mism += mi + ex;
+        }
+        (worst, (sq / n.max(1) as f64).sqrt(), dt, mism)
+    };
+    let vs_regularized = distance(&exact, segs);
+    let checks = EXACT_CHECKS
+        .iter()
+        .map(|&(k, rtol)| {
+            let m = Method::Ours(k);
+            let (run, failed) = run_all(m, rtol);
+            let (dx, _, dt, mm) = distance(&run, &exact);
+            let what = if failed > 0 {
+                format!(", {failed} of 40 segments failed")
+            } else {
+                String::new()
+            };
+            (
+                format!("{} rtol {rtol:.0e} (all 10 sections{what})", m.label()),
+                dx,
+                dt,
+                mm,
+            )
+        })
+        .collect();
+    (exact, vs_regularized, checks, ladder)
 }
 
 /// A reference segment: 10 periods from a state on the attractor.
@@ -449,8 +606,13 @@ fn measure(m: Method, rtol: f64, reference: &Reference, args: &Args) -> Row {
     let mut err_t: f64 = 0.0;
     let (mut missed, mut extra) = (0, 0);
     let mut acc_status = Status::Ok;
+    let segs = if m.exact_law() {
+        &reference.segs_exact
+    } else {
+        &reference.segs
+    };
     for (k, &i) in ACC_STARTS.iter().enumerate() {
-        let seg = &reference.segs[k];
+        let seg = &segs[k];
         let s = seg.start;
         let r = m.run(&job(i, [s[1], s[2]], ACC_PERIODS, rtol, args.budget));
         check_rhs_count(m, &r);
@@ -737,6 +899,9 @@ fn ratios(rows: &[Row], quantity: Quantity) -> (String, String) {
                     | Method::Ours(Ours::Dopri5Pred)
                     | Method::Ours(Ours::Dopri5Turning)
                     | Method::Ours(Ours::Dop853)
+                    | Method::Ours(Ours::Dopri5Exact)
+                    | Method::Ours(Ours::CuspExact)
+                    | Method::Ours(Ours::TurningCuspExact)
             ) && r.err_rms.is_finite()
                 && pick(r).status.is_ok()
         })
@@ -1082,13 +1247,18 @@ fn main() {
         // Per-start accuracy of one method (diagnostics).
         let m = find_method(label);
         let reference = reference();
+        let segs = if m.exact_law() {
+            &reference.segs_exact
+        } else {
+            &reference.segs
+        };
         for (k, &i) in ACC_STARTS.iter().enumerate() {
             let Seg {
                 start: s,
                 end: e,
                 impacts: imp,
                 ..
-            } = &reference.segs[k];
+            } = &segs[k];
             let r = m.run(&job(i, [s[1], s[2]], ACC_PERIODS, *rtol, args.budget));
             let (w, mi, ex) = impact_errors(imp, &r.impacts);
             println!(
@@ -1137,6 +1307,22 @@ fn main() {
     for (l, dx, dt, mm) in &reference.checks {
         println!(
             "  cross-check {l}: max |Δx| = {dx:.2e} m, max |Δt| = {dt:.2e} s, mismatches {mm}"
+        );
+        let _ = writeln!(checks, "| {l} | {dx:.2e} | {dt:.2e} | {mm} |");
+    }
+    let (ex, erms, edt, emm) = reference.exact_vs_regularized;
+    println!(
+        "  exact-law reference (Dop853, η = 1e-11; {}) vs the η = 1e-8 one: max |Δx| = {ex:.2e} m (RMS {erms:.2e} m) over the 400 sections, max |Δt| = {edt:.2e} s, mismatches {emm}",
+        reference.exact_ladder
+    );
+    let _ = write!(
+        checks,
+        "\nThe exact-law rows (η = 0) are measured against their own reference: the same 40 segments from the same starts, nonsmooth Dop853 with η = 1e-11 at the tightest rtol of 1e-14, 1e-13, 1e-12 at which the segment runs ({}; DOP853 at η = 1e-11 and rtol 1e-14 stops with 'step size too small' on some segments late in t) (within ≈ 8·10⁻⁵ of the η = 1e-8 reference's distance to η = 0, by the order 1 + 2n3 in η; DOP853 on the exact law itself stops with 'step size too small' at rtol 1e-13 on some segments). It differs from the η = 1e-8 reference by max |Δx| = {ex:.2e} m (RMS {erms:.2e} m) over the 400 sections, max |Δt impact| = {edt:.2e} s, {emm} impact mismatches. The exact law's own runs against it:\n\n| cross-check of the η = 0 reference | max |Δx| over 10 P (m) | max |Δt impact| (s) | impact count mismatches |\n|---|---|---|---|\n",
+        reference.exact_ladder
+    );
+    for (l, dx, dt, mm) in &reference.checks_exact {
+        println!(
+            "  cross-check (η = 0) {l}: max |Δx| = {dx:.2e} m, max |Δt| = {dt:.2e} s, mismatches {mm}"
         );
         let _ = writeln!(checks, "| {l} | {dx:.2e} | {dt:.2e} | {mm} |");
     }

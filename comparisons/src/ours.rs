@@ -7,10 +7,11 @@ use nonsmooth::Dynamics;
 use nonsmooth::drive::{Control, EventRecord, Observer, Simulation, StepView, Termination};
 use nonsmooth::event::{Direction, Event, Level};
 use nonsmooth::integrate::{
-    DenseOutput, Dop853, Dopri5, Rosenbrock23, StepOptions, Stepper, Tolerances, TurningPoints,
+    CuspImplicit, CuspSwitch, DenseOutput, Dop853, Dopri5, Rosenbrock23, StepOptions, Stepper,
+    Tolerances, TurningPoints,
 };
-use nonsmooth::systems::paper::{PAPER, PaperOscillator};
 use nonsmooth::sample::Stroboscopic;
+use nonsmooth::systems::paper::{PAPER, PaperOscillator, PaperParameters};
 
 use crate::common::{Counter, Job, RunResult, Status};
 
@@ -28,6 +29,50 @@ pub enum Ours {
     /// DOPRI5 in time, and DOPRI5 across the turning points (`|ẋ| < 3e-3 m/s`) with the
     /// velocity's power scale as the independent variable (`TurningPoints::dopri5`).
     Dopri5Turning,
+    /// The paper's exact contact law (`η = 0`) with DOPRI5 alone.
+    Dopri5Exact,
+    /// The exact law with `CuspSwitch::dopri5(tol, 1e-6)`: DOPRI5, and the extrapolated
+    /// backward Euler cusp step where the creep in contact makes DOPRI5 stiffness-bound.
+    CuspExact,
+    /// The exact law with `CuspSwitch` over `TurningPoints::dopri5(tol, 3e-3)` (the
+    /// fastest regularized configuration as the explicit side).
+    TurningCuspExact,
+    /// The exact law with DOP853 (a cross-check of the `η = 0` reference; not a table row).
+    Dop853Exact,
+    /// DOP853 with `η = 1e-11 m/s` (the `η = 0` accuracy reference; not a table row): the
+    /// exact law itself does not run at the reference tolerance, and `η = 1e-11` differs
+    /// from it by `(10⁻³)^{1+2n3} ≈ 8·10⁻⁵` of the distance between `η = 1e-8` and `η = 0`
+    /// (order `1 + 2n3` in `η`, `examples/exact_law.rs`).
+    Dop853Eta11,
+}
+
+/// The band `|ẋ| < CUSP_BAND` (m/s) in which `CuspSwitch` probes the cusp's stiffness (the
+/// value of `examples/exact_law.rs`).
+pub const CUSP_BAND: f64 = 1e-6;
+
+/// The band `|ẋ| < TURNING_BAND` (m/s) of `TurningPoints`.
+const TURNING_BAND: f64 = 3e-3;
+
+impl Ours {
+    /// Whether the configuration runs the exact contact law (`η = 0`) instead of the
+    /// crate's default regularization `η = 1e-8 m/s`.
+    pub fn exact_law(self) -> bool {
+        matches!(
+            self,
+            Ours::Dopri5Exact | Ours::CuspExact | Ours::TurningCuspExact | Ours::Dop853Exact
+        )
+    }
+}
+
+/// The paper's parameters, with `η = 0` for the exact-law configurations.
+fn parameters(kind: Ours) -> PaperParameters {
+    let mut p = PAPER;
+    if kind.exact_law() {
+        p.eta = 0.0;
+    } else if kind == Ours::Dop853Eta11 {
+        p.eta = 1e-11;
+    }
+    p
 }
 
 /// Impact times.
@@ -81,6 +126,9 @@ impl Dynamics<f64, 2> for NoInline {
     fn velocity_exponent(&self) -> Option<f64> {
         self.0.velocity_exponent()
     }
+    fn cusp_exponent(&self) -> Option<f64> {
+        self.0.cusp_exponent()
+    }
 }
 
 /// The system as `Simulation` sees it: every right-hand-side (and Jacobian) evaluation bumps
@@ -112,10 +160,15 @@ impl<S: Dynamics<f64, 2>> Dynamics<f64, 2> for Counted<S> {
     fn velocity_exponent(&self) -> Option<f64> {
         self.sys.velocity_exponent()
     }
+    fn cusp_exponent(&self) -> Option<f64> {
+        self.sys.cusp_exponent()
+    }
 }
 
 pub fn run(kind: Ours, job: &Job) -> RunResult {
-    let osc = PAPER.oscillator::<f64>(job.omega).expect("model");
+    let osc = parameters(kind)
+        .oscillator::<f64>(job.omega)
+        .expect("model");
     if std::env::var_os("NONSMOOTH_RHS_NOINLINE").is_some() {
         run_with(NoInline(osc), kind, job)
     } else {
@@ -139,10 +192,26 @@ fn run_with<S: Dynamics<f64, 2>>(sys: S, kind: Ours, job: &Job) -> RunResult {
             cpu0,
         ),
         Ours::Dopri5Turning => {
-            let st = TurningPoints::dopri5(tol, 3e-3).expect("band");
+            let st = TurningPoints::dopri5(tol, TURNING_BAND).expect("band");
             go(sys, st, job, false, start, cpu0)
         }
-        Ours::Dop853 => go(sys, Dop853::new(tol), job, false, start, cpu0),
+        Ours::Dopri5Exact => go(sys, Dopri5::new(tol), job, false, start, cpu0),
+        Ours::CuspExact => {
+            let st = CuspSwitch::dopri5(tol, CUSP_BAND).expect("band");
+            go(sys, st, job, false, start, cpu0)
+        }
+        Ours::TurningCuspExact => {
+            let st = CuspSwitch::new(
+                TurningPoints::dopri5(tol, TURNING_BAND).expect("band"),
+                CuspImplicit::new(tol),
+                CUSP_BAND,
+            )
+            .expect("band");
+            go(sys, st, job, false, start, cpu0)
+        }
+        Ours::Dop853 | Ours::Dop853Exact | Ours::Dop853Eta11 => {
+            go(sys, Dop853::new(tol), job, false, start, cpu0)
+        }
         Ours::Rosenbrock23 => go(sys, Rosenbrock23::new(tol), job, false, start, cpu0),
     }
 }
