@@ -11,7 +11,7 @@ use crate::validate::{ParameterError, positive};
 use super::error::TimeStepError;
 use super::lcp::{LcpReport, Lemke, Nsgs, Pgs};
 use super::observe::{ContactRecord, Energy, StepObserver, StepRecord, Summary};
-use super::system::{ContactSet, Jacobian, Lagrangian};
+use super::system::{ContactSet, Geometry, Jacobian, Lagrangian};
 
 /// The solver of each step's contact problem.
 #[derive(Debug, Clone)]
@@ -164,6 +164,34 @@ enum Factor {
 #[inline(always)]
 fn row<'a, T>(rows: &'a [(usize, T)], offsets: &[usize], a: usize) -> &'a [(usize, T)] {
     &rows[offsets[a]..offsets[a + 1]]
+}
+
+/// Contact `i`'s geometry at `(t, q)`, its Jacobian rows into the workspace's scratch rows.
+#[inline]
+fn evaluate_contact<T: Real, C: ContactSet<T>>(
+    contacts: &C,
+    ws: &mut Workspace<T>,
+    i: usize,
+    t: T,
+    q: &[T],
+) -> Result<Geometry<T>, TimeStepError> {
+    ws.scratch_n.clear();
+    ws.scratch_t.clear();
+    let mut jac = Jacobian {
+        normal: &mut ws.scratch_n,
+        tangent: &mut ws.scratch_t,
+        dofs: ws.n,
+        out_of_range: None,
+    };
+    let geo = contacts.evaluate(i, t, q, &mut jac);
+    match jac.out_of_range {
+        Some(dof) => Err(TimeStepError::Dimension {
+            what: "contact Jacobian index",
+            got: dof,
+            expected: ws.n,
+        }),
+        None => Ok(geo),
+    }
 }
 
 /// LU factorization with partial pivoting of the row-major `n × n` matrix `a` in place
@@ -766,7 +794,6 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
         q: &[T],
         tolerance: T,
     ) -> Result<Option<(usize, T)>, TimeStepError> {
-        let n = self.ws.n;
         let ws = &mut self.ws;
         ws.rows.clear();
         ws.offsets.clear();
@@ -775,22 +802,7 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
         ws.gaps.clear();
         let mut worst: Option<(usize, T)> = None;
         for i in 0..ws.m {
-            ws.scratch_n.clear();
-            ws.scratch_t.clear();
-            let mut jac = Jacobian {
-                normal: &mut ws.scratch_n,
-                tangent: &mut ws.scratch_t,
-                dofs: n,
-                out_of_range: None,
-            };
-            let gap = self.contacts.evaluate(i, t, q, &mut jac).gap;
-            if let Some(dof) = jac.out_of_range {
-                return Err(TimeStepError::Dimension {
-                    what: "contact Jacobian index",
-                    got: dof,
-                    expected: n,
-                });
-            }
+            let gap = evaluate_contact(&self.contacts, ws, i, t, q)?.gap;
             if !gap.is_finite() {
                 return Err(TimeStepError::NonFinite {
                     step: k,
@@ -862,7 +874,6 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
     /// pre-step rates and Jacobian rows (normal, tangent) into the workspace; an inactive
     /// contact's warm start is cleared.
     fn activate(&mut self, k: usize, ta: T, h: T, q: &[T], v: &[T]) -> Result<(), TimeStepError> {
-        let n = self.ws.n;
         let ws = &mut self.ws;
         let threshold = match self.threshold {
             Some(d) => d,
@@ -879,22 +890,7 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
         ws.pre.clear();
         ws.records.clear();
         for i in 0..ws.m {
-            ws.scratch_n.clear();
-            ws.scratch_t.clear();
-            let mut jac = Jacobian {
-                normal: &mut ws.scratch_n,
-                tangent: &mut ws.scratch_t,
-                dofs: n,
-                out_of_range: None,
-            };
-            let geo = self.contacts.evaluate(i, ta, q, &mut jac);
-            if let Some(dof) = jac.out_of_range {
-                return Err(TimeStepError::Dimension {
-                    what: "contact Jacobian index",
-                    got: dof,
-                    expected: n,
-                });
-            }
+            let geo = evaluate_contact(&self.contacts, ws, i, ta, q)?;
             let drift = self.contacts.drift(i, ta, q);
             let mut un = drift[0];
             for &(j, x) in ws.scratch_n.iter() {
