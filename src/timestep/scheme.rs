@@ -765,8 +765,11 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
             ws.q.extend_from_slice(&ws.gaps);
             ws.p.clear();
             ws.p.resize(act, T::zero());
-            let solver = &mut self.projection.as_mut().expect("checked above").solver;
-            solver
+            let Some(projection) = self.projection.as_mut() else {
+                return Ok(());
+            };
+            projection
+                .solver
                 .solve(&ws.w[..act * act], &ws.q, &mut ws.p)
                 .map_err(|source| TimeStepError::Contact {
                     step: k,
