@@ -46,6 +46,10 @@ impl<const M: usize> Observer<f64, M> for Events<M> {
             .push((e.t.to_bits(), bits(&e.y), e.y_after.as_ref().map(bits)));
         Control::Continue
     }
+    /// Events only: the lanes' quiet steps skip the scalar event search.
+    fn wants_steps(&self) -> bool {
+        false
+    }
 }
 
 /// A trajectory's result, comparable bit for bit (errors by their message).

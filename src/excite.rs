@@ -7,7 +7,7 @@
 use crate::Real;
 use crate::fastmath;
 use crate::lanes::{LaneMath, Lanes};
-use crate::scalar::lit;
+use crate::scalar::{lit, to_f64};
 use crate::validate::ParameterError;
 use crate::validate::{finite, non_negative, positive};
 
@@ -92,6 +92,23 @@ pub trait Excitation<T: Real> {
             (h.is_finite() && h > T::zero()).then_some(h)
         })
     }
+
+    /// The force and its rate `(f(t), ḟ(t))` at `L` times at once, one per lane, if the
+    /// excitation has a lane form (`None`, the default, if not). Each lane must be
+    /// [`force`](Excitation::force) and [`force_rate`](Excitation::force_rate) at that
+    /// lane's time to the bit. The ensemble uses it for an event surface that moves as
+    /// this excitation (a [`Gap`](crate::event::Gap) on a vibrating table), shared by all
+    /// lanes: with it, the events of a step are evaluated in the lanes, and a lane goes to
+    /// the scalar event search only when its step may hold an event; without it, every
+    /// step is searched lane by lane (the same results, more time). Implemented by `()`,
+    /// [`Constant`], [`Harmonic`] and [`UnbalancedRotor`] in `f64`.
+    #[inline(always)]
+    fn motion_lanes<V: Lanes>(&self, _t: V) -> Option<(V, V)>
+    where
+        Self: Sized,
+    {
+        None
+    }
 }
 
 /// The central difference `(f(t₊) − f(t₋))/(t₊ − t₋)` at `t± = t ± h`, `h = ε^{1/3}·s`, where
@@ -145,6 +162,10 @@ impl<T: Real> Excitation<T> for () {
         T::zero()
     }
     #[inline(always)]
+    fn motion_lanes<V: Lanes>(&self, _t: V) -> Option<(V, V)> {
+        Some((V::splat(0.0), V::splat(0.0)))
+    }
+    #[inline(always)]
     fn force_rate(&self, _t: T) -> T {
         T::zero()
     }
@@ -188,6 +209,10 @@ impl<T: Real> Excitation<T> for Constant<T> {
     #[inline(always)]
     fn force(&self, _t: T) -> T {
         self.value
+    }
+    #[inline(always)]
+    fn motion_lanes<V: Lanes>(&self, _t: V) -> Option<(V, V)> {
+        fastmath::is_f64::<T>().then(|| (V::splat(to_f64(self.value)), V::splat(0.0)))
     }
     #[inline(always)]
     fn force_rate(&self, _t: T) -> T {
@@ -299,6 +324,18 @@ impl<T: Real> Excitation<T> for Harmonic<T> {
     fn force_rate(&self, t: T) -> T {
         self.amplitude * self.omega * fastmath::cos(saturate(self.omega * t + self.phase0))
     }
+    #[inline(always)]
+    fn motion_lanes<V: Lanes>(&self, t: V) -> Option<(V, V)> {
+        if !fastmath::is_f64::<T>() {
+            return None;
+        }
+        let [a, w, p] = [self.amplitude, self.omega, self.phase0].map(|x| V::splat(to_f64(x)));
+        let phase = saturate_lanes(w * t + p);
+        Some((
+            a * crate::lanes::math::sin(phase),
+            a * w * crate::lanes::math::cos(phase),
+        ))
+    }
     fn force_acceleration(&self, t: T) -> T {
         -self.amplitude * self.omega * self.omega * fastmath::sin(self.omega * t + self.phase0)
     }
@@ -387,6 +424,18 @@ impl<T: Real> Excitation<T> for UnbalancedRotor<T> {
     #[inline(always)]
     fn force_rate(&self, t: T) -> T {
         self.amp * self.omega * fastmath::cos(saturate(self.omega * t))
+    }
+    #[inline(always)]
+    fn motion_lanes<V: Lanes>(&self, t: V) -> Option<(V, V)> {
+        if !fastmath::is_f64::<T>() {
+            return None;
+        }
+        let [a, w] = [self.amp, self.omega].map(|x| V::splat(to_f64(x)));
+        let phase = saturate_lanes(w * t);
+        Some((
+            a * crate::lanes::math::sin(phase),
+            a * w * crate::lanes::math::cos(phase),
+        ))
     }
     fn force_acceleration(&self, t: T) -> T {
         -self.amp * self.omega * self.omega * fastmath::sin(self.omega * t)

@@ -37,8 +37,9 @@ use core::any::TypeId;
 use crate::Real;
 use crate::scalar::{lit, to_f64};
 
+/// Whether `T` is `f64` (the fast kernels and the lane forms apply).
 #[inline(always)]
-fn is_f64<T: Real>() -> bool {
+pub(crate) fn is_f64<T: Real>() -> bool {
     TypeId::of::<T>() == TypeId::of::<f64>()
 }
 

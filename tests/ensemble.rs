@@ -460,7 +460,7 @@ fn lcg(n: usize) -> impl Iterator<Item = f64> {
 }
 
 #[test]
-fn lane_sin_is_the_scalar_kernel_to_the_bit() {
+fn lane_sin_and_cos_are_the_scalar_kernels_to_the_bit() {
     let mut xs: Vec<f64> = lcg(40_000)
         .flat_map(|u| [u * 8.0 - 4.0, (u - 0.5) * 1.1e6, u * 2e4, (u - 0.5) * 1e-8])
         .collect();
@@ -477,13 +477,17 @@ fn lane_sin_is_the_scalar_kernel_to_the_bit() {
     ]);
     for c in xs.chunks(4) {
         let v = F64x4::load(c);
-        let s = math::sin(v);
+        let (s, co) = (math::sin(v), math::cos(v));
         for (i, &x) in c.iter().enumerate() {
-            let want = nonsmooth::util::sin_f64(x);
-            let got = s.lane(i);
+            let (want, want_cos) = (nonsmooth::util::sin_f64(x), nonsmooth::util::cos_f64(x));
+            let (got, got_cos) = (s.lane(i), co.lane(i));
             assert!(
                 got.to_bits() == want.to_bits() || (got.is_nan() && want.is_nan()),
                 "sin({x}): {got} vs {want}"
+            );
+            assert!(
+                got_cos.to_bits() == want_cos.to_bits() || (got_cos.is_nan() && want_cos.is_nan()),
+                "cos({x}): {got_cos} vs {want_cos}"
             );
         }
     }
@@ -749,4 +753,189 @@ fn terminal_and_restarting_events_match_the_driver() {
             }
         }
     }
+}
+
+/// Every event of a run, to the bit (time, state, state after the reset), and nothing
+/// else: it does not want steps, so the ensemble skips the scalar event search of the
+/// lanes' quiet steps.
+#[derive(Debug, Clone, Default, PartialEq)]
+struct EventsOnly<const M: usize>(Vec<(u64, [u64; M], Option<[u64; M]>)>);
+
+impl<const M: usize> Observer<f64, M> for EventsOnly<M> {
+    fn on_event(&mut self, e: &EventRecord<f64, M>) -> Control {
+        let bits = |y: &nalgebra::SVector<f64, M>| core::array::from_fn(|i| y[i].to_bits());
+        self.0
+            .push((e.t.to_bits(), bits(&e.y), e.y_after.as_ref().map(bits)));
+        Control::Continue
+    }
+    fn wants_steps(&self) -> bool {
+        false
+    }
+}
+
+/// The ensemble against the driver, both with an observer that does not want steps:
+/// outcomes, statistics and every event record equal to the bit.
+fn same_as_driver<D, E, const M: usize>(jobs: &[MemberRun<D, M>], tol: Tolerances<f64, M>, ev: E)
+where
+    D: nonsmooth::LaneDynamics<M>,
+    E: nonsmooth::event::EventSet<f64, M> + Clone,
+{
+    let ens = Ensemble::new(tol).unwrap().with_events(ev.clone()).unwrap();
+    let mut lanes = vec![EventsOnly::<M>::default(); jobs.len()];
+    let out = ens.run::<F64x4, _, _>(jobs, &mut lanes).unwrap();
+    let mut events = 0;
+    for ((j, o), rec) in jobs.iter().zip(&out).zip(&lanes) {
+        let mut want_rec = EventsOnly::<M>::default();
+        let want = Simulation::new(j.member.clone(), Dopri5::new(tol))
+            .with_events(ev.clone())
+            .landing_grid(j.grid)
+            .unwrap()
+            .run(j.t0, j.y0, j.t_end, &mut want_rec);
+        match (o, want) {
+            (Ok(o), Ok(w)) => {
+                assert_eq!((o.t, o.y, o.stats), (w.t, w.y, w.stats));
+                assert_eq!(o.termination, w.termination);
+            }
+            (Err(a), Err(b)) => assert_eq!(a.to_string(), b.to_string()),
+            (a, b) => panic!("lanes {a:?}, driver {b:?}"),
+        }
+        assert_eq!(rec, &want_rec);
+        events += rec.0.len();
+    }
+    assert!(events > 10 * jobs.len(), "{events} events");
+}
+
+#[test]
+fn quiet_steps_skipped_in_lanes_keep_every_event() {
+    use nalgebra::SVector;
+    use nonsmooth::systems::{BouncingBallTable, TwoDofImpact};
+    use nonsmooth::testing::HarmonicOscillator;
+    // The ball on the vibrating table: restitution on a moving surface (a `Gap` on a
+    // harmonic motion), events evaluated in the lanes at every step end.
+    let base = BouncingBallTable::with_gamma(3.0, 0.8).unwrap();
+    let jobs: Vec<_> = (0..12)
+        .map(|i| {
+            let gamma = 2.5 + 0.125 * i as f64;
+            let ball = BouncingBallTable {
+                g: base.amplitude * base.omega * base.omega / gamma,
+                ..base
+            };
+            let v0 = ball.table_motion(0.0).1 + 2.0;
+            MemberRun::<_, 2>::periods_of(
+                ball.model::<f64>().unwrap(),
+                SVector::from([0.0, v0]),
+                ball.period(),
+                25.0,
+            )
+            .unwrap()
+        })
+        .collect();
+    let impact = Event::new(base.table::<f64>().unwrap(), Direction::Rising)
+        .with_reset(base.impact::<f64>().unwrap());
+    same_as_driver(&jobs, Tolerances::new(1e-10, 1e-12).unwrap(), impact);
+    // The 2-DOF impact system: its stop on the relative coordinate, with a level crossing
+    // of the first mass in both directions (two events, one of them grazing often).
+    let p = TwoDofImpact::default();
+    let jobs: Vec<_> = (0..10)
+        .map(|i| {
+            let w = 0.4 + 0.09 * i as f64;
+            MemberRun::<_, 4>::periods_of(
+                p.model::<f64>(w).unwrap(),
+                SVector::zeros(),
+                TwoDofImpact::period(w),
+                15.0,
+            )
+            .unwrap()
+        })
+        .collect();
+    let events = (
+        Event::new(p.stop::<f64>().unwrap(), Direction::Rising),
+        Event::new(Level::new(0, 0.0).unwrap(), Direction::Either),
+    );
+    same_as_driver(&jobs, Tolerances::new(1e-8, 1e-10).unwrap(), events);
+    // Grazing pairs: x = cos ωt against the level 0.9999, crossed twice within
+    // 2·acos(0.9999)/ω ≈ 0.028/ω of every maximum, inside one step at this tolerance (the
+    // rates at the step's ends show the pair).
+    let jobs: Vec<_> = (0..8)
+        .map(|i| {
+            let w = 1.0 + 0.3 * i as f64;
+            let osc = nonsmooth::LaneByLane(HarmonicOscillator::new(w).unwrap());
+            MemberRun::new(osc, 0.0, SVector::from([1.0, 0.0]), 40.0).unwrap()
+        })
+        .collect();
+    let graze = Event::new(Level::new(0, 0.9999).unwrap(), Direction::Either);
+    same_as_driver(&jobs, Tolerances::new(1e-6, 1e-8).unwrap(), graze);
+}
+
+#[test]
+fn lane_forms_of_events_and_motions_are_the_scalar_ones_to_the_bit() {
+    use nalgebra::SVector;
+    use nonsmooth::event::{EventFunction, Gap};
+    use nonsmooth::excite::{Constant, Excitation, Harmonic, UnbalancedRotor};
+    use nonsmooth::model::Coordinate;
+    let same = |a: f64, b: f64| a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan());
+    let pts: Vec<f64> = lcg(4 * 2000).map(|u| (u - 0.5) * 40.0).collect();
+    fn motion<S: Excitation<f64>>(s: &S, ts: &[f64], same: impl Fn(f64, f64) -> bool) {
+        for c in ts.chunks(8) {
+            let (f, df) = s.motion_lanes(F64x8::load(c)).unwrap();
+            for (i, &t) in c.iter().enumerate() {
+                assert!(same(f.lane(i), s.force(t)), "f({t})");
+                assert!(same(df.lane(i), s.force_rate(t)), "df({t})");
+            }
+        }
+    }
+    motion(&Harmonic::new(0.7, 3.3, 0.4).unwrap(), &pts, same);
+    motion(&UnbalancedRotor::new(0.018, 20.465).unwrap(), &pts, same);
+    motion(&Constant::new(-9.81).unwrap(), &pts, same);
+    motion(&(), &pts, same);
+    // Level, Stop, and gaps of every coordinate shape on a moving and a fixed surface.
+    fn check<G: EventFunction<f64, 4>>(g: &G, pts: &[f64], same: impl Fn(f64, f64) -> bool) {
+        for c in pts.chunks(4 * 9).filter(|c| c.len() == 36) {
+            let t = F64x4::load(&c[0..4]);
+            let y: [F64x4; 4] = core::array::from_fn(|k| F64x4::load(&c[4 + 4 * k..]));
+            let dy: [F64x4; 4] = core::array::from_fn(|k| F64x4::load(&c[20 + 4 * k..]));
+            let (v, r) = g.lanes(t, &y, &dy).unwrap();
+            for i in 0..4 {
+                let ys = SVector::<f64, 4>::from_fn(|k, _| y[k].lane(i));
+                let dys = SVector::<f64, 4>::from_fn(|k, _| dy[k].lane(i));
+                assert!(same(v.lane(i), g.value(t.lane(i), &ys)));
+                let want = g.rate(t.lane(i), &ys, &dys);
+                assert_eq!(r.is_some(), want.is_some());
+                if let (Some(r), Some(w)) = (r, want) {
+                    assert!(same(r.lane(i), w));
+                }
+            }
+        }
+    }
+    check(&Level::new(2, 0.3).unwrap(), &pts, same);
+    let stop = Stop {
+        position: 1,
+        velocity: 3,
+        level: -0.2,
+    };
+    check(&stop, &pts, same);
+    let surf = Harmonic::new(0.1, 5.0, 0.2).unwrap();
+    let shapes = [
+        Coordinate::dof(1).unwrap(),
+        Coordinate::dof(0).unwrap().with_offset(0.25).unwrap(),
+        Coordinate::relative(1, 0).unwrap(),
+        Coordinate::relative(0, 1)
+            .unwrap()
+            .with_offset(-0.5)
+            .unwrap(),
+        Coordinate::linear([0.3, -1.7])
+            .unwrap()
+            .with_offset(0.1)
+            .unwrap(),
+    ];
+    for c in shapes {
+        check(&Gap::below(c, surf), &pts, same);
+        check(&Gap::above(c, ()), &pts, same);
+    }
+    // An index outside the state has no lane form (the scalar value is NaN).
+    let y = [F64x4::splat(0.0); 4];
+    assert!(
+        EventFunction::<f64, 4>::lanes(&Level::new(7, 0.0).unwrap(), F64x4::splat(0.0), &y, &y)
+            .is_none()
+    );
 }

@@ -171,6 +171,15 @@ pub trait Observer<T: Real, const N: usize> {
         Control::Continue
     }
 
+    /// Whether [`on_step`](Observer::on_step) does anything (default `true`). An observer
+    /// that only reads events and the outcome may return `false`; the ensemble
+    /// ([`Ensemble`](crate::ensemble::Ensemble)) then need not build a lane's step for it
+    /// where the step holds no event. `on_step` must then be a no-op returning
+    /// [`Control::Continue`]: the drivers may still call it.
+    fn wants_steps(&self) -> bool {
+        true
+    }
+
     /// Called for each located event, after the step part that leads to it.
     fn on_event(&mut self, _event: &EventRecord<T, N>) -> Control {
         Control::Continue
@@ -186,7 +195,11 @@ pub trait Observer<T: Real, const N: usize> {
     fn on_finish(&mut self, _outcome: &Outcome<T, N>) {}
 }
 
-impl<T: Real, const N: usize> Observer<T, N> for () {}
+impl<T: Real, const N: usize> Observer<T, N> for () {
+    fn wants_steps(&self) -> bool {
+        false
+    }
+}
 
 impl<T: Real, const N: usize, O: Observer<T, N> + ?Sized> Observer<T, N> for &mut O {
     fn check(&self) -> Result<()> {
@@ -201,6 +214,9 @@ impl<T: Real, const N: usize, O: Observer<T, N> + ?Sized> Observer<T, N> for &mu
     #[inline(always)]
     fn on_step<D: DenseOutput<T, N>>(&mut self, step: &StepView<'_, T, N, D>) -> Control {
         (**self).on_step(step)
+    }
+    fn wants_steps(&self) -> bool {
+        (**self).wants_steps()
     }
     fn on_event(&mut self, event: &EventRecord<T, N>) -> Control {
         (**self).on_event(event)
@@ -232,6 +248,9 @@ macro_rules! observer_tuple {
                 let mut c = Control::Continue;
                 $(if self.$idx.on_step(step) == Control::Stop { c = Control::Stop; })+
                 c
+            }
+            fn wants_steps(&self) -> bool {
+                false $(|| self.$idx.wants_steps())+
             }
             fn on_event(&mut self, event: &EventRecord<T, N>) -> Control {
                 let mut c = Control::Continue;
@@ -272,6 +291,9 @@ impl<T: Real, const N: usize, O: Observer<T, N>> Observer<T, N> for Option<O> {
             Some(o) => o.on_step(step),
             None => Control::Continue,
         }
+    }
+    fn wants_steps(&self) -> bool {
+        self.as_ref().is_some_and(|o| o.wants_steps())
     }
     fn on_event(&mut self, event: &EventRecord<T, N>) -> Control {
         match self {

@@ -520,6 +520,72 @@ pub(crate) struct Sides {
     pub(crate) armed: [bool; MAX_EVENTS],
 }
 
+impl Sides {
+    /// Whether [`Scan::scan_step`] would find nothing in a step where event `i` goes from
+    /// `g0` to `g1` with rates `r0`, `r1` at the ends (the event's own values): both ends
+    /// finite and on one side of the surface, a known side, no interior samples, no
+    /// grazing pair in the rates (one end moving towards the surface and the other away),
+    /// and no sticking (the conditions of `start_scan`, `crossing_between` and
+    /// `check_sticking`, in which any doubt means "not quiet"). The scan of such a step
+    /// only moves the side to the sign of `g1` ([`quiet_step`](Self::quiet_step)); the
+    /// ensemble skips it where every event's step is quiet.
+    #[inline(always)]
+    pub(crate) fn is_quiet<T: Real, const N: usize, E: EventSet<T, N>>(
+        &self,
+        events: &E,
+        i: usize,
+        (g0, g1): (T, T),
+        (r0, r1): (Option<T>, Option<T>),
+    ) -> bool {
+        if !(g0.is_finite() && g1.is_finite())
+            || g0 == T::zero()
+            || g1 == T::zero()
+            || self.side[i] == 0
+            || events.interior_samples(i) > 0
+        {
+            return false;
+        }
+        let s = sign_of(g0);
+        if sign_of(g1) != s {
+            return false;
+        }
+        let positive = s > 0;
+        let towards = |r: T| {
+            if positive {
+                r < T::zero()
+            } else {
+                r > T::zero()
+            }
+        };
+        let away = |r: T| {
+            if positive {
+                r > T::zero()
+            } else {
+                r < T::zero()
+            }
+        };
+        if let (Some(r0), Some(r1)) = (r0, r1) {
+            if towards(r0) && away(r1) {
+                return false;
+            }
+        }
+        let wrong_side = match events.direction(i) {
+            Direction::Rising => 1,
+            Direction::Falling => -1,
+            Direction::Either => 0,
+        };
+        let stuck = !self.armed[i] || (events.resets(i) && s == wrong_side);
+        !(stuck && r1.is_some_and(|r| r != T::zero() && sign_of(r) == s))
+    }
+
+    /// What the scan of a quiet step ([`is_quiet`](Self::is_quiet)) does to event `i`:
+    /// its side becomes the sign of `g1 ≠ 0`.
+    #[inline(always)]
+    pub(crate) fn quiet_step<T: Real>(&mut self, i: usize, g1: T) {
+        self.side[i] = sign_of(g1);
+    }
+}
+
 /// One step's event data: its ends, each event's value and rate at the end, and the next
 /// crossing found for each (cached while earlier crossings are handled).
 #[derive(Debug, Clone, Copy)]

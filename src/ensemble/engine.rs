@@ -445,6 +445,9 @@ struct Engine<'a, V: Lanes, E, D: LaneDynamics<M>, const M: usize> {
     /// stays at the fast end.
     st: Box<LaneState<V, D, M>>,
     consts: StepConsts<M>,
+    /// Each event's value at the end of each lane's quiet step
+    /// ([`quiet_lanes`](Self::quiet_lanes)).
+    quiet_ends: [[f64; 16]; MAX_EVENTS],
 }
 
 /// The lanes whose bit is set in `mask`, in increasing order.
@@ -489,6 +492,7 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
                 active: z,
             }),
             consts: StepConsts::new(&cfg.tol, &cfg.opts, cfg.math, cfg.simd),
+            quiet_ends: [[0.0; 16]; MAX_EVENTS],
         }
     }
 
@@ -659,9 +663,14 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
                     }
                 }
             }
+            let quiet = self.quiet_lanes(&step.buf, step.accepted, observers);
             for i in lanes_of(step.accepted) {
-                let dense = LaneDense::<M>::from_rows(&step.buf, i);
-                self.after_step(i, &dense, observers, out);
+                if quiet & (1 << i) != 0 {
+                    self.after_quiet_step(i, &step.buf);
+                } else {
+                    let dense = LaneDense::<M>::from_rows(&step.buf, i);
+                    self.after_step(i, &dense, observers, out);
+                }
             }
         }
     }
@@ -715,6 +724,7 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
             slots,
             st: half,
             consts: self.consts,
+            quiet_ends: self.quiet_ends,
         }
     }
 
@@ -781,24 +791,108 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
                     };
                     self.finish(i, Err(e.into()), observers, out);
                 } else {
-                    // The driver computes the next limit after every step. Without a time
-                    // scale and short of the current limit (by more than the rounding of
-                    // that computation) it is the current one again, so it is then only
-                    // recomputed near or on it, or after a restart.
-                    let limit = self.st.limit.lane(i);
-                    let scale = t.abs() + slot.grid.map_or(0.0, |(o, dt)| o.abs() + dt);
-                    if slot.scaled || restart.is_some() || limit - t <= 64.0 * f64::EPSILON * scale
-                    {
-                        let bound = match (&slot.member, slot.scaled) {
-                            (Some(m), true) => time_scale(m, &cfg.events, t),
-                            _ => None,
-                        };
-                        let l = step_limit(t, slot.t_end, slot.grid, bound);
-                        self.st.limit = self.st.limit.with_lane(i, l);
-                    }
+                    self.update_limit(i, t, restart.is_some());
                 }
             }
         }
+    }
+
+    /// The next step limit of lane `i`, now at `t` (after a restart if `restarted`).
+    #[inline(always)]
+    fn update_limit(&mut self, i: usize, t: f64, restarted: bool) {
+        // The driver computes the next limit after every step. Without a time scale and
+        // short of the current limit (by more than the rounding of that computation) it
+        // is the current one again, so it is then only recomputed near or on it, or after
+        // a restart.
+        let slot = &self.slots[i];
+        let limit = self.st.limit.lane(i);
+        let scale = t.abs() + slot.grid.map_or(0.0, |(o, dt)| o.abs() + dt);
+        if slot.scaled || restarted || limit - t <= 64.0 * f64::EPSILON * scale {
+            let bound = match (&slot.member, slot.scaled) {
+                (Some(m), true) => time_scale(m, &self.cfg.events, t),
+                _ => None,
+            };
+            let l = step_limit(t, slot.t_end, slot.grid, bound);
+            self.st.limit = self.st.limit.with_lane(i, l);
+        }
+    }
+
+    /// The accepted lanes whose step the driver's event handling would pass through
+    /// without doing anything but moving the events' sides: every event's step is quiet
+    /// ([`Sides::is_quiet`], from the events' lane forms evaluated at both ends of every
+    /// lane's step at once), the observer does not want steps
+    /// ([`Observer::wants_steps`]), and the trajectory does not end with this step. Empty
+    /// if an event has no lane form.
+    fn quiet_lanes<O: Observer<f64, M>>(
+        &mut self,
+        buf: &[[f64; 16]],
+        accepted: u32,
+        observers: &[O],
+    ) -> u32 {
+        let mut quiet = 0;
+        for i in lanes_of(accepted) {
+            let slot = &self.slots[i];
+            let ends = buf[row::T1][i] >= slot.t_end || slot.steps + 1 >= self.cfg.max_steps;
+            if let (Some(j), false) = (slot.job, ends) {
+                if !observers[j].wants_steps() {
+                    quiet |= 1 << i;
+                }
+            }
+        }
+        if quiet == 0 || E::LEN == 0 {
+            return quiet;
+        }
+        let load = |r: usize| V::load(&buf[r]);
+        let vector = |q: usize| -> [V; M] { core::array::from_fn(|c| load(row::vector(q, M) + c)) };
+        let (t0, t1) = (load(row::T0), load(row::T1));
+        let (y0, y1, f0, f1) = (
+            vector(row::X0),
+            vector(row::X1),
+            vector(row::F0),
+            vector(row::F1),
+        );
+        for e in 0..E::LEN {
+            let (Some((g0, r0)), Some((g1, r1))) = (
+                self.cfg.events.lanes(e, t0, &y0, &f0),
+                self.cfg.events.lanes(e, t1, &y1, &f1),
+            ) else {
+                return 0;
+            };
+            for i in lanes_of(quiet) {
+                let Some(sides) = &self.slots[i].sides else {
+                    quiet &= !(1 << i);
+                    continue;
+                };
+                let g = (g0.lane(i), g1.lane(i));
+                let r = (r0.map(|r| r.lane(i)), r1.map(|r| r.lane(i)));
+                if sides.is_quiet(&self.cfg.events, e, g, r) {
+                    self.quiet_ends[e][i] = g.1;
+                } else {
+                    quiet &= !(1 << i);
+                }
+            }
+            if quiet == 0 {
+                return 0;
+            }
+        }
+        quiet
+    }
+
+    /// A lane's accepted quiet step ([`quiet_lanes`](Self::quiet_lanes)): what
+    /// [`after_step`](Self::after_step) does for it, without building the step.
+    fn after_quiet_step(&mut self, i: usize, buf: &[[f64; 16]]) {
+        let slot = &mut self.slots[i];
+        slot.stats.rhs_evals += 6;
+        slot.stats.accepted += 1;
+        slot.steps += 1;
+        slot.nonfinite = 0;
+        let t1 = buf[row::T1][i];
+        if let Some(sides) = &mut slot.sides {
+            for (e, g1) in self.quiet_ends.iter().enumerate().take(E::LEN) {
+                sides.quiet_step(e, g1[i]);
+            }
+        }
+        self.update_limit(i, t1, false);
     }
 }
 

@@ -5,6 +5,7 @@ use nalgebra::SVector;
 
 use super::error::EventError;
 use crate::Real;
+use crate::lanes::Lanes;
 
 /// A scalar function `g(t, y)` whose zeros are events.
 ///
@@ -43,6 +44,24 @@ pub trait EventFunction<T: Real, const N: usize> {
     /// [`EventError::IndexOutOfRange`] for an index `≥ N`.
     fn check(&self) -> Result<(), EventError> {
         Ok(())
+    }
+
+    /// The lane form: [`value`](EventFunction::value) and [`rate`](EventFunction::rate) at
+    /// `L` points `(t, y, dy)` at once, one per lane, each lane equal to the scalar
+    /// functions at that lane's point to the bit (the rate `None` exactly where `rate` is
+    /// `None`). `None` (the default) if the function has none. The ensemble
+    /// ([`Ensemble`](crate::ensemble::Ensemble)) evaluates its events at both ends of every
+    /// lane's step with it and searches a step lane by lane only where it may hold an
+    /// event (the driver's own conditions); without it, every step is searched lane by
+    /// lane: the same results, more time. Implemented by [`Level`](super::Level),
+    /// [`Stop`](super::Stop) and [`Gap`](super::Gap) (on a surface whose motion has
+    /// [`Excitation::motion_lanes`](crate::excite::Excitation::motion_lanes)) in `f64`.
+    #[inline(always)]
+    fn lanes<V: Lanes>(&self, _t: V, _y: &[V; N], _dy: &[V; N]) -> Option<(V, Option<V>)>
+    where
+        Self: Sized,
+    {
+        None
     }
 }
 

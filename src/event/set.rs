@@ -8,6 +8,7 @@ use super::error::EventError;
 use super::function::EventFunction;
 use super::reset::ResetMap;
 use crate::Real;
+use crate::lanes::Lanes;
 use crate::scalar::lit;
 use crate::validate::ParameterError;
 
@@ -145,6 +146,15 @@ pub trait EventSet<T: Real, const N: usize> {
     fn max_step(&self, _t: T) -> Option<T> {
         None
     }
+    /// Event `i`'s value and rate at `L` points at once, one per lane (its function's
+    /// [`EventFunction::lanes`]), or `None` if its function has no lane form.
+    #[inline(always)]
+    fn lanes<V: Lanes>(&self, _i: usize, _t: V, _y: &[V; N], _dy: &[V; N]) -> Option<(V, Option<V>)>
+    where
+        Self: Sized,
+    {
+        None
+    }
 }
 
 #[inline(always)]
@@ -221,6 +231,10 @@ impl<T: Real, const N: usize, G: EventFunction<T, N>, R: ResetMap<T, N>> EventSe
     fn max_step(&self, t: T) -> Option<T> {
         min_option(self.function.time_scale(t), self.max_step.map(lit))
     }
+    #[inline(always)]
+    fn lanes<V: Lanes>(&self, _i: usize, t: V, y: &[V; N], dy: &[V; N]) -> Option<(V, Option<V>)> {
+        self.function.lanes(t, y, dy)
+    }
 }
 
 /// Dispatches flat index `$i` to the member that holds it (members are visited in order;
@@ -273,6 +287,16 @@ macro_rules! event_tuple {
             fn check(&self) -> Result<(), EventError> {
                 $(self.$idx.check()?;)+
                 Ok(())
+            }
+            #[inline(always)]
+            fn lanes<V: Lanes>(
+                &self,
+                i: usize,
+                t: V,
+                y: &[V; N],
+                dy: &[V; N],
+            ) -> Option<(V, Option<V>)> {
+                dispatch!(self, i, None, |m, j| m.lanes(j, t, y, dy); $($name $idx),+)
             }
             #[inline(always)]
             fn max_step(&self, t: T) -> Option<T> {

@@ -6,7 +6,9 @@ use nalgebra::SVector;
 use super::error::EventError;
 use super::function::{EventFunction, check_index};
 use crate::Real;
+use crate::lanes::Lanes;
 use crate::model::Coordinate;
+use crate::scalar::to_f64;
 use crate::validate::ParameterError;
 
 /// The hyperplane `g = y[index] − level` (e.g. the stop `x = x_I`), with rate `ẏ[index]`.
@@ -66,6 +68,10 @@ impl<T: Real, const N: usize> EventFunction<T, N> for Level<T> {
     fn check(&self) -> Result<(), EventError> {
         check_index(self.index, N)
     }
+    #[inline(always)]
+    fn lanes<V: Lanes>(&self, _t: V, y: &[V; N], dy: &[V; N]) -> Option<(V, Option<V>)> {
+        component_lanes::<T, V, N>(self.index, self.level, y, dy)
+    }
 }
 
 /// A one-sided stop `y[position] = level` with `y[velocity]` the position's rate: the
@@ -98,6 +104,10 @@ impl<T: Real, const N: usize> EventFunction<T, N> for Stop<T> {
     fn rate(&self, _t: T, _y: &SVector<T, N>, dy: &SVector<T, N>) -> Option<T> {
         dy.get(self.position).copied()
     }
+    #[inline(always)]
+    fn lanes<V: Lanes>(&self, _t: V, y: &[V; N], dy: &[V; N]) -> Option<(V, Option<V>)> {
+        component_lanes::<T, V, N>(self.position, self.level, y, dy)
+    }
     fn check(&self) -> Result<(), EventError> {
         check_index(self.position, N)?;
         check_index(self.velocity, N)?;
@@ -110,6 +120,24 @@ impl<T: Real, const N: usize> EventFunction<T, N> for Stop<T> {
         }
         Ok(())
     }
+}
+
+/// The lane form of `g = y[index] − level`, `ġ = ẏ[index]` (`T = f64` only; `None` for an
+/// index outside the state, where the scalar value is NaN).
+#[inline(always)]
+fn component_lanes<T: Real, V: Lanes, const N: usize>(
+    index: usize,
+    level: T,
+    y: &[V; N],
+    dy: &[V; N],
+) -> Option<(V, Option<V>)> {
+    if !crate::fastmath::is_f64::<T>() {
+        return None;
+    }
+    Some((
+        *y.get(index)? - V::splat(to_f64(level)),
+        Some(*dy.get(index)?),
+    ))
 }
 
 /// A contact surface of an `N`-DOF mechanical system with state `y = (q, q̇)` (dimension
@@ -206,6 +234,16 @@ impl<T: Real, const N: usize, const M: usize, S: crate::excite::Excitation<T>> E
     /// harmonic surface: sixteen steps per surface period at least).
     fn time_scale(&self, t: T) -> Option<T> {
         self.motion.time_scale(t)
+    }
+    #[inline(always)]
+    fn lanes<V: Lanes>(&self, t: V, y: &[V; M], _dy: &[V; M]) -> Option<(V, Option<V>)> {
+        if M != 2 * N || !crate::fastmath::is_f64::<T>() {
+            return None;
+        }
+        let (s, ds) = self.motion.motion_lanes(t)?;
+        let sign = V::splat(to_f64(self.sign));
+        let (c, w) = self.coordinate.lanes(&y[..N], &y[N..]);
+        Some((sign * (c - s), Some(sign * (w - ds))))
     }
     fn check(&self) -> Result<(), EventError> {
         if M != 2 * N {

@@ -1,4 +1,5 @@
-//! Lane forms of the math functions of the built-in parts: `sin` of the forcing, `exp` and
+//! Lane forms of the math functions of the built-in parts: `sin` and `cos` of the forcing and
+//! of moving surfaces, `exp` and
 //! `ln` of the contact law's exponents and of the step-size controller.
 //!
 //! # `sin`
@@ -80,19 +81,28 @@ fn kcos<V: Lanes>(r: V) -> V {
     w + (((s(1.0) - w) - hz) + z * p)
 }
 
+/// `x = k·π/2 + r` in every lane: `(r, q)` with `q = k − 4·round(k/4) ∈ {−2, …, 2}`
+/// (the scalar reduction's `k mod 4`, as an exact integer: `k/4` is exact and rounded with
+/// the same 1.5·2⁵² trick; quadrant 1 is `q = 1`, quadrant 2 is `q = ±2`, quadrant 3 is
+/// `q = −1`).
+#[inline(always)]
+fn reduce_pio2<V: Lanes>(x: V) -> (V, V) {
+    let s = V::splat;
+    let y = x * s(core::f64::consts::FRAC_2_PI) + s(ROUND_MAGIC);
+    let k = y - s(ROUND_MAGIC);
+    let r = (x - k * s(PIO2_HI)) - k * s(PIO2_LO);
+    let q = k - s(4.0) * ((k * s(0.25) + s(ROUND_MAGIC)) - s(ROUND_MAGIC));
+    (r, q)
+}
+
 /// `sin x` in every lane, bit-identical to
 /// [`fastmath::sin_f64`](crate::fastmath::sin_f64) (see the [module docs](self)).
 #[inline(always)]
 pub fn sin<V: Lanes>(x: V) -> V {
     let s = V::splat;
-    let y = x * s(core::f64::consts::FRAC_2_PI) + s(ROUND_MAGIC);
-    let k = y - s(ROUND_MAGIC);
-    let r = (x - k * s(PIO2_HI)) - k * s(PIO2_LO);
-    // k mod 4 from q = k − 4·round(k/4) ∈ {−2, …, 2} (exact: k/4 is exact and rounded
-    // with the same 1.5·2⁵² trick): quadrants 1, 3 are q = ±1, quadrants 2, 3 are
-    // q ∈ {2, −2, −1}.
-    let q = k - s(4.0) * ((k * s(0.25) + s(ROUND_MAGIC)) - s(ROUND_MAGIC));
+    let (r, q) = reduce_pio2(x);
     let (sn, cs) = (ksin(r), kcos(r));
+    // Quadrants 1, 3 take the cosine kernel; quadrants 2, 3 change the sign.
     let odd = q.eq(s(1.0)) | q.eq(s(-1.0));
     let neg = q.ge(s(2.0)) | q.lt(s(0.0));
     let v = odd.select(cs, sn);
@@ -101,6 +111,25 @@ pub fn sin<V: Lanes>(x: V) -> V {
     v = a.lt(s(TINY)).select(x, v);
     let slow = !a.le(s(TRIG_LIMIT));
     patch(v, slow, x, f64::sin)
+}
+
+/// `cos x` in every lane, bit-identical to
+/// [`fastmath::cos_f64`](crate::fastmath::cos_f64) (the reduction and kernels of [`sin`];
+/// `1` for `|x| < 2⁻²⁷`, the platform's `cos` lane by lane outside the kernels' range).
+#[inline(always)]
+pub fn cos<V: Lanes>(x: V) -> V {
+    let s = V::splat;
+    let (r, q) = reduce_pio2(x);
+    let (sn, cs) = (ksin(r), kcos(r));
+    // Quadrants 1, 3 take the sine kernel; quadrants 1, 2 change the sign.
+    let odd = q.eq(s(1.0)) | q.eq(s(-1.0));
+    let neg = q.eq(s(1.0)) | q.eq(s(2.0)) | q.eq(s(-2.0));
+    let v = odd.select(sn, cs);
+    let mut v = neg.select(-v, v);
+    let a = x.abs();
+    v = a.lt(s(TINY)).select(s(1.0), v);
+    let slow = !a.le(s(TRIG_LIMIT));
+    patch(v, slow, x, f64::cos)
 }
 
 /// `e^x` in every lane.

@@ -43,6 +43,9 @@ use crate::{Dynamics, Real};
 struct ResetCount(u64);
 
 impl<T: Real, const N: usize> Observer<T, N> for ResetCount {
+    fn wants_steps(&self) -> bool {
+        false
+    }
     fn on_event(&mut self, e: &EventRecord<T, N>) -> Control {
         if e.y_after.is_some() {
             self.0 += 1;

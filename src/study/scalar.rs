@@ -73,6 +73,9 @@ pub(super) struct ImpactLog {
 }
 
 impl<const M: usize> Observer<f64, M> for ImpactLog {
+    fn wants_steps(&self) -> bool {
+        false
+    }
     fn on_event(&mut self, e: &EventRecord<f64, M>) -> Control {
         if e.direction != Direction::Rising {
             return Control::Continue;

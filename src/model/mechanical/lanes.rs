@@ -16,8 +16,21 @@ use crate::excite::LaneExcitation;
 use crate::force::LaneLaw;
 use crate::lanes::{LaneMath, Lanes};
 
-impl<const N: usize> Coordinate<f64, N> {
-    /// [`combine`](Coordinate::combine) lane-wise, by the same shapes.
+impl<T: crate::Real, const N: usize> Coordinate<T, N> {
+    /// `(c(q), w·q̇)` lane-wise ([`value`](Coordinate::value) and
+    /// [`rate`](Coordinate::rate) of every lane, to the bit for `T = f64`).
+    #[inline(always)]
+    pub(crate) fn lanes<V: Lanes>(&self, q: &[V], qd: &[V]) -> (V, V) {
+        (
+            self.combine_lanes(crate::scalar::to_f64(self.offset), q),
+            self.combine_lanes(0.0, qd),
+        )
+    }
+}
+
+impl<T: crate::Real, const N: usize> Coordinate<T, N> {
+    /// [`combine`](Coordinate::combine) lane-wise, by the same shapes (weights read as
+    /// `f64`).
     #[inline(always)]
     fn combine_lanes<V: Lanes>(&self, start: f64, x: &[V]) -> V {
         let start_v = V::splat(start);
@@ -38,7 +51,7 @@ impl<const N: usize> Coordinate<f64, N> {
             Shape::General => {
                 let mut g = start_v;
                 for (w, v) in self.weights.iter().zip(x) {
-                    g = g + V::splat(*w) * *v;
+                    g = g + V::splat(crate::scalar::to_f64(*w)) * *v;
                 }
                 g
             }
@@ -63,7 +76,7 @@ impl<const N: usize> Coordinate<f64, N> {
             }
             Shape::General => {
                 for k in 0..N {
-                    out[k] = out[k] + V::splat(self.weights[k]) * f;
+                    out[k] = out[k] + V::splat(crate::scalar::to_f64(self.weights[k])) * f;
                 }
             }
         }
