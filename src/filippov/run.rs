@@ -520,6 +520,28 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
     }
 }
 
+/// The bookkeeping of one [`FilippovSimulation::run`].
+struct RunState<T: Real, const N: usize, const S: usize> {
+    mode: Mode<S>,
+    history: EventHistory<T>,
+    transitions: Vec<ModeTransition<T, N, S>>,
+    max_drift: T,
+    steps: usize,
+    stalls: usize,
+}
+
+/// How a step in a mode ended.
+enum StepEnd {
+    /// The mode goes on.
+    Next,
+    /// The run reached its end.
+    End,
+    /// The observer stopped the run.
+    Stopped,
+    /// The mode ends at surface `k` (`S`: the sliding mode's exit).
+    Transition(usize),
+}
+
 impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
     /// Runs from `(t0, x0)` to `t_end` through crossings, sliding and exits, streaming every
     /// step with its mode and every transition to `observer`.
@@ -559,144 +581,43 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
         self.settings.validate()?;
         self.stepper.check()?;
         let start_mode = self.mode_at(t0, &x0)?;
-        let mut mode = start_mode;
         let mut x = x0;
-        if let Some(i) = mode.sliding {
+        if let Some(i) = start_mode.sliding {
             project(&self.system, i, t0, &mut x);
         }
         self.stepper.reset_state(t0, x);
         let stats0 = *self.stepper.stats();
-        let mut history = EventHistory::new();
-        let mut transitions = Vec::new();
-        let mut max_drift = T::zero();
-        let mut steps = 0usize;
-        let mut stalls = 0usize;
+        let mut state = RunState {
+            mode: start_mode,
+            history: EventHistory::new(),
+            transitions: Vec::new(),
+            max_drift: T::zero(),
+            steps: 0,
+            stalls: 0,
+        };
         let mut stopped = false;
-        observer.on_start(t0, &x0, &mode);
+        observer.on_start(t0, &x0, &start_mode);
         'modes: loop {
-            let field = ModeField {
-                sys: &self.system,
-                mode,
-                exit_samples: self.settings.exit_samples,
+            let mut sides = {
+                let field = self.field(state.mode);
+                let (t, y) = self.stepper.current();
+                crate::drive::initial_sides(&field, &field, t, y)?
             };
-            let (t, y) = self.stepper.current();
-            let mut sides = crate::drive::initial_sides(&field, &field, t, y)?;
             loop {
-                let t_now = self.stepper.current().0;
-                if t_now >= t_end {
-                    break 'modes;
-                }
-                if steps >= self.settings.max_steps {
-                    return Err(IntegrateError::MaxSteps {
-                        t: to_f64(t_now),
-                        max_steps: self.settings.max_steps,
-                    }
-                    .into());
-                }
-                let limit = crate::drive::step_limit(
-                    t_now,
-                    t_end,
-                    None,
-                    crate::drive::time_scale(&field, &field, t_now),
-                );
-                self.stepper.step(&field, limit)?;
-                steps += 1;
-                let mut work = Stats::default();
-                let mut restart = None;
-                let out = Scan {
-                    system: &field,
-                    events: &field,
-                    zeno: &self.zeno,
-                    event_tol: self.settings.event_tol,
-                    history: &mut history,
-                    dense: self.stepper.dense(),
-                    stats: &mut work,
-                    restart: &mut restart,
-                }
-                .scan_step(
-                    &mut sides,
-                    &mut WithMode {
-                        inner: &mut *observer,
-                        mode,
-                    },
-                );
-                if let Some(i) = mode.sliding {
-                    // The surface between step ends, on the part of the step that was kept.
-                    let (ta, tb) = self.stepper.dense().span();
-                    let tb = restart.map_or(tb, |(t, _)| t);
-                    let d = self.drift_on_step(i, ta, tb)?;
-                    max_drift = max_drift.max(d);
-                }
-                let stats = self.stepper.stats_mut();
-                stats.events += work.events;
-                stats.rhs_evals += work.rhs_evals;
-                if let Some((t, y)) = restart {
-                    self.stepper.reset_state(t, y);
-                }
-                let terminal = match out? {
-                    None => {
-                        let mut forced = None;
-                        if let Some(i) = mode.sliding {
-                            // Drift correction: back onto the surface at the step end.
-                            let (t, y) = self.stepper.current();
-                            let mut y = *y;
-                            let grad = self.system.gradient(i, t, &y);
-                            if self.system.surface(i, t, &y).abs() > band::<T>() * scale(&grad, &y)
-                            {
-                                project(&self.system, i, t, &mut y);
-                                self.stepper.reset_state(t, y);
-                            }
-                            // The equivalent control out of [0, 1] at a step end without an
-                            // exit event (after an exit was judged a touch): exit here.
-                            let a = rates(&self.system, i, &mode.sides, t, &y).alpha();
-                            let slack = lit::<T>(1e3) * self.settings.tangency;
-                            if a < -slack || a > T::one() + slack {
-                                forced = Some(S);
-                            }
-                        }
-                        forced
-                    }
-                    Some(Termination::TerminalEvent(k)) => Some(k),
-                    Some(_) => {
+                match self.step_in_mode(&mut sides, &mut state, t_end, observer)? {
+                    StepEnd::Next => {}
+                    StepEnd::End => break 'modes,
+                    StepEnd::Stopped => {
                         stopped = true;
                         break 'modes;
                     }
-                };
-                if let Some(k) = terminal {
-                    let (t, y) = self.stepper.current();
-                    let mut y = *y;
-                    let (next, surface, kind) = self.next_mode(mode, k, t, &mut y)?;
-                    let last_t = transitions.last().map(|tr: &ModeTransition<T, N, S>| tr.t);
-                    let stall_tol =
-                        self.settings.event_tol + lit::<T>(4.0) * T::default_epsilon() * t.abs();
-                    if last_t.is_some_and(|lt| (t - lt).abs() <= stall_tol) {
-                        stalls += 1;
-                        if stalls >= self.settings.max_stalls {
-                            return Err(FilippovError::NoProgress {
-                                t: to_f64(t),
-                                count: stalls,
-                                mode: next.name(),
-                            });
+                    StepEnd::Transition(k) => {
+                        if self.transition(k, &mut state, observer)? == Control::Stop {
+                            stopped = true;
+                            break 'modes;
                         }
-                    } else {
-                        stalls = 0;
+                        continue 'modes;
                     }
-                    let tr = ModeTransition {
-                        t,
-                        x: y,
-                        surface,
-                        kind,
-                        from: mode,
-                        to: next,
-                    };
-                    transitions.push(tr);
-                    self.stepper.reset_state(t, y);
-                    mode = next;
-                    if observer.on_transition(&tr) == Control::Stop {
-                        stopped = true;
-                        break 'modes;
-                    }
-                    continue 'modes;
                 }
             }
         }
@@ -704,15 +625,180 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
         let run = FilippovRun {
             t,
             x: *y,
-            mode,
+            mode: state.mode,
             start_mode,
-            transitions,
+            transitions: state.transitions,
             stopped,
-            max_drift,
+            max_drift: state.max_drift,
             stats: self.stepper.stats().since(&stats0),
         };
         observer.on_finish(&run);
         Ok(run)
+    }
+
+    /// The field of `mode` (its vector field and its surfaces as events).
+    fn field<const S: usize>(&self, mode: Mode<S>) -> ModeField<'_, Sys, S> {
+        ModeField {
+            sys: &self.system,
+            mode,
+            exit_samples: self.settings.exit_samples,
+        }
+    }
+
+    /// One step in the current mode (the events' sides `sides`): the
+    /// step, the driver's event scan with the mode's observer view, the drift check and
+    /// correction while sliding, and whether the mode ends here.
+    fn step_in_mode<const N: usize, const S: usize, O: SlidingObserver<T, N, S>>(
+        &mut self,
+        sides: &mut crate::drive::Sides,
+        state: &mut RunState<T, N, S>,
+        t_end: T,
+        observer: &mut O,
+    ) -> Result<StepEnd>
+    where
+        Sys: Filippov<T, N, S>,
+        St: Stepper<T, N>,
+    {
+        let mode = state.mode;
+        let field = &ModeField {
+            sys: &self.system,
+            mode,
+            exit_samples: self.settings.exit_samples,
+        };
+        let t_now = self.stepper.current().0;
+        if t_now >= t_end {
+            return Ok(StepEnd::End);
+        }
+        if state.steps >= self.settings.max_steps {
+            return Err(IntegrateError::MaxSteps {
+                t: to_f64(t_now),
+                max_steps: self.settings.max_steps,
+            }
+            .into());
+        }
+        let limit = crate::drive::step_limit(
+            t_now,
+            t_end,
+            None,
+            crate::drive::time_scale(field, field, t_now),
+        );
+        self.stepper.step(field, limit)?;
+        state.steps += 1;
+        let mut work = Stats::default();
+        let mut restart = None;
+        let out = Scan {
+            system: field,
+            events: field,
+            zeno: &self.zeno,
+            event_tol: self.settings.event_tol,
+            history: &mut state.history,
+            dense: self.stepper.dense(),
+            stats: &mut work,
+            restart: &mut restart,
+        }
+        .scan_step(
+            sides,
+            &mut WithMode {
+                inner: &mut *observer,
+                mode,
+            },
+        );
+        if let Some(i) = mode.sliding {
+            // The surface between step ends, on the part of the step that was kept.
+            let (ta, tb) = self.stepper.dense().span();
+            let tb = restart.map_or(tb, |(t, _)| t);
+            let d = self.drift_on_step(i, ta, tb)?;
+            state.max_drift = state.max_drift.max(d);
+        }
+        let stats = self.stepper.stats_mut();
+        stats.events += work.events;
+        stats.rhs_evals += work.rhs_evals;
+        if let Some((t, y)) = restart {
+            self.stepper.reset_state(t, y);
+        }
+        Ok(match out? {
+            None => match mode.sliding {
+                Some(i) => self.after_sliding_step(i, &mode),
+                None => StepEnd::Next,
+            },
+            Some(Termination::TerminalEvent(k)) => StepEnd::Transition(k),
+            Some(_) => StepEnd::Stopped,
+        })
+    }
+
+    /// The end of a step sliding on surface `i` without an event: the drift correction
+    /// (back onto the surface), and an exit here if the equivalent control is out of
+    /// `[0, 1]` (after an exit was judged a touch).
+    fn after_sliding_step<const N: usize, const S: usize>(
+        &mut self,
+        i: usize,
+        mode: &Mode<S>,
+    ) -> StepEnd
+    where
+        Sys: Filippov<T, N, S>,
+        St: Stepper<T, N>,
+    {
+        let (t, y) = self.stepper.current();
+        let mut y = *y;
+        let grad = self.system.gradient(i, t, &y);
+        if self.system.surface(i, t, &y).abs() > band::<T>() * scale(&grad, &y) {
+            project(&self.system, i, t, &mut y);
+            self.stepper.reset_state(t, y);
+        }
+        let a = rates(&self.system, i, &mode.sides, t, &y).alpha();
+        let slack = lit::<T>(1e3) * self.settings.tangency;
+        if a < -slack || a > T::one() + slack {
+            StepEnd::Transition(S)
+        } else {
+            StepEnd::Next
+        }
+    }
+
+    /// The transition at the current state through surface `k` (`S`: the sliding mode's
+    /// exit): the next mode, the stall guard, the record and the observer's call.
+    ///
+    /// # Errors
+    /// [`FilippovError::NoProgress`] after [`Settings::max_stalls`] transitions at one
+    /// instant; the errors of choosing the next mode.
+    fn transition<const N: usize, const S: usize, O: SlidingObserver<T, N, S>>(
+        &mut self,
+        k: usize,
+        state: &mut RunState<T, N, S>,
+        observer: &mut O,
+    ) -> Result<Control>
+    where
+        Sys: Filippov<T, N, S>,
+        St: Stepper<T, N>,
+    {
+        let (t, y) = self.stepper.current();
+        let mut y = *y;
+        let (next, surface, kind) = self.next_mode(state.mode, k, t, &mut y)?;
+        let last_t = state.transitions.last().map(|tr| tr.t);
+        let stall_tol = self.settings.event_tol + lit::<T>(4.0) * T::default_epsilon() * t.abs();
+        if last_t.is_some_and(|lt| (t - lt).abs() <= stall_tol) {
+            state.stalls += 1;
+            if state.stalls >= self.settings.max_stalls {
+                return Err(FilippovError::NoProgress {
+                    t: to_f64(t),
+                    count: state.stalls,
+                    mode: next.name(),
+                });
+            }
+        } else {
+            state.stalls = 0;
+        }
+        let tr = ModeTransition {
+            t,
+            x: y,
+            surface,
+            kind,
+            from: state.mode,
+            to: next,
+        };
+        state.transitions.push(tr);
+        self.stepper.reset_state(t, y);
+        state.mode = next;
+        Ok(observer.on_transition(&tr))
     }
 
     /// The largest relative `|H_i|` on the stepper's dense output over `[ta, tb]` (its ends
