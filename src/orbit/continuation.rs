@@ -395,6 +395,19 @@ struct Point<const N: usize> {
     extrema: Vec<(f64, f64)>,
 }
 
+impl<const N: usize> From<Point<N>> for BranchPoint<N> {
+    fn from(q: Point<N>) -> Self {
+        Self {
+            arclength: q.arclength,
+            p: q.p,
+            state: q.y,
+            stable: q.multipliers.iter().all(|m| modulus(m) < 1.0),
+            multipliers: q.multipliers,
+            grazing_margin: q.margin,
+        }
+    }
+}
+
 const FOLD: usize = 0;
 const PD: usize = 1;
 const NS: usize = 2;
@@ -793,18 +806,7 @@ where
     S: Dynamics<f64, N> + Clone,
     E: EventSet<f64, N> + Clone,
 {
-    for g in [settings.grazing, settings.contacts].into_iter().flatten() {
-        if !g.level.is_finite() {
-            return Err(invalid("the grazing level", "finite", g.level));
-        }
-        if g.component >= N {
-            return Err(invalid(
-                "the grazing component",
-                "< N (the state dimension)",
-                g.component as f64,
-            ));
-        }
-    }
+    check_grazing_tests::<N>(settings)?;
     let first = build(p0)?.find(t0, period(p0), guess)?;
     let (sy, sp) = match &settings.scales {
         Some((s, sp)) => {
@@ -813,21 +815,10 @@ where
             }
             (SVector::<f64, N>::from_iterator(s.iter().copied()), *sp)
         }
-        None => {
-            // Each component by its range over the first orbit (how far it moves), floored
-            // at 10⁻⁶ of its magnitude.
-            let shooting = build(p0)?;
-            let span = period(p0);
-            let mut sy = SVector::<f64, N>::zeros();
-            for i in 0..N {
-                let lo = shooting.extremum(t0, span, first.state, i, Extremum::Min)?;
-                let hi = shooting.extremum(t0, span, first.state, i, Extremum::Max)?;
-                sy[i] = (hi - lo)
-                    .max(1e-6 * lo.abs().max(hi.abs()))
-                    .max(f64::MIN_POSITIVE);
-            }
-            (sy, p0.abs().max(1.0))
-        }
+        None => (
+            orbit_ranges(&build(p0)?, t0, period(p0), &first.state)?,
+            p0.abs().max(1.0),
+        ),
     };
     let problem = Problem {
         build: &build,
@@ -868,15 +859,7 @@ where
                 if outside {
                     break BranchEnd::ParameterRange;
                 }
-                // Step control on the corrector's effort: grow after easy corrections,
-                // hold after moderate ones, shrink after hard ones.
-                let factor = match iterations {
-                    0..=3 => 1.5,
-                    4..=5 => 1.1,
-                    6..=7 => 1.0,
-                    _ => 0.7,
-                };
-                ds = (ds * factor).clamp(settings.min_step, settings.max_step);
+                ds = (ds * step_factor(iterations)).clamp(settings.min_step, settings.max_step);
             }
             Err(_) => {
                 ds *= 0.5;
@@ -889,20 +872,61 @@ where
         }
     };
     Ok(Branch {
-        points: points
-            .into_iter()
-            .map(|q| BranchPoint {
-                arclength: q.arclength,
-                p: q.p,
-                state: q.y,
-                stable: q.multipliers.iter().all(|m| modulus(m) < 1.0),
-                multipliers: q.multipliers,
-                grazing_margin: q.margin,
-            })
-            .collect(),
+        points: points.into_iter().map(BranchPoint::from).collect(),
         bifurcations,
         end,
     })
+}
+
+/// The grazing and contact tests' settings: a finite level, a component `< N`.
+fn check_grazing_tests<const N: usize>(settings: &ContinuationSettings) -> Result<()> {
+    for g in [settings.grazing, settings.contacts].into_iter().flatten() {
+        if !g.level.is_finite() {
+            return Err(invalid("the grazing level", "finite", g.level));
+        }
+        if g.component >= N {
+            return Err(invalid(
+                "the grazing component",
+                "< N (the state dimension)",
+                g.component as f64,
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The default state scales of a branch: each component by its range over the first orbit
+/// (how far it moves), floored at 10⁻⁶ of its magnitude.
+fn orbit_ranges<S, E, const N: usize, const M: usize>(
+    shooting: &Shooting<f64, S, E, N, M>,
+    t0: f64,
+    span: f64,
+    state: &SVector<f64, N>,
+) -> Result<SVector<f64, N>>
+where
+    S: Dynamics<f64, N> + Clone,
+    E: EventSet<f64, N> + Clone,
+{
+    let mut sy = SVector::<f64, N>::zeros();
+    for i in 0..N {
+        let lo = shooting.extremum(t0, span, *state, i, Extremum::Min)?;
+        let hi = shooting.extremum(t0, span, *state, i, Extremum::Max)?;
+        sy[i] = (hi - lo)
+            .max(1e-6 * lo.abs().max(hi.abs()))
+            .max(f64::MIN_POSITIVE);
+    }
+    Ok(sy)
+}
+
+/// Step control on the corrector's effort: grow after easy corrections, hold after
+/// moderate ones, shrink after hard ones.
+fn step_factor(iterations: usize) -> f64 {
+    match iterations {
+        0..=3 => 1.5,
+        4..=5 => 1.1,
+        6..=7 => 1.0,
+        _ => 0.7,
+    }
 }
 
 /// Whether a value relative to the level is beyond it for this kind of extremum.
