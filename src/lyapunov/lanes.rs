@@ -95,25 +95,25 @@ struct Pair<D, const M: usize> {
     stats: Stats,
 }
 
-fn estimate<D: LaneDynamics<M> + Clone, const M: usize>(
-    systems: &[(f64, D)],
+/// Checks the inputs of [`estimate`]; returns the separation direction `dir`, the second
+/// start `y0 + d0·dir` and the separation realized after rounding.
+fn start_pair<const M: usize>(
+    n_systems: usize,
     y0: SVector<f64, M>,
     d0: f64,
-    norm: Norm<f64, M>,
+    norm: &Norm<f64, M>,
     settings: &DiagramSettings<f64>,
-    run: impl Fn(&[MemberRun<D, M>]) -> Outcomes<M>,
-) -> Result<Vec<DiagramPoint<f64>>> {
-    if systems.is_empty() {
+) -> Result<(SVector<f64, M>, SVector<f64, M>, f64)> {
+    if n_systems == 0 {
         return Err(LyapunovError::NoParameters);
     }
     if !(d0.is_finite() && d0 > 0.0) {
         return Err(LyapunovError::InvalidSeparation { d0 });
     }
     norm.validate()?;
-    let n = settings.intervals;
-    if n < 2 {
+    if settings.intervals < 2 {
         return Err(LyapunovError::TooFewIntervals {
-            intervals: n,
+            intervals: settings.intervals,
             minimum: 2,
         });
     }
@@ -136,6 +136,19 @@ fn estimate<D: LaneDynamics<M> + Clone, const M: usize>(
     if !((realized - d0).abs() <= 1e-3 * d0) {
         return Err(LyapunovError::UnresolvedSeparation { d0, realized });
     }
+    Ok((dir, y1, realized))
+}
+
+fn estimate<D: LaneDynamics<M> + Clone, const M: usize>(
+    systems: &[(f64, D)],
+    y0: SVector<f64, M>,
+    d0: f64,
+    norm: Norm<f64, M>,
+    settings: &DiagramSettings<f64>,
+    run: impl Fn(&[MemberRun<D, M>]) -> Outcomes<M>,
+) -> Result<Vec<DiagramPoint<f64>>> {
+    let (dir, y1, realized) = start_pair(systems.len(), y0, d0, &norm, settings)?;
+    let (n, t0) = (settings.intervals, settings.t0);
     let mut pairs = Vec::with_capacity(systems.len());
     for (p, system) in systems {
         pairs.push(Pair {
@@ -172,49 +185,67 @@ fn estimate<D: LaneDynamics<M> + Clone, const M: usize>(
             let (Some(ra), Some(rb)) = (out.next(), out.next()) else {
                 break;
             };
-            let (oa, ob) = (ra?, rb?);
-            if recording {
-                p.stats += &oa.stats;
-                p.stats += &ob.stats;
-            }
-            let a = oa.y;
-            let mut delta = ob.y - a;
-            let mut d = norm.norm(&delta);
-            if !recording && d == 0.0 {
-                delta = dir * d0;
-                d = norm.norm(&delta);
-            }
-            if !(d.is_finite() && d > 0.0) {
-                return Err(LyapunovError::SeparationLost {
-                    t: oa.t,
-                    separation: d,
-                });
-            }
-            if recording {
-                p.local.push((d / p.d_start).ln() / p.tau);
-            }
-            let b_new = a + delta * (d0 / d);
-            p.d_start = norm.norm(&(b_new - a));
-            if !(p.d_start > 0.0) {
-                return Err(LyapunovError::UnresolvedSeparation {
-                    d0,
-                    realized: p.d_start,
-                });
-            }
-            p.a = a;
-            p.b = b_new;
+            p.renormalize(&ra?, &rb?, recording, (dir, d0), &norm)?;
         }
     }
-    Ok(pairs
-        .iter()
-        .map(|p| {
-            let sum: f64 = p.local.iter().fold(0.0, |s, &x| s + x);
-            DiagramPoint {
-                parameter: p.param,
-                exponent: sum / n as f64,
-                spread: block_standard_error(n, settings.blocks.min(n), |k| p.local[k]),
-                stats: p.stats,
-            }
-        })
-        .collect())
+    Ok(pairs.iter().map(|p| p.point(settings.blocks)).collect())
+}
+
+impl<D, const M: usize> Pair<D, M> {
+    /// The pair after an interval whose runs ended in `oa` (reference) and `ob`
+    /// (perturbed): the local exponent (if `recording`), and the perturbed state back at
+    /// distance `d0` along the separation (along `dir` if it vanished in the transient).
+    fn renormalize(
+        &mut self,
+        oa: &crate::drive::Outcome<f64, M>,
+        ob: &crate::drive::Outcome<f64, M>,
+        recording: bool,
+        (dir, d0): (SVector<f64, M>, f64),
+        norm: &Norm<f64, M>,
+    ) -> Result<()> {
+        if recording {
+            self.stats += &oa.stats;
+            self.stats += &ob.stats;
+        }
+        let a = oa.y;
+        let mut delta = ob.y - a;
+        let mut d = norm.norm(&delta);
+        if !recording && d == 0.0 {
+            delta = dir * d0;
+            d = norm.norm(&delta);
+        }
+        if !(d.is_finite() && d > 0.0) {
+            return Err(LyapunovError::SeparationLost {
+                t: oa.t,
+                separation: d,
+            });
+        }
+        if recording {
+            self.local.push((d / self.d_start).ln() / self.tau);
+        }
+        let b_new = a + delta * (d0 / d);
+        self.d_start = norm.norm(&(b_new - a));
+        if !(self.d_start > 0.0) {
+            return Err(LyapunovError::UnresolvedSeparation {
+                d0,
+                realized: self.d_start,
+            });
+        }
+        self.a = a;
+        self.b = b_new;
+        Ok(())
+    }
+
+    /// The pair's diagram point: the mean of its local exponents and their block
+    /// standard error over `blocks` blocks.
+    fn point(&self, blocks: usize) -> DiagramPoint<f64> {
+        let n = self.local.len();
+        let sum: f64 = self.local.iter().fold(0.0, |s, &x| s + x);
+        DiagramPoint {
+            parameter: self.param,
+            exponent: sum / n as f64,
+            spread: block_standard_error(n, blocks.min(n), |k| self.local[k]),
+            stats: self.stats,
+        }
+    }
 }
