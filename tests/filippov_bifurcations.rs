@@ -663,3 +663,38 @@ fn relay_feedback_orbit_continued_in_the_damping_against_the_exact_flow() {
         last_period = q.period;
     }
 }
+
+#[test]
+fn arclength_locates_the_sliding_bifurcations_of_the_natural_branch() {
+    // The branch of `switching_and_crossing_sliding_on_the_belt_oscillator_branch`, now by
+    // arclength: the same two sliding bifurcations at the same F₀ (each located by its
+    // own brackets, so they agree to the location and shooting tolerances only).
+    let (w, u) = (2.0, 0.5);
+    let build = move |f0: f64| Ok(FilippovSimulation::new(belt(f0, w, u), Dopri5::new(tol2())));
+    let settings = SlidingContinuation::new(1.25, 2.1, 0.05, 0)
+        .unwrap()
+        .with_locate_tolerance(1e-12)
+        .unwrap();
+    let x0 = settled(1.3, w, u);
+    let natural = follow_sliding(build, |_| PI, 0.0, 1.3, x0, tol6(), &settings).unwrap();
+    let arc = follow_sliding_arclength(build, |_| PI, 0.0, 1.3, x0, tol6(), &settings).unwrap();
+    assert!(arc.folds.is_empty(), "{:?}", arc.folds);
+    let kinds = |b: &[nonsmooth::orbit::sliding::SlidingBifurcation<2>]| -> Vec<_> {
+        b.iter().map(|b| b.kind).collect()
+    };
+    assert_eq!(kinds(&arc.bifurcations), kinds(&natural.bifurcations));
+    assert_eq!(arc.bifurcations.len(), 2);
+    for (a, n) in arc.bifurcations.iter().zip(&natural.bifurcations) {
+        println!(
+            "{:?}: arclength F₀ = {:.12}, natural F₀ = {:.12}",
+            a.kind, a.p, n.p
+        );
+        assert!((a.p - n.p).abs() < 1e-9, "{} vs {}", a.p, n.p);
+        assert!(
+            (a.state - n.state).norm() < 1e-7,
+            "{} vs {}",
+            a.state,
+            n.state
+        );
+    }
+}

@@ -556,6 +556,52 @@ impl<B, P> Problem<'_, B, P> {
         })
     }
 
+    /// The sliding bifurcations between two points of a branch along which `p` is
+    /// monotone: each test function's sign change, located by [`locate`](Self::locate)
+    /// and kept if its value there is a zero (not a jump of the test), crossing-sliding
+    /// told from switching-sliding by the far field's curvature.
+    fn sliding_bifurcations<Sys, St, const N: usize, const S: usize, const M: usize>(
+        &self,
+        a: &SlidingBranchPoint<N>,
+        b: &SlidingBranchPoint<N>,
+        tol: Tolerances<f64, M>,
+    ) -> Result<Vec<SlidingBifurcation<N>>>
+    where
+        B: Fn(f64) -> Result<FilippovSimulation<f64, Sys, St>>,
+        P: Fn(f64) -> f64,
+        Sys: Filippov<f64, N, S> + Clone,
+        St: Stepper<f64, N> + Clone,
+    {
+        let mut found = Vec::new();
+        for kind in [
+            SlidingBifurcationKind::GrazingSliding,
+            SlidingBifurcationKind::CrossingSliding,
+            SlidingBifurcationKind::AddingSliding,
+        ] {
+            let test = test_of(kind);
+            let (fa, fb) = (test(&a.tests), test(&b.tests));
+            if let Some((at, value, bracket)) = self.locate::<Sys, St, N, S, M>(a, b, test, tol)?
+                && is_zero(value, fa, fb)
+            {
+                // g_cs = 0 at a visible or an invisible fold of the far field.
+                let kind = match (kind, at.tests.crossing_curvature) {
+                    (SlidingBifurcationKind::CrossingSliding, Some(c)) if c < 0.0 => {
+                        SlidingBifurcationKind::SwitchingSliding
+                    }
+                    _ => kind,
+                };
+                found.push(SlidingBifurcation {
+                    kind,
+                    p: at.p,
+                    state: at.state,
+                    value,
+                    bracket,
+                });
+            }
+        }
+        Ok(found)
+    }
+
     /// Locates the zero of `test` between two points by the Illinois method in `p`.
     fn locate<Sys, St, const N: usize, const S: usize, const M: usize>(
         &self,
@@ -737,33 +783,7 @@ where
             break BranchEnd::StepTooSmall { p: last.p };
         };
         let b = ev.point;
-        for kind in [
-            SlidingBifurcationKind::GrazingSliding,
-            SlidingBifurcationKind::CrossingSliding,
-            SlidingBifurcationKind::AddingSliding,
-        ] {
-            let test = test_of(kind);
-            let (fa, fb) = (test(&last.tests), test(&b.tests));
-            if let Some((at, value, bracket)) =
-                problem.locate::<Sys, St, N, S, M>(last, &b, test, tol)?
-                && is_zero(value, fa, fb)
-            {
-                // g_cs = 0 at a visible or an invisible fold of the far field.
-                let kind = match (kind, at.tests.crossing_curvature) {
-                    (SlidingBifurcationKind::CrossingSliding, Some(c)) if c < 0.0 => {
-                        SlidingBifurcationKind::SwitchingSliding
-                    }
-                    _ => kind,
-                };
-                bifurcations.push(SlidingBifurcation {
-                    kind,
-                    p: at.p,
-                    state: at.state,
-                    value,
-                    bracket,
-                });
-            }
-        }
+        bifurcations.extend(problem.sliding_bifurcations::<Sys, St, N, S, M>(last, &b, tol)?);
         points.push(b);
         k += 1;
     };
@@ -796,6 +816,10 @@ pub struct SlidingArcBranch<const N: usize> {
     pub points: Vec<SlidingBranchPoint<N>>,
     /// The folds, in order of arclength.
     pub folds: Vec<SlidingFold<N>>,
+    /// The sliding bifurcations located between neighbouring points, in order of
+    /// arclength (as in [`follow_sliding`]; not between the two neighbours of a fold,
+    /// where `p` is not monotone).
+    pub bifurcations: Vec<SlidingBifurcation<N>>,
     /// Why it ended.
     pub end: BranchEnd,
 }
@@ -1011,9 +1035,11 @@ impl<B, P> Problem<'_, B, P> {
 /// A **fold** is a zero of the tangent's `p`-component `τ_p` (there `Φ − I` is singular:
 /// a Floquet multiplier 1); a sign change of `τ_p` between two points is located by the
 /// Illinois method in the arclength to the settings' locate tolerance (relative to the
-/// step). The sliding tests of each point are evaluated as in [`follow_sliding`]; the
-/// sliding bifurcations are not located on this branch (use [`follow_sliding`] on a
-/// part of the branch that does not fold).
+/// step). The sliding tests of each point are evaluated as in [`follow_sliding`], and
+/// a sign change of a test between two neighbouring points is located as there (by the
+/// Illinois method in `p`, each trial orbit found by shooting from the points'
+/// interpolation), except between the two neighbours of a fold, where `p` is not
+/// monotone: a sliding bifurcation that close to a fold is not located.
 ///
 /// # Errors
 /// [`OrbitError::InvalidSetting`] for a tested surface `≥ S` or autonomous settings (not
@@ -1074,6 +1100,7 @@ where
     };
     let mut points = vec![first.point];
     let mut folds = Vec::new();
+    let mut bifurcations = Vec::new();
     let ds_max = 4.0 * settings.step.abs();
     let ds_min = 1e-4 * settings.step.abs();
     let mut ds = settings.step.abs();
@@ -1094,6 +1121,7 @@ where
         if next.p < settings.lo || next.p > settings.hi {
             break BranchEnd::ParameterRange;
         }
+        let b = point_of(&next)?;
         if next.tangent[N].signum() != current.tangent[N].signum() {
             let fold = problem.locate_fold::<Sys, St, N, S, M>(&current, &next, ds, tol)?;
             folds.push(SlidingFold {
@@ -1103,12 +1131,19 @@ where
                 tangent_p: fold.tangent[N],
                 multipliers: fold.multipliers,
             });
+        } else if let Some(a) = points.last() {
+            bifurcations.extend(problem.sliding_bifurcations::<Sys, St, N, S, M>(a, &b, tol)?);
         }
-        points.push(point_of(&next)?);
+        points.push(b);
         current = next;
         if iterations <= 3 {
             ds = (ds * 1.5).min(ds_max);
         }
     };
-    Ok(SlidingArcBranch { points, folds, end })
+    Ok(SlidingArcBranch {
+        points,
+        folds,
+        bifurcations,
+        end,
+    })
 }
