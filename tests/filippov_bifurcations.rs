@@ -599,12 +599,13 @@ fn relay_feedback_orbit_continued_in_the_damping_against_the_exact_flow() {
     let branch =
         follow_sliding(build, move |_| period, 0.0, 0.05, start, tol12, &settings).unwrap();
     assert_eq!(branch.points.len(), 5, "{:?}", branch.end);
-    // Not located: along this branch pairs of short sliding segments vanish (14 segments
-    // per period at ζ = 0.05, 12 from about 0.0502, then 10, 8 and 6 by 0.06): an
-    // interior region arc that entered the surface for a short slide (0.0017 at
-    // ζ = 0.0501) misses it at ζ = 0.0503 — a grazing-sliding of one arc of an orbit that
-    // slides elsewhere, which the global test g_gs (closest approach of an orbit that does
-    // not slide) does not see. A missing capability, so nothing is asserted about
+    // Along this branch pairs of short sliding segments vanish (14 segments per period at
+    // ζ = 0.05, 12 from ζ* = 0.0502412, then 10, 8 and 6 by 0.06): an interior region arc
+    // that entered the surface for a short slide misses it past ζ* — a grazing-sliding of
+    // one arc of an orbit that slides elsewhere, located by the local test g_lgs
+    // (`relay_grazing_sliding_of_one_arc_located_and_confirmed_by_simulation`, on a finer
+    // grid). On this coarse grid (Δζ = 0.0025) several such changes fall between two
+    // points and the sign of g_lgs need not change, so nothing is asserted about
     // `branch.bifurcations` here; the segment counts below show the changes.
     let segments: Vec<usize> = branch
         .points
@@ -697,4 +698,84 @@ fn arclength_locates_the_sliding_bifurcations_of_the_natural_branch() {
             n.state
         );
     }
+}
+
+#[test]
+fn relay_grazing_sliding_of_one_arc_located_and_confirmed_by_simulation() {
+    let relay = |zeta: f64| RelayFeedback {
+        zeta,
+        ..RelayFeedback::default()
+    };
+    let build = move |zeta: f64| {
+        Ok(FilippovSimulation::new(
+            relay(zeta).system().unwrap(),
+            Dopri5::new(Tolerances::<f64, 3>::new(1e-12, 1e-14).unwrap()),
+        ))
+    };
+    let mut sim = build(0.05).unwrap();
+    let warm = sim
+        .run(0.0, SVector::from(RelayFeedback::X0), 40.0, &mut ())
+        .unwrap();
+    let run = sim.run(warm.t, warm.x, warm.t + 10.0, &mut ()).unwrap();
+    let entries: Vec<f64> = run
+        .transitions
+        .iter()
+        .filter(|tr| tr.kind == TransitionKind::SlidingEntry)
+        .map(|tr| tr.t)
+        .collect();
+    let period = entries[14] - entries[0];
+    let exit = run
+        .transitions
+        .windows(2)
+        .find(|w| w[0].kind == TransitionKind::SlidingExit && w[1].t - w[0].t > 0.05)
+        .unwrap();
+    let start = sim
+        .run(exit[0].t, exit[0].x, 0.5 * (exit[0].t + exit[1].t), &mut ())
+        .unwrap()
+        .x;
+    let settings = SlidingContinuation::new(0.0499, 0.0506, 0.0001, 0)
+        .unwrap()
+        .autonomous()
+        .with_locate_tolerance(1e-10)
+        .unwrap();
+    let tol12 = Tolerances::<f64, 12>::new(1e-12, 1e-14).unwrap();
+    let branch =
+        follow_sliding(build, move |_| period, 0.0, 0.05, start, tol12, &settings).unwrap();
+    for q in &branch.points {
+        println!(
+            "ζ = {:.5}: segments {}, g_lgs {:?}",
+            q.p, q.tests.sliding_segments, q.tests.local_grazing_sliding
+        );
+    }
+    // The local test is smooth through the change (linear in ζ: −1.4e-6 at 0.0502,
+    // +2.0e-6 at 0.0503) and located between the two grid points where a pair of
+    // sliding segments vanishes (14 → 12 per period).
+    let segments: Vec<usize> = branch
+        .points
+        .iter()
+        .map(|q| q.tests.sliding_segments)
+        .collect();
+    assert_eq!(segments, [14, 14, 14, 12, 12, 12], "{segments:?}");
+    assert_eq!(branch.bifurcations.len(), 1, "{:?}", branch.bifurcations);
+    let b = &branch.bifurcations[0];
+    println!(
+        "grazing-sliding of one arc at ζ = {:.13} (g_lgs {:.1e})",
+        b.p, b.value
+    );
+    assert_eq!(b.kind, SlidingBifurcationKind::GrazingSliding);
+    assert!(b.p > 0.0502 && b.p < 0.0503, "{}", b.p);
+    // Confirmed by plain simulation from the located orbit on both sides: 14 sliding
+    // segments per period at ζ* − 1e-6, 12 at ζ* + 1e-6 (after settling).
+    let count = |zeta: f64| {
+        let mut sim = build(zeta).unwrap();
+        let warm = sim.run(0.0, b.state, 20.0 * period, &mut ()).unwrap();
+        let run = sim.run(warm.t, warm.x, warm.t + period, &mut ()).unwrap();
+        run.transitions
+            .iter()
+            .filter(|tr| tr.kind == TransitionKind::SlidingEntry)
+            .count()
+    };
+    let (below, above) = (count(b.p - 1e-6), count(b.p + 1e-6));
+    println!("sliding segments per period at ζ* ∓ 1e-6: {below}, {above}");
+    assert_eq!((below, above), (14, 12));
 }

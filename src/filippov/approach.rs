@@ -29,6 +29,13 @@ pub struct Approach<'a, T: Real, Sys> {
     pub closest: Option<(T, T)>,
     /// Whether the orbit slid on surface `i` after `t_from`.
     pub sliding: bool,
+    /// The smallest *interior* local minimum of `s·H_i` over the region steps after
+    /// `t_from` (inside a step, not at its ends: an arc that leaves the surface
+    /// tangentially has its minimum, zero, where it starts) and where, if one was seen: the
+    /// near miss of an arc of an orbit that may slide elsewhere (the local grazing-sliding
+    /// test; a touch within rounding that the run did not report as a transition may be
+    /// `≤ 0`).
+    pub near_miss: Option<(T, T)>,
 }
 
 impl<'a, T: Real, Sys> Approach<'a, T, Sys> {
@@ -42,6 +49,7 @@ impl<'a, T: Real, Sys> Approach<'a, T, Sys> {
             samples: samples.max(2),
             closest: None,
             sliding: false,
+            near_miss: None,
         }
     }
 
@@ -105,6 +113,10 @@ impl<T: Real, const N: usize, const S: usize, Sys: Filippov<T, N, S>> SlidingObs
         };
         if self.closest.is_none_or(|c| gmin < c.0) {
             self.closest = Some((gmin, tmin));
+        }
+        let margin = lit::<T>(1e-9) * (tb - ta);
+        if tmin > ta + margin && tmin < tb - margin && self.near_miss.is_none_or(|c| gmin < c.0) {
+            self.near_miss = Some((gmin, tmin));
         }
         Control::Continue
     }

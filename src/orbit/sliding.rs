@@ -19,6 +19,16 @@
 //!   [`Approach`]); positive while the orbit stays off the surface, zero where it grazes,
 //!   negative once it slides. (An orbit that crosses the surface has approach 0: this test
 //!   is for orbits that, without sliding, do not reach the surface.)
+//! - **grazing-sliding of one arc** of an orbit that already slides elsewhere (a short
+//!   sliding segment is born or dies where a region arc touches the surface): over the
+//!   region arcs, each arc's interior local minimum of `s·H` (a near miss) and, at each
+//!   arrival from a region `a` that slides or grazes, the minimum the arriving arc would
+//!   reach past the surface by its second-order expansion,
+//!   $$ g_{\mathrm{lgs}} = \operatorname*{arg\,min}_{|\cdot|}\Bigl\{\min_{\text{arc}} s\,H,\;
+//!   -\frac{v^2}{2c}\Bigr\},\qquad v = s_a\,L_{F_a}H < 0,\quad c = s_a\,L^2_{F_a}H > 0, $$
+//!   the candidate nearest to zero (`SlidingTests::local_grazing_sliding`; defined for
+//!   orbits that slide). It is smooth through the graze (the near miss and the virtual
+//!   minimum are the same quadratic's minimum on the two sides).
 //! - **crossing-sliding** and **switching-sliding** (a point where the orbit arrives at
 //!   the surface from a region reaches the boundary of the sliding region, where the far
 //!   field `F_ā` is tangent, `h_ā = 0`, a fold of `F_ā`): over the orbit's arrivals at the
@@ -239,6 +249,15 @@ pub struct SlidingTests {
     /// along a sliding segment (continued past its exit up to a re-entry from the side it
     /// left to) nearest to its bound; `None` if there is no such extremum.
     pub adding_sliding: Option<f64>,
+    /// `g_lgs`, the local grazing-sliding test of an orbit that slides on the surface: over
+    /// its region arcs, the interior local minimum of `s·H` (a near miss, `> 0`) or, at a
+    /// sliding entry from a region whose field turns back (`c = s·L²_F H > 0`), the
+    /// minimum the arriving arc would reach past the surface, `−v²/(2c)` with
+    /// `v = s·L_F H` (`< 0`), whichever is nearest to zero. It vanishes where one arc of
+    /// the orbit grazes the surface while the orbit slides elsewhere: a short sliding
+    /// segment appears or disappears. `None` for an orbit that does not slide (its test
+    /// is `grazing_sliding`) or has no such arc.
+    pub local_grazing_sliding: Option<f64>,
     /// The number of sliding segments on the surface over one period.
     pub sliding_segments: usize,
     /// The time spent sliding on the surface over one period.
@@ -335,7 +354,10 @@ where
         &run.transitions,
         run.start_mode.sliding == Some(surface),
         (t0, run.t),
-        approach.closest.map(|c| c.0),
+        (
+            approach.closest.map(|c| c.0),
+            approach.near_miss.map(|c| c.0),
+        ),
     );
     tests.adding_sliding = adding_test(sim, surface, &run, (t0, x0));
     Ok(tests)
@@ -432,7 +454,7 @@ fn tests_of_run<Sys, const N: usize, const S: usize>(
     transitions: &[ModeTransition<f64, N, S>],
     starts_sliding: bool,
     (t0, t1): (f64, f64),
-    closest: Option<f64>,
+    (closest, near_miss): (Option<f64>, Option<f64>),
 ) -> SlidingTests
 where
     Sys: Filippov<f64, N, S>,
@@ -442,12 +464,23 @@ where
     let mut segments = 0usize;
     let mut since = if starts_sliding { Some(t0) } else { None };
     let mut crossing: Option<(f64, f64)> = None;
+    let mut local = near_miss;
     for tr in transitions.iter().filter(|tr| tr.surface == surface) {
         let slides_after = tr.to.sliding == Some(surface);
         let slid_before = tr.from.sliding == Some(surface);
         if slides_after && !slid_before {
             since = Some(tr.t);
             segments += 1;
+        }
+        // An arrival from a region that slides, or touches and stays (a graze judged by
+        // the second-order test): the arc's minimum past the surface.
+        let arrives = tr.from.sliding.is_none()
+            && (slides_after || (tr.kind == TransitionKind::Graze && tr.to.sliding.is_none()));
+        if arrives {
+            let v = entry_minimum(system, surface, tr);
+            if v.is_some_and(|v| local.is_none_or(|l| v.abs() < l.abs())) {
+                local = v;
+            }
         }
         if slid_before
             && !slides_after
@@ -489,12 +522,35 @@ where
     };
     SlidingTests {
         grazing_sliding,
+        local_grazing_sliding: local.filter(|_| segments > 0),
         crossing_sliding: crossing.map(|c| c.0),
         crossing_curvature: crossing.map(|c| c.1),
         adding_sliding: None,
         sliding_segments: segments,
         sliding_time,
     }
+}
+
+/// At an arrival from a region `a` (sign `s`) that slides or grazes: the minimum of `s·H`
+/// the arriving arc would reach past the surface, `−v²/(2c)` with `v = s·L_F H` and `c = s·L²_F H`, if
+/// the field turns back (`c > 0`, finite).
+fn entry_minimum<Sys, const N: usize, const S: usize>(
+    system: &Sys,
+    surface: usize,
+    tr: &ModeTransition<f64, N, S>,
+) -> Option<f64>
+where
+    Sys: Filippov<f64, N, S>,
+{
+    let sign = tr.from.sides[surface].sign::<f64>();
+    let mut f = SVector::zeros();
+    system.field(&tr.from.sides, tr.t, &tr.x, &mut f);
+    let v = sign
+        * (system.gradient(surface, tr.t, &tr.x).dot(&f)
+            + system.surface_time_rate(surface, tr.t, &tr.x));
+    let c = sign * second_rate(system, surface, &tr.from.sides, tr.t, &tr.x);
+    let m = -v * v / (2.0 * c);
+    (c > 0.0 && m.is_finite()).then_some(m)
 }
 
 /// A located zero: the point, the test's value there and the final bracket.
@@ -573,12 +629,14 @@ impl<B, P> Problem<'_, B, P> {
         St: Stepper<f64, N> + Clone,
     {
         let mut found = Vec::new();
-        for kind in [
-            SlidingBifurcationKind::GrazingSliding,
-            SlidingBifurcationKind::CrossingSliding,
-            SlidingBifurcationKind::AddingSliding,
+        use SlidingBifurcationKind::{AddingSliding, CrossingSliding, GrazingSliding};
+        let local: fn(&SlidingTests) -> Option<f64> = |t| t.local_grazing_sliding;
+        for (kind, test) in [
+            (GrazingSliding, test_of(GrazingSliding)),
+            (GrazingSliding, local),
+            (CrossingSliding, test_of(CrossingSliding)),
+            (AddingSliding, test_of(AddingSliding)),
         ] {
-            let test = test_of(kind);
             let (fa, fb) = (test(&a.tests), test(&b.tests));
             if let Some((at, value, bracket)) = self.locate::<Sys, St, N, S, M>(a, b, test, tol)?
                 && is_zero(value, fa, fb)
