@@ -215,39 +215,7 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, E: EventSet<T, N>, D: DenseOutp
             }
             let terminal = self.events.is_terminal(i);
             if self.events.resets(i) {
-                // An impact moves into the surface. A located crossing where the rate does
-                // not (the far end of a bracket past the top of a graze of zero normal
-                // velocity: the arrival of a chattering sequence) is no impact: the body
-                // stays on the surface, reported as sticking, not as an event.
-                let mut fc = SVector::zeros();
-                self.system.rhs(tc, &yc, &mut fc);
-                self.stats.rhs_evals += 1;
-                let into = if c.rising { T::one() } else { -T::one() };
-                if let Some(r) = self.events.rate(i, tc, &yc, &fc) {
-                    if !(into * r > T::zero()) {
-                        self.stats.events -= 1;
-                        *self.restart = Some((tc, yc));
-                        return Err(EventError::Sticking {
-                            index: i,
-                            t: to_f64(tc),
-                            depth: to_f64(self.events.value(i, tc, &yc).abs()),
-                            state: yc.iter().map(|&v| to_f64(v)).collect(),
-                        }
-                        .into());
-                    }
-                }
-                let mut ya = yc;
-                self.events.apply_reset(i, tc, &mut ya);
-                let rec = EventRecord {
-                    index: i,
-                    t: tc,
-                    y: yc,
-                    y_after: Some(ya),
-                    direction,
-                };
-                let stop_ev = observer.on_event(&rec) == Control::Stop;
-                *self.restart = Some((tc, ya));
-                self.after_reset(i, tc, &ya, sides);
+                let stop_ev = self.impact(i, (tc, &yc), c.rising, sides, observer)?;
                 return Ok(if terminal {
                     Crossings::End(Termination::TerminalEvent(i))
                 } else if stop_obs || stop_ev {
@@ -281,6 +249,59 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, E: EventSet<T, N>, D: DenseOutp
             t_lo = tc;
             y_lo = yc;
         }
+    }
+
+    /// The crossing of resetting event `i` at `(tc, yc)` (`rising` its direction): its
+    /// record with the state after the reset, which the step restarts from. Returns
+    /// whether the observer stopped the run.
+    ///
+    /// An impact moves into the surface. A located crossing where the rate does not (the
+    /// far end of a bracket past the top of a graze of zero normal velocity: the arrival of
+    /// a chattering sequence) is no impact: the body stays on the surface, reported as
+    /// sticking ([`EventError::Sticking`]), not as an event.
+    #[inline(always)]
+    fn impact<O: Observer<T, N>>(
+        &mut self,
+        i: usize,
+        (tc, yc): (T, &SVector<T, N>),
+        rising: bool,
+        sides: &mut Sides,
+        observer: &mut O,
+    ) -> Result<bool> {
+        let mut fc = SVector::zeros();
+        self.system.rhs(tc, yc, &mut fc);
+        self.stats.rhs_evals += 1;
+        let into = if rising { T::one() } else { -T::one() };
+        if let Some(r) = self.events.rate(i, tc, yc, &fc) {
+            if !(into * r > T::zero()) {
+                self.stats.events -= 1;
+                *self.restart = Some((tc, *yc));
+                return Err(EventError::Sticking {
+                    index: i,
+                    t: to_f64(tc),
+                    depth: to_f64(self.events.value(i, tc, yc).abs()),
+                    state: yc.iter().map(|&v| to_f64(v)).collect(),
+                }
+                .into());
+            }
+        }
+        let mut ya = *yc;
+        self.events.apply_reset(i, tc, &mut ya);
+        let rec = EventRecord {
+            index: i,
+            t: tc,
+            y: *yc,
+            y_after: Some(ya),
+            direction: if rising {
+                Direction::Rising
+            } else {
+                Direction::Falling
+            },
+        };
+        let stop = observer.on_event(&rec) == Control::Stop;
+        *self.restart = Some((tc, ya));
+        self.after_reset(i, tc, &ya, sides);
+        Ok(stop)
     }
 
     /// The sides after event `i`'s reset to `ya` at `tc`; event `i` is disarmed if the
