@@ -163,26 +163,16 @@ impl<V: Lanes, D: LaneDynamics<M>, const M: usize> pulp::WithSimd for Pass<'_, V
     }
 }
 
-/// `Σ_j k_j·a_j` over the given stages, component `c`, in the scalar stepper's order.
+/// The six new stages of the trial step `hs` from `(t, st.y)` (ending at `t_new`), in one
+/// loop so that the right-hand side is inlined once instead of six times: the stage
+/// inputs are the scalar stepper's expressions, term for term. Returns the seven stages
+/// (the first is `st.f`) and the new state.
 #[inline(always)]
-fn combo<V: Lanes, const M: usize>(k: &[[V; M]; 7], terms: &[(usize, V)], c: usize) -> V {
-    let (j0, a0) = terms[0];
-    let mut s = k[j0][c] * a0;
-    for &(j, a) in &terms[1..] {
-        s = s + k[j][c] * a;
-    }
-    s
-}
-
-/// The trial step of every lane (the same operations in the same order as the scalar
-/// [`Dopri5`](crate::integrate::Dopri5) and its controller), the masked update of the
-/// accepted and rejected lanes, and the accepted lanes' step data in `out.buf`.
-#[inline(always)]
-fn body<V: Lanes, D: LaneDynamics<M>, const M: usize>(
-    st: &mut LaneState<V, D, M>,
+fn stages<V: Lanes, D: LaneDynamics<M>, const M: usize>(
+    st: &LaneState<V, D, M>,
     k: &StepConsts<M>,
-    out: &mut StepOut,
-) {
+    (t, hs, t_new): (V, V, V),
+) -> ([[V; M]; 7], [V; M]) {
     let s = V::splat;
     let a21 = s(1.0 / 5.0);
     let [a31, a32] = tableau::A3.map(s);
@@ -190,40 +180,8 @@ fn body<V: Lanes, D: LaneDynamics<M>, const M: usize>(
     let [a51, a52, a53, a54] = tableau::A5.map(s);
     let [a61, a62, a63, a64, a65] = tableau::A6.map(s);
     let [a71, a73, a74, a75, a76] = tableau::B.map(s);
-    let [e1, e3, e4, e5, e6, e7] = tableau::E.map(s);
-    let [d1, d3, d4, d5, d6, d7] = tableau::D.map(s);
     let [c2, c3, c4, c5] = tableau::C.map(s);
-    let (expo_v, beta_v) = (s(k.expo), s(k.beta));
-    let (safety, inv_fac_max, inv_fac_min) = (s(k.safety), s(k.inv_fac_max), s(k.inv_fac_min));
-    let h_max = s(k.h_max);
-    let ln_floor = s(1e-4f64.ln());
-    let min_step_rel = s(16.0 * f64::EPSILON);
-    let h_min = s(k.h_min);
-    let math = k.math;
-    let one = s(1.0);
-    let zero = s(0.0);
-
-    out.too_small = 0;
-    out.rejected = 0;
-    out.accepted = 0;
-    out.non_finite = 0;
-    let p = &st.packed;
-    let (t, y, h) = (st.t, st.y, st.h);
-    // The trial step, cut to land on the lane's limit (clamp_to_limit).
-    let rest = st.limit - t;
-    let lands = h.ge(rest * s(0.99));
-    let hs = lands.select(rest, h);
-    let too_small =
-        (hs.lt((min_step_rel * t.abs()).max(h_min)) | !(t + hs).gt(t)) & !lands & st.active;
-    if too_small.bits() != 0 {
-        out.too_small = too_small.bits();
-        t.store(&mut out.buf[row::T0]);
-        hs.store(&mut out.buf[row::H]);
-        return;
-    }
-    let t_new = lands.select(st.limit, t + hs);
-    // The six new stages in one loop, so that the right-hand side is inlined once instead
-    // of six times: the stage inputs are the scalar stepper's expressions, term for term.
+    let (p, math, y, zero) = (&st.packed, k.math, st.y, s(0.0));
     let mut kk = [[zero; M]; 7];
     kk[0] = st.f;
     let mut yn = y;
@@ -280,23 +238,92 @@ fn body<V: Lanes, D: LaneDynamics<M>, const M: usize>(
         D::rhs_lanes(p, math, ts, &time, &ys, &mut f);
         kk[stage] = f;
     }
-    let k1 = kk[0];
-    let k7 = kk[6];
-    // The error norm (Tolerances::error_norm), lane-wise.
-    let mut acc = zero;
+    (kk, yn)
+}
+
+/// The error norm of the trial step ([`Tolerances::error_norm`](crate::integrate::Tolerances),
+/// lane-wise) and the mask of lanes whose new state and last stage are finite (the norm
+/// is NaN elsewhere).
+#[inline(always)]
+fn error_norm<V: Lanes, const M: usize>(
+    k: &StepConsts<M>,
+    kk: &[[V; M]; 7],
+    y: &[V; M],
+    yn: &[V; M],
+    hs: V,
+) -> (V, V) {
+    let s = V::splat;
+    let [e1, e3, e4, e5, e6, e7] = tableau::E.map(s);
+    let mut acc = s(0.0);
     let mut finite = s(TRUE);
     for c in 0..M {
         let e = combo(
-            &kk,
+            kk,
             &[(0, e1), (2, e3), (3, e4), (4, e5), (5, e6), (6, e7)],
             c,
         ) * hs;
         let q = e / (s(k.atol[c]) + s(k.rtol[c]) * y[c].abs().max(yn[c].abs()));
         acc = acc + q * q;
-        finite = finite & yn[c].finite() & k7[c].finite();
+        finite = finite & yn[c].finite() & kk[6][c].finite();
     }
     let err = (acc / s(M as f64)).sqrt();
-    let err = finite.select(err, s(f64::NAN));
+    (finite.select(err, s(f64::NAN)), finite)
+}
+
+/// `Σ_j k_j·a_j` over the given stages, component `c`, in the scalar stepper's order.
+#[inline(always)]
+fn combo<V: Lanes, const M: usize>(k: &[[V; M]; 7], terms: &[(usize, V)], c: usize) -> V {
+    let (j0, a0) = terms[0];
+    let mut s = k[j0][c] * a0;
+    for &(j, a) in &terms[1..] {
+        s = s + k[j][c] * a;
+    }
+    s
+}
+
+/// The trial step of every lane (the same operations in the same order as the scalar
+/// [`Dopri5`](crate::integrate::Dopri5) and its controller), the masked update of the
+/// accepted and rejected lanes, and the accepted lanes' step data in `out.buf`.
+#[inline(always)]
+fn body<V: Lanes, D: LaneDynamics<M>, const M: usize>(
+    st: &mut LaneState<V, D, M>,
+    k: &StepConsts<M>,
+    out: &mut StepOut,
+) {
+    let s = V::splat;
+    let [d1, d3, d4, d5, d6, d7] = tableau::D.map(s);
+    let (expo_v, beta_v) = (s(k.expo), s(k.beta));
+    let (safety, inv_fac_max, inv_fac_min) = (s(k.safety), s(k.inv_fac_max), s(k.inv_fac_min));
+    let h_max = s(k.h_max);
+    let ln_floor = s(1e-4f64.ln());
+    let min_step_rel = s(16.0 * f64::EPSILON);
+    let h_min = s(k.h_min);
+    let math = k.math;
+    let one = s(1.0);
+    let zero = s(0.0);
+
+    out.too_small = 0;
+    out.rejected = 0;
+    out.accepted = 0;
+    out.non_finite = 0;
+    let (t, y, h) = (st.t, st.y, st.h);
+    // The trial step, cut to land on the lane's limit (clamp_to_limit).
+    let rest = st.limit - t;
+    let lands = h.ge(rest * s(0.99));
+    let hs = lands.select(rest, h);
+    let too_small =
+        (hs.lt((min_step_rel * t.abs()).max(h_min)) | !(t + hs).gt(t)) & !lands & st.active;
+    if too_small.bits() != 0 {
+        out.too_small = too_small.bits();
+        t.store(&mut out.buf[row::T0]);
+        hs.store(&mut out.buf[row::H]);
+        return;
+    }
+    let t_new = lands.select(st.limit, t + hs);
+    let (kk, yn) = stages(st, k, (t, hs, t_new));
+    let k1 = kk[0];
+    let k7 = kk[6];
+    let (err, finite) = error_norm(k, &kk, &y, &yn, hs);
     // The PI controller (Controller::propose), lane-wise.
     let err_ok = err.finite();
     let pos = err.gt(zero) & err_ok;
