@@ -557,21 +557,27 @@ impl ExactPlant {
     }
 }
 
-#[test]
-fn relay_feedback_orbit_continued_in_the_damping_against_the_exact_flow() {
-    let relay = |zeta: f64| RelayFeedback {
+/// The relay feedback simulation at damping `zeta` (rtol 1e-12).
+fn relay_build(
+    zeta: f64,
+) -> Result<
+    FilippovSimulation<f64, impl Filippov<f64, 3, 1> + Clone, Dopri5<f64, 3>>,
+    nonsmooth::orbit::OrbitError,
+> {
+    let relay = RelayFeedback {
         zeta,
         ..RelayFeedback::default()
     };
-    let build = move |zeta: f64| {
-        Ok(FilippovSimulation::new(
-            relay(zeta).system().unwrap(),
-            Dopri5::new(Tolerances::<f64, 3>::new(1e-12, 1e-14).unwrap()),
-        ))
-    };
-    // A start in a region piece of the converged orbit, and the period from its
-    // symmetry (seven sliding segments each half period).
-    let mut sim = build(0.05).unwrap();
+    Ok(FilippovSimulation::new(
+        relay.system().unwrap(),
+        Dopri5::new(Tolerances::<f64, 3>::new(1e-12, 1e-14).unwrap()),
+    ))
+}
+
+/// The period of the relay orbit at ζ = 0.05 (from its symmetry: seven sliding segments
+/// each half period) and a start in a region piece of the converged orbit.
+fn relay_orbit_start() -> (f64, SVector<f64, 3>) {
+    let mut sim = relay_build(0.05).unwrap();
     let warm = sim
         .run(0.0, SVector::from(RelayFeedback::X0), 40.0, &mut ())
         .unwrap();
@@ -592,6 +598,17 @@ fn relay_feedback_orbit_continued_in_the_damping_against_the_exact_flow() {
         .run(exit[0].t, exit[0].x, 0.5 * (exit[0].t + exit[1].t), &mut ())
         .unwrap()
         .x;
+    (period, start)
+}
+
+#[test]
+fn relay_feedback_orbit_continued_in_the_damping_against_the_exact_flow() {
+    let relay = |zeta: f64| RelayFeedback {
+        zeta,
+        ..RelayFeedback::default()
+    };
+    let (period, start) = relay_orbit_start();
+    let build = relay_build;
     let settings = SlidingContinuation::new(0.045, 0.0605, 0.0025, 0)
         .unwrap()
         .autonomous();
@@ -702,37 +719,8 @@ fn arclength_locates_the_sliding_bifurcations_of_the_natural_branch() {
 
 #[test]
 fn relay_grazing_sliding_of_one_arc_located_and_confirmed_by_simulation() {
-    let relay = |zeta: f64| RelayFeedback {
-        zeta,
-        ..RelayFeedback::default()
-    };
-    let build = move |zeta: f64| {
-        Ok(FilippovSimulation::new(
-            relay(zeta).system().unwrap(),
-            Dopri5::new(Tolerances::<f64, 3>::new(1e-12, 1e-14).unwrap()),
-        ))
-    };
-    let mut sim = build(0.05).unwrap();
-    let warm = sim
-        .run(0.0, SVector::from(RelayFeedback::X0), 40.0, &mut ())
-        .unwrap();
-    let run = sim.run(warm.t, warm.x, warm.t + 10.0, &mut ()).unwrap();
-    let entries: Vec<f64> = run
-        .transitions
-        .iter()
-        .filter(|tr| tr.kind == TransitionKind::SlidingEntry)
-        .map(|tr| tr.t)
-        .collect();
-    let period = entries[14] - entries[0];
-    let exit = run
-        .transitions
-        .windows(2)
-        .find(|w| w[0].kind == TransitionKind::SlidingExit && w[1].t - w[0].t > 0.05)
-        .unwrap();
-    let start = sim
-        .run(exit[0].t, exit[0].x, 0.5 * (exit[0].t + exit[1].t), &mut ())
-        .unwrap()
-        .x;
+    let (period, start) = relay_orbit_start();
+    let build = relay_build;
     let settings = SlidingContinuation::new(0.0499, 0.0506, 0.0001, 0)
         .unwrap()
         .autonomous()
