@@ -139,17 +139,23 @@ fn excursions(period: &[(f64, TransitionKind, Region)], length: f64) -> Vec<f64>
         .collect()
 }
 
+/// The settings of the belt's branch in F₀ over [1.25, 2.1] (step 0.05, location to
+/// 1e-12) and its start: the settled orbit at F₀ = 1.3.
+fn belt_branch((w, u): (f64, f64)) -> (SlidingContinuation, SVector<f64, 2>) {
+    let settings = SlidingContinuation::new(1.25, 2.1, 0.05, 0)
+        .unwrap()
+        .with_locate_tolerance(1e-12)
+        .unwrap();
+    (settings, settled(1.3, w, u))
+}
+
 #[test]
 fn switching_and_crossing_sliding_on_the_belt_oscillator_branch() {
     // ω = 2, u = 0.5: the orbit of the forcing period π followed in F₀ from a stick-slip
     // orbit at F₀ = 1.3 to 2.1.
     let (w, u) = (2.0, 0.5);
     let build = move |f0: f64| Ok(FilippovSimulation::new(belt(f0, w, u), Dopri5::new(tol2())));
-    let settings = SlidingContinuation::new(1.25, 2.1, 0.05, 0)
-        .unwrap()
-        .with_locate_tolerance(1e-12)
-        .unwrap();
-    let x0 = settled(1.3, w, u);
+    let (settings, x0) = belt_branch((w, u));
     let branch = follow_sliding(build, |_| PI, 0.0, 1.3, x0, tol6(), &settings).unwrap();
     let kinds: Vec<_> = branch.bifurcations.iter().map(|b| b.kind).collect();
     assert_eq!(
@@ -689,11 +695,7 @@ fn arclength_locates_the_sliding_bifurcations_of_the_natural_branch() {
     // own brackets, so they agree to the location and shooting tolerances only).
     let (w, u) = (2.0, 0.5);
     let build = move |f0: f64| Ok(FilippovSimulation::new(belt(f0, w, u), Dopri5::new(tol2())));
-    let settings = SlidingContinuation::new(1.25, 2.1, 0.05, 0)
-        .unwrap()
-        .with_locate_tolerance(1e-12)
-        .unwrap();
-    let x0 = settled(1.3, w, u);
+    let (settings, x0) = belt_branch((w, u));
     let natural = follow_sliding(build, |_| PI, 0.0, 1.3, x0, tol6(), &settings).unwrap();
     let arc = follow_sliding_arclength(build, |_| PI, 0.0, 1.3, x0, tol6(), &settings).unwrap();
     assert!(arc.folds.is_empty(), "{:?}", arc.folds);
