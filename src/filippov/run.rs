@@ -599,7 +599,11 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
         observer.on_start(t0, &x0, &start_mode);
         'modes: loop {
             let mut sides = {
-                let field = self.field(state.mode);
+                let field = ModeField {
+                    sys: &self.system,
+                    mode: state.mode,
+                    exit_samples: self.settings.exit_samples,
+                };
                 let (t, y) = self.stepper.current();
                 crate::drive::initial_sides(&field, &field, t, y)?
             };
@@ -634,15 +638,6 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
         };
         observer.on_finish(&run);
         Ok(run)
-    }
-
-    /// The field of `mode` (its vector field and its surfaces as events).
-    fn field<const S: usize>(&self, mode: Mode<S>) -> ModeField<'_, Sys, S> {
-        ModeField {
-            sys: &self.system,
-            mode,
-            exit_samples: self.settings.exit_samples,
-        }
     }
 
     /// One step in the current mode (the events' sides `sides`): the
