@@ -627,7 +627,9 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
         observers: &mut [O],
         out: &mut [Option<Result<Outcome<f64, M>>>],
     ) {
-        let mut step = Box::new(StepOut::new(M));
+        let mut step = Box::new(StepOut::new(M, E::LEN));
+        // The events' ends are wanted where a lane's step may be quiet (quiet_lanes).
+        step.want_events = E::LEN > 0 && observers.iter().any(|o| !o.wants_steps());
         while self.st.active.bits() != 0 {
             if self.next >= self.queue.len()
                 && <V::Half as Lanes>::LANES < V::LANES
@@ -636,7 +638,7 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
                 self.compact().drive(observers, out);
                 return;
             }
-            super::kernel::step(&mut self.st, &self.consts, &mut step);
+            super::kernel::step(&mut self.st, &self.consts, &self.cfg.events, &mut step);
             if step.too_small != 0 {
                 for i in lanes_of(step.too_small) {
                     let e = IntegrateError::StepSizeTooSmall {
@@ -663,7 +665,7 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
                     }
                 }
             }
-            let quiet = self.quiet_lanes(&step.buf, step.accepted, observers);
+            let quiet = self.quiet_lanes(&step, observers);
             for i in lanes_of(step.accepted) {
                 if quiet & (1 << i) != 0 {
                     self.after_quiet_step(i, &step.buf);
@@ -819,18 +821,15 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
 
     /// The accepted lanes whose step the driver's event handling would pass through
     /// without doing anything but moving the events' sides: every event's step is quiet
-    /// ([`Sides::is_quiet`], from the events' lane forms evaluated at both ends of every
-    /// lane's step at once), the observer does not want steps
+    /// ([`Sides::is_quiet`], from the events' lane forms, which the kernel evaluates at
+    /// both ends of every lane's step at once, under the run's instruction set), the
+    /// observer does not want steps
     /// ([`Observer::wants_steps`]), and the trajectory does not end with this step. Empty
     /// if an event has no lane form.
-    fn quiet_lanes<O: Observer<f64, M>>(
-        &mut self,
-        buf: &[[f64; 16]],
-        accepted: u32,
-        observers: &[O],
-    ) -> u32 {
+    fn quiet_lanes<O: Observer<f64, M>>(&mut self, step: &StepOut, observers: &[O]) -> u32 {
+        let buf = &step.buf;
         let mut quiet = 0;
-        for i in lanes_of(accepted) {
+        for i in lanes_of(step.accepted) {
             let slot = &self.slots[i];
             let ends = buf[row::T1][i] >= slot.t_end || slot.steps + 1 >= self.cfg.max_steps;
             if let (Some(j), false) = (slot.job, ends) {
@@ -842,29 +841,20 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
         if quiet == 0 || E::LEN == 0 {
             return quiet;
         }
-        let load = |r: usize| V::load(&buf[r]);
-        let vector = |q: usize| -> [V; M] { core::array::from_fn(|c| load(row::vector(q, M) + c)) };
-        let (t0, t1) = (load(row::T0), load(row::T1));
-        let (y0, y1, f0, f1) = (
-            vector(row::X0),
-            vector(row::X1),
-            vector(row::F0),
-            vector(row::F1),
-        );
+        if !step.events {
+            return 0;
+        }
         for e in 0..E::LEN {
-            let (Some((g0, r0)), Some((g1, r1))) = (
-                self.cfg.events.lanes(e, t0, &y0, &f0),
-                self.cfg.events.lanes(e, t1, &y1, &f1),
-            ) else {
-                return 0;
-            };
+            let at = |q: usize| &buf[row::event(e, q, M)];
+            let (g0, g1, r0, r1) = (at(row::G0), at(row::G1), at(row::R0), at(row::R1));
+            let (has0, has1) = (step.rates & (1 << (2 * e)), step.rates & (1 << (2 * e + 1)));
             for i in lanes_of(quiet) {
                 let Some(sides) = &self.slots[i].sides else {
                     quiet &= !(1 << i);
                     continue;
                 };
-                let g = (g0.lane(i), g1.lane(i));
-                let r = (r0.map(|r| r.lane(i)), r1.map(|r| r.lane(i)));
+                let g = (g0[i], g1[i]);
+                let r = ((has0 != 0).then(|| r0[i]), (has1 != 0).then(|| r1[i]));
                 if sides.is_quiet(&self.cfg.events, e, g, r) {
                     self.quiet_ends[e][i] = g.1;
                 } else {

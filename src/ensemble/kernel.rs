@@ -9,6 +9,7 @@
 //! AVX-512 target features where the CPU has them.
 
 use crate::LaneDynamics;
+use crate::event::EventSet;
 use crate::integrate::dopri5::tableau;
 use crate::integrate::{StepOptions, Tolerances};
 use crate::lanes::math::{exp, ln};
@@ -86,10 +87,19 @@ pub(crate) mod row {
     pub const R3: usize = 5;
     pub const R4: usize = 6;
     pub const R5: usize = 7;
-    /// The number of rows for a state of `m` components.
+    /// The number of rows for a state of `m` components (without the events' rows).
     pub const fn count(m: usize) -> usize {
         3 + 8 * m
     }
+    /// The row of event `e`'s quantity `q` (`G0, G1, R0, R1`: value and rate at the step's
+    /// start and end), after the state's rows.
+    pub const fn event(e: usize, q: usize, m: usize) -> usize {
+        count(m) + 4 * e + q
+    }
+    pub const G0: usize = 0;
+    pub const G1: usize = 1;
+    pub const R0: usize = 2;
+    pub const R1: usize = 3;
 }
 
 /// What one pass did (bit `i` for lane `i`) and the data of the accepted steps.
@@ -104,75 +114,93 @@ pub(crate) struct StepOut {
     pub(crate) accepted: u32,
     /// Lanes whose trial step was not finite (rejected; `buf[T0]` holds their `t`).
     pub(crate) non_finite: u32,
+    /// Set by the caller: evaluate the events' lane forms at both ends of the accepted
+    /// steps (into the rows [`row::event`]).
+    pub(crate) want_events: bool,
+    /// Whether every event has a lane form and its values are in `buf` (when wanted and
+    /// some lane was accepted).
+    pub(crate) events: bool,
+    /// Bit `2e` (`2e + 1`): event `e`'s rate at the start (end) is in `buf`.
+    pub(crate) rates: u32,
     /// For accepted lanes: `t₀, t₁, h`, then `y₀, y₁, f₀, f₁` and the dense output's
     /// `r₂…r₅`, `M` rows each (see [`row`]). Allocated once per run.
     pub(crate) buf: Vec<[f64; 16]>,
 }
 
 impl StepOut {
-    pub(crate) fn new(m: usize) -> Self {
+    /// The output of a state of `m` components with `events` events.
+    pub(crate) fn new(m: usize, events: usize) -> Self {
         Self {
             too_small: 0,
             rejected: 0,
             accepted: 0,
             non_finite: 0,
-            buf: vec![[0.0; 16]; row::count(m)],
+            want_events: false,
+            events: false,
+            rates: 0,
+            buf: vec![[0.0; 16]; row::count(m) + 4 * events],
         }
     }
 }
 
 /// One pass of the lane loop in the instruction set `k.simd`.
 #[inline(never)]
-pub(crate) fn step<V: Lanes, D: LaneDynamics<M>, const M: usize>(
+pub(crate) fn step<V: Lanes, D: LaneDynamics<M>, E: EventSet<f64, M>, const M: usize>(
     st: &mut LaneState<V, D, M>,
     k: &StepConsts<M>,
+    events: &E,
     out: &mut StepOut,
 ) {
     #[cfg(target_arch = "x86_64")]
     match k.simd {
         Simd::Avx512 => {
             if let Some(v4) = pulp::x86::V4::try_new() {
-                return pulp::Simd::vectorize(v4, Pass { st, k, out });
+                return pulp::Simd::vectorize(v4, Pass { st, k, events, out });
             }
         }
         Simd::Avx2 => {
             if let Some(v3) = pulp::x86::V3::try_new() {
-                return pulp::Simd::vectorize(v3, Pass { st, k, out });
+                return pulp::Simd::vectorize(v3, Pass { st, k, events, out });
             }
         }
         _ => {}
     }
-    body(st, k, out)
+    body(st, k, events, out)
 }
 
 /// One pass, handed to `pulp` to be compiled with the instruction set's target features.
 #[cfg(target_arch = "x86_64")]
-struct Pass<'a, V: Lanes, D: LaneDynamics<M>, const M: usize> {
+struct Pass<'a, V: Lanes, D: LaneDynamics<M>, E, const M: usize> {
     st: &'a mut LaneState<V, D, M>,
     k: &'a StepConsts<M>,
+    events: &'a E,
     out: &'a mut StepOut,
 }
 
 #[cfg(target_arch = "x86_64")]
-impl<V: Lanes, D: LaneDynamics<M>, const M: usize> pulp::WithSimd for Pass<'_, V, D, M> {
+impl<V: Lanes, D: LaneDynamics<M>, E: EventSet<f64, M>, const M: usize> pulp::WithSimd
+    for Pass<'_, V, D, E, M>
+{
     type Output = ();
 
     #[inline(always)]
     fn with_simd<S: pulp::Simd>(self, _simd: S) {
-        body(self.st, self.k, self.out)
+        body(self.st, self.k, self.events, self.out)
     }
 }
 
 /// The six new stages of the trial step `hs` from `(t, st.y)` (ending at `t_new`), in one
 /// loop so that the right-hand side is inlined once instead of six times: the stage
-/// inputs are the scalar stepper's expressions, term for term. Returns the seven stages
-/// (the first is `st.f`) and the new state.
+/// inputs are the scalar stepper's expressions, term for term. Fills the seven stages
+/// `kk` (the first is `st.f`) and returns the new state (`kk` is the caller's: returning
+/// it would copy it twice).
 #[inline(always)]
 fn stages<V: Lanes, D: LaneDynamics<M>, const M: usize>(
     st: &LaneState<V, D, M>,
     k: &StepConsts<M>,
     (t, hs, t_new): (V, V, V),
-) -> ([[V; M]; 7], [V; M]) {
+    kk: &mut [[V; M]; 7],
+) -> [V; M] {
     let s = V::splat;
     let a21 = s(1.0 / 5.0);
     let [a31, a32] = tableau::A3.map(s);
@@ -182,7 +210,6 @@ fn stages<V: Lanes, D: LaneDynamics<M>, const M: usize>(
     let [a71, a73, a74, a75, a76] = tableau::B.map(s);
     let [c2, c3, c4, c5] = tableau::C.map(s);
     let (p, math, y, zero) = (&st.packed, k.math, st.y, s(0.0));
-    let mut kk = [[zero; M]; 7];
     kk[0] = st.f;
     let mut yn = y;
     // Stage 2's time terms; stages 3 to 6 compute theirs in the loop, stage 7 shares
@@ -199,33 +226,33 @@ fn stages<V: Lanes, D: LaneDynamics<M>, const M: usize>(
             }
             2 => {
                 for c in 0..M {
-                    ys[c] = y[c] + combo(&kk, &[(0, a31), (1, a32)], c) * hs;
+                    ys[c] = y[c] + combo(kk, &[(0, a31), (1, a32)], c) * hs;
                 }
                 t + c3 * hs
             }
             3 => {
                 for c in 0..M {
-                    ys[c] = y[c] + combo(&kk, &[(0, a41), (1, a42), (2, a43)], c) * hs;
+                    ys[c] = y[c] + combo(kk, &[(0, a41), (1, a42), (2, a43)], c) * hs;
                 }
                 t + c4 * hs
             }
             4 => {
                 for c in 0..M {
-                    ys[c] = y[c] + combo(&kk, &[(0, a51), (1, a52), (2, a53), (3, a54)], c) * hs;
+                    ys[c] = y[c] + combo(kk, &[(0, a51), (1, a52), (2, a53), (3, a54)], c) * hs;
                 }
                 t + c5 * hs
             }
             5 => {
                 let terms = [(0, a61), (1, a62), (2, a63), (3, a64), (4, a65)];
                 for c in 0..M {
-                    ys[c] = y[c] + combo(&kk, &terms, c) * hs;
+                    ys[c] = y[c] + combo(kk, &terms, c) * hs;
                 }
                 t_new
             }
             _ => {
                 let terms = [(0, a71), (2, a73), (3, a74), (4, a75), (5, a76)];
                 for c in 0..M {
-                    yn[c] = y[c] + combo(&kk, &terms, c) * hs;
+                    yn[c] = y[c] + combo(kk, &terms, c) * hs;
                 }
                 ys = yn;
                 t_new
@@ -234,11 +261,9 @@ fn stages<V: Lanes, D: LaneDynamics<M>, const M: usize>(
         if stage != 1 && stage != 6 {
             time = D::time_lanes(p, math, ts);
         }
-        let mut f = [zero; M];
-        D::rhs_lanes(p, math, ts, &time, &ys, &mut f);
-        kk[stage] = f;
+        D::rhs_lanes(p, math, ts, &time, &ys, &mut kk[stage]);
     }
-    (kk, yn)
+    yn
 }
 
 /// The error norm of the trial step ([`Tolerances::error_norm`](crate::integrate::Tolerances),
@@ -285,9 +310,10 @@ fn combo<V: Lanes, const M: usize>(k: &[[V; M]; 7], terms: &[(usize, V)], c: usi
 /// [`Dopri5`](crate::integrate::Dopri5) and its controller), the masked update of the
 /// accepted and rejected lanes, and the accepted lanes' step data in `out.buf`.
 #[inline(always)]
-fn body<V: Lanes, D: LaneDynamics<M>, const M: usize>(
+fn body<V: Lanes, D: LaneDynamics<M>, E: EventSet<f64, M>, const M: usize>(
     st: &mut LaneState<V, D, M>,
     k: &StepConsts<M>,
+    events: &E,
     out: &mut StepOut,
 ) {
     let s = V::splat;
@@ -306,6 +332,7 @@ fn body<V: Lanes, D: LaneDynamics<M>, const M: usize>(
     out.rejected = 0;
     out.accepted = 0;
     out.non_finite = 0;
+    out.events = false;
     let (t, y, h) = (st.t, st.y, st.h);
     // The trial step, cut to land on the lane's limit (clamp_to_limit).
     let rest = st.limit - t;
@@ -320,7 +347,8 @@ fn body<V: Lanes, D: LaneDynamics<M>, const M: usize>(
         return;
     }
     let t_new = lands.select(st.limit, t + hs);
-    let (kk, yn) = stages(st, k, (t, hs, t_new));
+    let mut kk = [[zero; M]; 7];
+    let yn = stages(st, k, (t, hs, t_new), &mut kk);
     let k1 = kk[0];
     let k7 = kk[6];
     let (err, finite) = error_norm(k, &kk, &y, &yn, hs);
@@ -373,4 +401,37 @@ fn body<V: Lanes, D: LaneDynamics<M>, const M: usize>(
             w.store(&mut out.buf[row::vector(q, M) + c]);
         }
     }
+    if out.want_events {
+        event_ends(events, out, (t, &y, &k1), (t_new, &yn, &k7));
+    }
+}
+
+/// Every event's value and rate at both ends of the step, from its lane form, into the
+/// rows [`row::event`]; `out.events` tells whether every event has one.
+#[inline(always)]
+fn event_ends<V: Lanes, E: EventSet<f64, M>, const M: usize>(
+    events: &E,
+    out: &mut StepOut,
+    (t0, y0, f0): (V, &[V; M], &[V; M]),
+    (t1, y1, f1): (V, &[V; M], &[V; M]),
+) {
+    out.rates = 0;
+    for e in 0..E::LEN {
+        let (Some((g0, r0)), Some((g1, r1))) =
+            (events.lanes(e, t0, y0, f0), events.lanes(e, t1, y1, f1))
+        else {
+            return;
+        };
+        g0.store(&mut out.buf[row::event(e, row::G0, M)]);
+        g1.store(&mut out.buf[row::event(e, row::G1, M)]);
+        if let Some(r0) = r0 {
+            r0.store(&mut out.buf[row::event(e, row::R0, M)]);
+            out.rates |= 1 << (2 * e);
+        }
+        if let Some(r1) = r1 {
+            r1.store(&mut out.buf[row::event(e, row::R1, M)]);
+            out.rates |= 1 << (2 * e + 1);
+        }
+    }
+    out.events = true;
 }
