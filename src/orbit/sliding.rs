@@ -589,26 +589,37 @@ impl<B, P> Problem<'_, B, P> {
             self.settings.xtol,
             self.settings.max_iterations,
         )?;
-        let tests = sliding_tests(
-            &mut sim,
-            self.settings.surface,
-            self.t0,
-            orbit.state,
-            orbit.period,
-        )?;
-        Ok(Evaluated {
-            point: SlidingBranchPoint {
-                p,
-                state: orbit.state,
-                period: orbit.period,
-                multipliers: orbit
-                    .monodromy
-                    .multipliers()
-                    .into_iter()
-                    .map(|m| Complex::new(m.re, m.im))
-                    .collect(),
-                tests,
-            },
+        let multipliers = orbit
+            .monodromy
+            .multipliers()
+            .into_iter()
+            .map(|m| Complex::new(m.re, m.im))
+            .collect();
+        let point = self.point_on(&mut sim, p, orbit.state, orbit.period, multipliers)?;
+        Ok(Evaluated { point })
+    }
+
+    /// The branch point at `p` on the orbit through `state` of period `period` of `sim`,
+    /// with its Floquet `multipliers`: its sliding tests evaluated.
+    fn point_on<Sys, St, const N: usize, const S: usize>(
+        &self,
+        sim: &mut FilippovSimulation<f64, Sys, St>,
+        p: f64,
+        state: SVector<f64, N>,
+        period: f64,
+        multipliers: Vec<Complex<f64>>,
+    ) -> Result<SlidingBranchPoint<N>>
+    where
+        Sys: Filippov<f64, N, S> + Clone,
+        St: Stepper<f64, N> + Clone,
+    {
+        let tests = sliding_tests(sim, self.settings.surface, self.t0, state, period)?;
+        Ok(SlidingBranchPoint {
+            p,
+            state,
+            period,
+            multipliers,
+            tests,
         })
     }
 
@@ -1010,29 +1021,6 @@ impl<B, P> Problem<'_, B, P> {
         }
     }
 
-    /// The branch point of a corrected point `c`: its orbit, multipliers and sliding tests.
-    fn branch_point<Sys, St, const N: usize, const S: usize>(
-        &self,
-        c: &ArcPoint<N>,
-    ) -> Result<SlidingBranchPoint<N>>
-    where
-        B: Fn(f64) -> Result<FilippovSimulation<f64, Sys, St>>,
-        P: Fn(f64) -> f64,
-        Sys: Filippov<f64, N, S> + Clone,
-        St: Stepper<f64, N> + Clone,
-    {
-        let mut sim = (self.build)(c.p)?;
-        let period = (self.period)(c.p);
-        let tests = sliding_tests(&mut sim, self.settings.surface, self.t0, c.x, period)?;
-        Ok(SlidingBranchPoint {
-            p: c.p,
-            state: c.x,
-            period,
-            multipliers: c.multipliers.clone(),
-            tests,
-        })
-    }
-
     /// Newton's method on `φ(x; p) − x = 0`, `τ·(z − z_pred) = 0` from the prediction
     /// `z_pred = z + σ τ`, then the tangent there.
     fn correct<Sys, St, const N: usize, const S: usize, const M: usize>(
@@ -1244,7 +1232,9 @@ where
         if next.p < settings.lo || next.p > settings.hi {
             break BranchEnd::ParameterRange;
         }
-        let b = problem.branch_point::<Sys, St, N, S>(&next)?;
+        let mut sim = build(next.p)?;
+        let multipliers = next.multipliers.clone();
+        let b = problem.point_on(&mut sim, next.p, next.x, period(next.p), multipliers)?;
         if next.tangent[N].signum() != current.tangent[N].signum() {
             let fold = problem.locate_fold::<Sys, St, N, S, M>(&current, &next, ds, tol)?;
             folds.push(SlidingFold {
