@@ -154,15 +154,7 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, E: EventSet<T, N>, D: DenseOutp
         let mut t_lo = scan.t0;
         let mut y_lo = scan.y0;
         loop {
-            let mut best: Option<(usize, Crossing<T>)> = None;
-            for (i, f) in scan.found.iter().enumerate().take(n_ev) {
-                if let Some(c) = f {
-                    if best.is_none_or(|(_, b)| c.t < b.t) {
-                        best = Some((i, *c));
-                    }
-                }
-            }
-            let Some((i, c)) = best else {
+            let Some((i, c)) = scan.earliest(n_ev) else {
                 return Ok(Crossings::Through(t_lo, y_lo));
             };
             // Where the scan of event i resumes (None: no further crossing this step).
@@ -196,23 +188,7 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, E: EventSet<T, N>, D: DenseOutp
             } else {
                 Direction::Falling
             };
-            self.stats.events += 1;
-            if let Some((count, last)) = self.history.push(tc, self.zeno) {
-                // Leave the simulation at the event (after its reset) so that the
-                // caller can change the model and continue from there.
-                let mut ya = yc;
-                if self.events.resets(i) {
-                    self.events.apply_reset(i, tc, &mut ya);
-                }
-                *self.restart = Some((tc, ya));
-                return Err(EventError::Zeno {
-                    t: to_f64(tc),
-                    count,
-                    last_interval: to_f64(last),
-                    state: ya.iter().map(|&v| to_f64(v)).collect(),
-                }
-                .into());
-            }
+            self.count_event(i, tc, &yc)?;
             let terminal = self.events.is_terminal(i);
             if self.events.resets(i) {
                 let stop_ev = self.impact(i, (tc, &yc), c.rising, sides, observer)?;
@@ -249,6 +225,28 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, E: EventSet<T, N>, D: DenseOutp
             t_lo = tc;
             y_lo = yc;
         }
+    }
+
+    /// Counts event `i` at `(tc, yc)` in the history; when the Zeno guard trips, leaves the
+    /// simulation at the event (after its reset, so that the caller can change the model
+    /// and continue from there) and returns [`EventError::Zeno`].
+    fn count_event(&mut self, i: usize, tc: T, yc: &SVector<T, N>) -> Result<()> {
+        self.stats.events += 1;
+        let Some((count, last)) = self.history.push(tc, self.zeno) else {
+            return Ok(());
+        };
+        let mut ya = *yc;
+        if self.events.resets(i) {
+            self.events.apply_reset(i, tc, &mut ya);
+        }
+        *self.restart = Some((tc, ya));
+        Err(EventError::Zeno {
+            t: to_f64(tc),
+            count,
+            last_interval: to_f64(last),
+            state: ya.iter().map(|&v| to_f64(v)).collect(),
+        }
+        .into())
     }
 
     /// The crossing of resetting event `i` at `(tc, yc)` (`rising` its direction): its
@@ -618,6 +616,22 @@ struct StepScan<T: Real, const N: usize> {
     g_end: [T; MAX_EVENTS],
     r_end: [Option<T>; MAX_EVENTS],
     found: [Option<Crossing<T>>; MAX_EVENTS],
+}
+
+impl<T: Real, const N: usize> StepScan<T, N> {
+    /// The earliest crossing found among the first `n` events, with its event's index (the
+    /// lowest index among equal times).
+    fn earliest(&self, n: usize) -> Option<(usize, Crossing<T>)> {
+        let mut best: Option<(usize, Crossing<T>)> = None;
+        for (i, f) in self.found.iter().enumerate().take(n) {
+            if let Some(c) = f {
+                if best.is_none_or(|(_, b)| c.t < b.t) {
+                    best = Some((i, *c));
+                }
+            }
+        }
+        best
+    }
 }
 
 /// How a step's crossings ended.

@@ -143,7 +143,7 @@ pub struct TurningPoints<T: Real, St: Stepper<T, 2>, Sg: Stepper<T, 2>> {
     onset_band: Option<T>,
     mode: Mode<T>,
     /// The rest of a velocity segment step after `ẋ = 0`, to report next.
-    pending: Option<Pending<T>>,
+    pending: Option<SegmentEnd<T>>,
     t: T,
     y: SVector<T, 2>,
     dense: TurningDense<T, St::Dense, Sg::Dense>,
@@ -235,6 +235,20 @@ impl<T: Real> Kind<T> {
         }
     }
 
+    /// `ẍ` at `s` from the segment's rates where `dτ/ds ≠ 0`: `ẋ = v`, `dz₁/ds = dz1` and
+    /// `dτ/ds = dtau` (the inverse of [`rates`](Self::rates): `ẍ = σ·ẋ'(u)/(dτ/ds)` for a
+    /// velocity segment, `(dẋ/ds)/(dτ/ds)` for a contact one).
+    #[inline(always)]
+    fn acceleration(&self, s: T, v: T, dz1: T, dtau: T) -> T {
+        match *self {
+            Kind::Velocity { sigma, p } => {
+                let au = (sigma * s).abs();
+                lit::<T>(f64::from(p)) * v.abs() / au * sigma / dtau
+            }
+            Kind::Contact { .. } => dz1 / dtau,
+        }
+    }
+
     fn is_contact(&self) -> bool {
         matches!(self, Kind::Contact { .. })
     }
@@ -254,10 +268,11 @@ struct Segment<T> {
     kind: Kind<T>,
 }
 
-/// The end of a segment step across `ẋ = 0` whose part after `ẋ = 0` is still to be
-/// reported (the step itself is accepted and its dense output kept).
+/// The end of a segment step: `s`, the segment state `z` and `dz/ds` there. Kept for a step
+/// across `ẋ = 0` whose part after `ẋ = 0` is still to be reported (the step itself is
+/// accepted and its dense output kept).
 #[derive(Debug, Clone, Copy)]
-struct Pending<T> {
+struct SegmentEnd<T> {
     s: T,
     z: Vector2<T>,
     dz: Vector2<T>,
@@ -624,9 +639,115 @@ where
         Ok(())
     }
 
+    /// `f(t, y)` at the current point: the reported step's end derivative if that step ended
+    /// here, else an evaluation.
+    fn current_derivative<S: Dynamics<T, 2>>(&mut self, sys: &S) -> SVector<T, 2> {
+        let (t, y) = (self.t, self.y);
+        let ends = &self.dense.ends;
+        if ends.span().1 == t && *ends.endpoints().1 == y {
+            *ends.end_derivatives().1
+        } else {
+            self.eval(sys, t, &y)
+        }
+    }
+
+    /// Steps segment `g` in `s` until its time passes `t_a` (a step below the resolution of
+    /// `t` is followed by the next): the step's start `s_a` and its end, the segment
+    /// stepper's dense output kept. `None` if the segment was left at `(t_a, y_a)` instead:
+    /// abandoned (a failed step, too many steps, `τ(s)` not monotone, a non-finite state),
+    /// or finished below the resolution of `t`.
+    fn next_segment_step<S: Dynamics<T, 2>>(
+        &mut self,
+        sys: &S,
+        g: &mut Segment<T>,
+        t_a: T,
+        y_a: SVector<T, 2>,
+    ) -> Option<(T, SegmentEnd<T>)> {
+        loop {
+            let (s_a, z_a) = (self.seg.current().0, *self.seg.current().1);
+            let r = Reparam {
+                sys,
+                t0: g.t0,
+                scale: g.scale,
+                kind: g.kind,
+            };
+            g.steps += 1;
+            if g.steps > MAX_SEGMENT_STEPS || self.seg.step(&r, g.s_end).is_err() {
+                self.leave(g, t_a, y_a, true);
+                return None;
+            }
+            let (s_b, z_b) = (self.seg.current().0, *self.seg.current().1);
+            let dz_b = *self.seg.dense().end_derivatives().1;
+            let y_end = g.kind.state(s_b, &z_b);
+            // dτ/ds > 0 except where the scale's derivative vanishes (u = 0, w = 0);
+            // a sign change means that a (or ẋ) changed sign. θ may stand still in
+            // floating point next to u = 0 (it grows like |u|^p there).
+            let monotone = z_b[0] >= z_a[0] && dz_b[0] >= T::zero();
+            if !(monotone && y_end[0].is_finite() && y_end[1].is_finite()) {
+                self.leave(g, t_a, y_a, true);
+                return None;
+            }
+            if !(g.t0 + g.scale * z_b[0] > t_a) {
+                // Below the resolution of t: step on in s.
+                if s_b >= g.s_end {
+                    self.leave(g, t_a, y_a, false);
+                    return None;
+                }
+                continue;
+            }
+            self.dense.seg = self.seg.dense().clone();
+            return Some((
+                s_a,
+                SegmentEnd {
+                    s: s_b,
+                    z: z_b,
+                    dz: dz_b,
+                },
+            ));
+        }
+    }
+
+    /// The end of the part to report of a velocity step of segment `g` from `s_a < 0` (time
+    /// `t_a`) to `end` (`s > 0`): `ẋ = 0` (`s = 0`), keeping `end` to report next, unless
+    /// `ẋ = 0` falls on the step's ends in `t`; else `end`.
+    ///
+    /// A velocity step across `ẋ = 0` is reported in two parts, so that no reported step
+    /// has `ẋ` changing sign inside it: observers that look for an interior extremum of `x`
+    /// (inverting `τ(s)` at every trial point) find it at the end of the first part.
+    fn split_at_turn(&mut self, g: &Segment<T>, t_a: T, end: SegmentEnd<T>) -> SegmentEnd<T> {
+        let mut z0 = SVector::zeros();
+        self.dense.seg.interpolate_unchecked(T::zero(), &mut z0);
+        let t0 = g.t0 + g.scale * z0[0];
+        if !(t0 > t_a && t0 < g.t0 + g.scale * end.z[0]) {
+            return end;
+        }
+        self.pending = Some(end);
+        SegmentEnd {
+            s: T::zero(),
+            z: z0,
+            // dτ/ds = 0 at u = 0: ẍ comes from an evaluation below.
+            dz: SVector::zeros(),
+        }
+    }
+
+    /// Cuts the step of segment `g` being reported at `τ = t_limit − t₀`: the state there.
+    /// The segment goes on from there (its stepper restarts at the cut, nothing is pending).
+    fn cut_at(&mut self, g: &Segment<T>, t_limit: T) -> Vector2<T> {
+        let target = (t_limit - g.t0) / g.scale;
+        let s_c = self.dense.invert(target);
+        let mut z_c = SVector::zeros();
+        self.dense.seg.interpolate_unchecked(s_c, &mut z_c);
+        z_c[0] = target;
+        let y_c = g.kind.state(s_c, &z_c);
+        self.dense.s1 = s_c;
+        self.seg.reset_state(s_c, z_c);
+        self.pending = None;
+        y_c
+    }
+
     /// One accepted step of the segment, or the part of it after `ẋ = 0` (see
-    /// [`Pending`]). Returns `false` if the segment was left before a step was reported
-    /// (abandoned, or finished below the resolution of `t`).
+    /// [`split_at_turn`](Self::split_at_turn)). Returns `false` if the segment was left
+    /// before a step was reported (abandoned, or finished below the resolution of `t`).
     fn segment_step<S: Dynamics<T, 2>>(
         &mut self,
         sys: &S,
@@ -634,105 +755,42 @@ where
         mut g: Segment<T>,
     ) -> Result<bool, IntegrateError> {
         let (t_a, y_a) = (self.t, self.y);
-        let ends = &self.dense.ends;
-        let f_a = if ends.span().1 == t_a && *ends.endpoints().1 == y_a {
-            *ends.end_derivatives().1
-        } else {
-            self.eval(sys, t_a, &y_a)
-        };
-        let (s_a, mut s_b, mut z_b, mut dz_b) = match self.pending.take() {
+        let f_a = self.current_derivative(sys);
+        let (s_a, mut end) = match self.pending.take() {
             // The rest of the step already taken, from ẋ = 0 on.
-            Some(p) => (T::zero(), p.s, p.z, p.dz),
-            None => loop {
-                let (s_a, z_a) = (self.seg.current().0, *self.seg.current().1);
-                let r = Reparam {
-                    sys,
-                    t0: g.t0,
-                    scale: g.scale,
-                    kind: g.kind,
-                };
-                g.steps += 1;
-                if g.steps > MAX_SEGMENT_STEPS || self.seg.step(&r, g.s_end).is_err() {
-                    self.leave(&g, t_a, y_a, true);
-                    return Ok(false);
-                }
-                let (s_b, z_b) = (self.seg.current().0, *self.seg.current().1);
-                let dz_b = *self.seg.dense().end_derivatives().1;
-                let y_end = g.kind.state(s_b, &z_b);
-                // dτ/ds > 0 except where the scale's derivative vanishes (u = 0, w = 0);
-                // a sign change means that a (or ẋ) changed sign. θ may stand still in
-                // floating point next to u = 0 (it grows like |u|^p there).
-                let monotone = z_b[0] >= z_a[0] && dz_b[0] >= T::zero();
-                if !(monotone && y_end[0].is_finite() && y_end[1].is_finite()) {
-                    self.leave(&g, t_a, y_a, true);
-                    return Ok(false);
-                }
-                if !(g.t0 + g.scale * z_b[0] > t_a) {
-                    // Below the resolution of t: step on in s.
-                    if s_b >= g.s_end {
-                        self.leave(&g, t_a, y_a, false);
-                        return Ok(false);
-                    }
-                    continue;
-                }
-                self.dense.seg = self.seg.dense().clone();
-                break (s_a, s_b, z_b, dz_b);
+            Some(p) => (T::zero(), p),
+            None => match self.next_segment_step(sys, &mut g, t_a, y_a) {
+                Some(step) => step,
+                None => return Ok(false),
             },
         };
         self.dense.kind = Some(g.kind);
         self.dense.t_seg = g.t0;
         self.dense.scale = g.scale;
         self.dense.s0 = s_a;
-        // A velocity step across ẋ = 0 is reported in two parts, so that no reported step
-        // has ẋ changing sign inside it: observers that look for an interior extremum of x
-        // (inverting τ(s) at every trial point) find it at the end of the first part.
         if let Kind::Velocity { .. } = g.kind
             && s_a < T::zero()
-            && s_b > T::zero()
+            && end.s > T::zero()
         {
-            let mut z0 = SVector::zeros();
-            self.dense.seg.interpolate_unchecked(T::zero(), &mut z0);
-            let t0 = g.t0 + g.scale * z0[0];
-            if t0 > t_a && t0 < g.t0 + g.scale * z_b[0] {
-                self.pending = Some(Pending {
-                    s: s_b,
-                    z: z_b,
-                    dz: dz_b,
-                });
-                (s_b, z_b) = (T::zero(), z0);
-                // dτ/ds = 0 at u = 0: ẍ comes from an evaluation below.
-                dz_b = SVector::zeros();
-            }
+            end = self.split_at_turn(&g, t_a, end);
         }
+        let SegmentEnd {
+            s: s_b,
+            z: z_b,
+            dz: dz_b,
+        } = end;
         let dtau_b = dz_b[0] * g.scale;
         let mut t_b = g.t0 + g.scale * z_b[0];
         let mut y_b = g.kind.state(s_b, &z_b);
         self.dense.s1 = s_b;
-        let mut cut = false;
-        if t_b > t_limit {
-            // Cut at τ = t_limit − t₀; the segment goes on from there.
-            let target = (t_limit - g.t0) / g.scale;
-            let s_c = self.dense.invert(target);
-            let mut z_c = SVector::zeros();
-            self.dense.seg.interpolate_unchecked(s_c, &mut z_c);
-            z_c[0] = target;
-            y_b = g.kind.state(s_c, &z_c);
+        let cut = t_b > t_limit;
+        if cut {
+            y_b = self.cut_at(&g, t_limit);
             t_b = t_limit;
-            self.dense.s1 = s_c;
-            self.seg.reset_state(s_c, z_c);
-            self.pending = None;
-            cut = true;
         }
         // ẍ from the step's last stage where dτ/ds ≠ 0.
         let f_b = if !cut && dtau_b != T::zero() {
-            let a = match g.kind {
-                Kind::Velocity { sigma, p } => {
-                    let au = (sigma * s_b).abs();
-                    lit::<T>(f64::from(p)) * y_b[1].abs() / au * sigma / dtau_b
-                }
-                Kind::Contact { .. } => dz_b[1] / dtau_b,
-            };
-            Vector2::new(y_b[1], a)
+            Vector2::new(y_b[1], g.kind.acceleration(s_b, y_b[1], dz_b[1], dtau_b))
         } else {
             self.eval(sys, t_b, &y_b)
         };

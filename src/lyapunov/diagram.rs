@@ -231,6 +231,62 @@ where
     St: Stepper<T, M> + Clone + Send + Sync,
     F: Fn(T) -> Result<S> + Sync,
 {
+    check_diagram::<T, N, M>(values, d0, &norm, settings)?;
+    let branch = |dir: DiagramDirection| -> Result<Vec<DiagramPoint<T>>> {
+        let mut out = Vec::with_capacity(values.len());
+        let mut est: Option<TwoTrajectory<T, N, M, S, St>> = None;
+        for i in 0..values.len() {
+            let p = match dir {
+                DiagramDirection::Increasing => values[i],
+                DiagramDirection::Decreasing => values[values.len() - 1 - i],
+            };
+            let system = make(p)?;
+            let tau = settings.interval.interval(p)?;
+            let point = match est.as_mut() {
+                None => {
+                    let mut e = TwoTrajectory::new(system, stepper.clone(), d0, norm)?
+                        .with_blocks(settings.blocks)?;
+                    e.start(settings.t0, y0)?;
+                    let point = measure(&mut e, p, tau, settings.first_transient, settings)?;
+                    est = Some(e);
+                    point
+                }
+                // From the previous value's end state, reference and perturbation.
+                Some(e) => {
+                    e.set_system(system);
+                    e.set_time(settings.t0)?;
+                    measure(e, p, tau, settings.step_transient, settings)?
+                }
+            };
+            out.push(point);
+        }
+        Ok(out)
+    };
+    #[cfg(feature = "parallel")]
+    let (up, down) = rayon::join(
+        || branch(DiagramDirection::Increasing),
+        || branch(DiagramDirection::Decreasing),
+    );
+    #[cfg(not(feature = "parallel"))]
+    let (up, down) = (
+        branch(DiagramDirection::Increasing),
+        branch(DiagramDirection::Decreasing),
+    );
+    Ok(Diagram {
+        increasing: up?,
+        decreasing: down?,
+    })
+}
+
+/// Checks the inputs of [`tle_diagram`], everything that can be checked before spending
+/// time on a branch: the values (at least one, finite, `> 0` with
+/// [`IntervalRule::ForcingPeriod`]), the schedule and the pair's `d0` and norm.
+fn check_diagram<T: Real, const N: usize, const M: usize>(
+    values: &[T],
+    d0: T,
+    norm: &Norm<T, N>,
+    settings: &DiagramSettings<T>,
+) -> Result<()> {
     if values.is_empty() {
         return Err(LyapunovError::NoParameters);
     }
@@ -256,62 +312,31 @@ where
             value: to_f64(settings.t0),
         });
     }
-    // Validate everything that can be validated before spending time on a branch.
-    super::two_trajectory::check_pair_settings::<T, N, M>(d0, &norm)?;
+    super::two_trajectory::check_pair_settings::<T, N, M>(d0, norm)
+}
 
-    let branch = |dir: DiagramDirection| -> Result<Vec<DiagramPoint<T>>> {
-        let mut out = Vec::with_capacity(values.len());
-        let mut est: Option<TwoTrajectory<T, N, M, S, St>> = None;
-        for i in 0..values.len() {
-            let p = match dir {
-                DiagramDirection::Increasing => values[i],
-                DiagramDirection::Decreasing => values[values.len() - 1 - i],
-            };
-            let system = make(p)?;
-            let tau = settings.interval.interval(p)?;
-            let e = match est.as_mut() {
-                None => {
-                    let mut e = TwoTrajectory::new(system, stepper.clone(), d0, norm)?
-                        .with_blocks(settings.blocks)?;
-                    e.start(settings.t0, y0)?;
-                    let s0 = *e.stepper().stats();
-                    e.transient(tau, settings.first_transient)?;
-                    let r = e.estimate(tau, settings.intervals)?;
-                    let stats = e.stepper().stats().since(&s0);
-                    est = Some(e);
-                    (r, stats)
-                }
-                Some(e) => {
-                    e.set_system(system);
-                    e.set_time(settings.t0)?;
-                    let s0 = *e.stepper().stats();
-                    e.transient(tau, settings.step_transient)?;
-                    let r = e.estimate(tau, settings.intervals)?;
-                    (r, e.stepper().stats().since(&s0))
-                }
-            };
-            out.push(DiagramPoint {
-                parameter: p,
-                exponent: e.0.exponent,
-                spread: e.0.spread,
-                stats: e.1,
-            });
-        }
-        Ok(out)
-    };
-    #[cfg(feature = "parallel")]
-    let (up, down) = rayon::join(
-        || branch(DiagramDirection::Increasing),
-        || branch(DiagramDirection::Decreasing),
-    );
-    #[cfg(not(feature = "parallel"))]
-    let (up, down) = (
-        branch(DiagramDirection::Increasing),
-        branch(DiagramDirection::Decreasing),
-    );
-    Ok(Diagram {
-        increasing: up?,
-        decreasing: down?,
+/// The point at `p` of a started estimator `e`: `transient` intervals `tau` discarded,
+/// then `settings.intervals` averaged; its work counts both.
+fn measure<T, const N: usize, const M: usize, S, St>(
+    e: &mut TwoTrajectory<T, N, M, S, St>,
+    p: T,
+    tau: T,
+    transient: usize,
+    settings: &DiagramSettings<T>,
+) -> Result<DiagramPoint<T>>
+where
+    T: Real,
+    S: Dynamics<T, N>,
+    St: Stepper<T, M>,
+{
+    let s0 = *e.stepper().stats();
+    e.transient(tau, transient)?;
+    let r = e.estimate(tau, settings.intervals)?;
+    Ok(DiagramPoint {
+        parameter: p,
+        exponent: r.exponent,
+        spread: r.spread,
+        stats: e.stepper().stats().since(&s0),
     })
 }
 

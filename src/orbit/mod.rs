@@ -312,30 +312,16 @@ where
             let jac = phi - SMatrix::<T, N, N>::identity();
             let lu = Lu::new(jac).ok_or(OrbitError::Singular { iteration })?;
             let delta = lu.solve(&(-residual));
-            // Backtracking on ‖P(y) − y‖: the full step, halved while the residual grows.
-            let mut lambda = T::one();
-            let mut accepted = None;
-            for _ in 0..12 {
+            let accepted = backtrack(residual.amax(), |lambda| {
                 let trial = y + delta * lambda;
-                if let Ok((p_t, phi_t)) = self.flow(t0, trial, period) {
-                    let r_t = p_t - trial;
-                    if r_t.amax() < residual.amax() || lambda < lit(1e-3) {
-                        accepted = Some((trial, phi_t, r_t));
-                        break;
-                    }
-                }
-                lambda *= lit(0.5);
-            }
+                let (p_t, phi_t) = self.flow(t0, trial, period).ok()?;
+                let r_t = p_t - trial;
+                Some(((trial, phi_t, r_t), r_t.amax()))
+            });
             let Some((trial, phi_t, r_t)) = accepted else {
                 break;
             };
-            let taken = trial - y;
-            step = (0..N)
-                .map(|i| {
-                    let scale = self.tolerances.atol[i] + self.tolerances.rtol[i] * trial[i].abs();
-                    to_f64(taken[i].abs() / scale)
-                })
-                .fold(0.0, f64::max);
+            step = self.step_in_tolerances(&y, &trial);
             y = trial;
             phi = phi_t;
             residual = r_t;
@@ -391,66 +377,27 @@ where
         }
         check_period(period)?;
         let h = period / lit(m as f64);
-        let start = |i: usize| t0 + h * lit(i as f64);
-        // Every segment's end state and Jacobian, and the mismatches φᵢ(yᵢ) − yᵢ₊₁.
-        type Segments<T, const N: usize> = (Vec<SMatrix<T, N, N>>, Vec<SVector<T, N>>);
-        let segments = |ys: &[SVector<T, N>]| -> Result<Segments<T, N>> {
-            let mut phis = Vec::with_capacity(m);
-            let mut residuals = Vec::with_capacity(m);
-            for i in 0..m {
-                let (p, phi) = self.flow(start(i), ys[i], h)?;
-                phis.push(phi);
-                residuals.push(p - ys[(i + 1) % m]);
-            }
-            Ok((phis, residuals))
-        };
-        let largest = |r: &[SVector<T, N>]| r.iter().map(|v| v.amax()).fold(T::zero(), T::max);
         let mut ys = guesses.to_vec();
-        let (mut phis, mut residuals) = segments(&ys)?;
+        let (mut phis, mut residuals) = self.segments(t0, h, &ys)?;
         let mut step = f64::INFINITY;
         for iteration in 0..self.max_iterations {
-            let size = m * N;
-            let mut jac = DMatrix::<T>::zeros(size, size);
-            let mut rhs = nalgebra::DVector::<T>::zeros(size);
-            for i in 0..m {
-                let next = (i + 1) % m;
-                for r in 0..N {
-                    rhs[i * N + r] = -residuals[i][r];
-                    for c in 0..N {
-                        jac[(i * N + r, i * N + c)] += phis[i][(r, c)];
-                    }
-                    jac[(i * N + r, next * N + r)] -= T::one();
-                }
-            }
-            let delta = jac
-                .lu()
-                .solve(&rhs)
-                .ok_or(OrbitError::Singular { iteration })?;
-            let before = largest(&residuals);
-            let mut lambda = T::one();
-            let mut accepted = None;
-            for _ in 0..12 {
+            let delta =
+                cyclic_newton_step(&phis, &residuals).ok_or(OrbitError::Singular { iteration })?;
+            let accepted = backtrack(largest_mismatch(&residuals), |lambda| {
                 let trial: Vec<SVector<T, N>> = (0..m)
                     .map(|i| ys[i] + delta.fixed_rows::<N>(i * N) * lambda)
                     .collect();
-                if let Ok((phis_t, r_t)) = segments(&trial) {
-                    if largest(&r_t) < before || lambda < lit(1e-3) {
-                        accepted = Some((trial, phis_t, r_t));
-                        break;
-                    }
-                }
-                lambda *= lit(0.5);
-            }
+                let (phis_t, r_t) = self.segments(t0, h, &trial).ok()?;
+                let mismatch = largest_mismatch(&r_t);
+                Some(((trial, phis_t, r_t), mismatch))
+            });
             let Some((trial, phis_t, r_t)) = accepted else {
                 break;
             };
-            step = (0..m)
-                .flat_map(|i| (0..N).map(move |c| (i, c)))
-                .map(|(i, c)| {
-                    let scale =
-                        self.tolerances.atol[c] + self.tolerances.rtol[c] * trial[i][c].abs();
-                    to_f64((trial[i][c] - ys[i][c]).abs() / scale)
-                })
+            step = ys
+                .iter()
+                .zip(&trial)
+                .map(|(y, trial)| self.step_in_tolerances(y, trial))
                 .fold(0.0, f64::max);
             ys = trial;
             phis = phis_t;
@@ -466,16 +413,90 @@ where
                     monodromy,
                     multipliers: multipliers(&monodromy),
                     iterations: iteration + 1,
-                    residual: largest(&residuals),
+                    residual: largest_mismatch(&residuals),
                 });
             }
         }
         Err(OrbitError::NotConverged {
             iterations: self.max_iterations,
             step,
-            residual: to_f64(largest(&residuals)),
+            residual: to_f64(largest_mismatch(&residuals)),
         })
     }
+
+    /// The segments of multiple shooting from the starts `ys` at `t₀ + i·h`: each one's
+    /// Jacobian `Φᵢ` and mismatch `φᵢ(yᵢ) − y₍ᵢ₊₁₎ mod m`.
+    fn segments(&self, t0: T, h: T, ys: &[SVector<T, N>]) -> Result<Segments<T, N>> {
+        let m = ys.len();
+        let mut phis = Vec::with_capacity(m);
+        let mut residuals = Vec::with_capacity(m);
+        for i in 0..m {
+            let (p, phi) = self.flow(t0 + h * lit(i as f64), ys[i], h)?;
+            phis.push(phi);
+            residuals.push(p - ys[(i + 1) % m]);
+        }
+        Ok((phis, residuals))
+    }
+
+    /// The largest component of the step from `y` to `trial` in units of the state's
+    /// integration tolerance `atol_i + rtol_i·|trialᵢ|` (Newton's convergence measure).
+    fn step_in_tolerances(&self, y: &SVector<T, N>, trial: &SVector<T, N>) -> f64 {
+        let taken = trial - y;
+        (0..N)
+            .map(|i| {
+                let scale = self.tolerances.atol[i] + self.tolerances.rtol[i] * trial[i].abs();
+                to_f64(taken[i].abs() / scale)
+            })
+            .fold(0.0, f64::max)
+    }
+}
+
+/// The Jacobians `Φᵢ` and mismatches of the segments of multiple shooting.
+type Segments<T, const N: usize> = (Vec<SMatrix<T, N, N>>, Vec<SVector<T, N>>);
+
+/// The largest mismatch of the segments of multiple shooting.
+fn largest_mismatch<T: Real, const N: usize>(residuals: &[SVector<T, N>]) -> T {
+    residuals.iter().map(|v| v.amax()).fold(T::zero(), T::max)
+}
+
+/// Newton's step for multiple shooting: the solution `Δy` of the block-cyclic system
+/// `Φᵢ·Δyᵢ − Δy₍ᵢ₊₁₎ mod m = −rᵢ` (`Φᵢ` on the diagonal, `−I` right of it and in the
+/// top-right corner for the closing segment), `None` if it is singular.
+fn cyclic_newton_step<T: Real, const N: usize>(
+    phis: &[SMatrix<T, N, N>],
+    residuals: &[SVector<T, N>],
+) -> Option<nalgebra::DVector<T>> {
+    let m = phis.len();
+    let size = m * N;
+    let mut jac = DMatrix::<T>::zeros(size, size);
+    let mut rhs = nalgebra::DVector::<T>::zeros(size);
+    for i in 0..m {
+        let next = (i + 1) % m;
+        for r in 0..N {
+            rhs[i * N + r] = -residuals[i][r];
+            for c in 0..N {
+                jac[(i * N + r, i * N + c)] += phis[i][(r, c)];
+            }
+            jac[(i * N + r, next * N + r)] -= T::one();
+        }
+    }
+    jac.lu().solve(&rhs)
+}
+
+/// Backtracking on the largest mismatch: the Newton step scaled by `λ = 1, ½, ¼, …` (at
+/// most 12 trials) until a trial's mismatch is below `before`, or any trial once
+/// `λ < 10⁻³`. `trial(λ)` returns the trial with its mismatch, `None` if its run failed.
+fn backtrack<T: Real, X>(before: T, mut trial: impl FnMut(T) -> Option<(X, T)>) -> Option<X> {
+    let mut lambda = T::one();
+    for _ in 0..12 {
+        if let Some((x, mismatch)) = trial(lambda)
+            && (mismatch < before || lambda < lit(1e-3))
+        {
+            return Some(x);
+        }
+        lambda *= lit(0.5);
+    }
+    None
 }
 
 /// A shooting period must be finite and `> 0`.

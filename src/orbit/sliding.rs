@@ -589,26 +589,37 @@ impl<B, P> Problem<'_, B, P> {
             self.settings.xtol,
             self.settings.max_iterations,
         )?;
-        let tests = sliding_tests(
-            &mut sim,
-            self.settings.surface,
-            self.t0,
-            orbit.state,
-            orbit.period,
-        )?;
-        Ok(Evaluated {
-            point: SlidingBranchPoint {
-                p,
-                state: orbit.state,
-                period: orbit.period,
-                multipliers: orbit
-                    .monodromy
-                    .multipliers()
-                    .into_iter()
-                    .map(|m| Complex::new(m.re, m.im))
-                    .collect(),
-                tests,
-            },
+        let multipliers = orbit
+            .monodromy
+            .multipliers()
+            .into_iter()
+            .map(|m| Complex::new(m.re, m.im))
+            .collect();
+        let point = self.point_on(&mut sim, p, orbit.state, orbit.period, multipliers)?;
+        Ok(Evaluated { point })
+    }
+
+    /// The branch point at `p` on the orbit through `state` of period `period` of `sim`,
+    /// with its Floquet `multipliers`: its sliding tests evaluated.
+    fn point_on<Sys, St, const N: usize, const S: usize>(
+        &self,
+        sim: &mut FilippovSimulation<f64, Sys, St>,
+        p: f64,
+        state: SVector<f64, N>,
+        period: f64,
+        multipliers: Vec<Complex<f64>>,
+    ) -> Result<SlidingBranchPoint<N>>
+    where
+        Sys: Filippov<f64, N, S> + Clone,
+        St: Stepper<f64, N> + Clone,
+    {
+        let tests = sliding_tests(sim, self.settings.surface, self.t0, state, period)?;
+        Ok(SlidingBranchPoint {
+            p,
+            state,
+            period,
+            multipliers,
+            tests,
         })
     }
 
@@ -891,6 +902,39 @@ struct ArcPoint<const N: usize> {
     multipliers: Vec<Complex<f64>>,
 }
 
+/// The arclength step `Δs` of [`follow_sliding_arclength`]: `|step|` at first, halved when
+/// the corrector fails (down to `10⁻⁴|step|`), grown by 1.5 after a corrector of at most 3
+/// iterations (up to `4|step|`).
+struct ArcStep {
+    ds: f64,
+    min: f64,
+    max: f64,
+}
+
+impl ArcStep {
+    fn new(step: f64) -> Self {
+        Self {
+            ds: step.abs(),
+            min: 1e-4 * step.abs(),
+            max: 4.0 * step.abs(),
+        }
+    }
+
+    /// Halves the step after a failed corrector; `false` if it fell below the smallest (the
+    /// branch ends).
+    fn halve(&mut self) -> bool {
+        self.ds *= 0.5;
+        !(self.ds < self.min)
+    }
+
+    /// Grows the step after a corrector of `iterations` if that was at most 3.
+    fn grow(&mut self, iterations: usize) {
+        if iterations <= 3 {
+            self.ds = (self.ds * 1.5).min(self.max);
+        }
+    }
+}
+
 impl<B, P> Problem<'_, B, P> {
     /// The period map's residual `φ(x; p) − x`, its Jacobian `[Φ − I, ∂φ/∂p]` (`∂φ/∂p` by a
     /// central difference in `p`, the period `period(p)` included) and the multipliers.
@@ -948,6 +992,33 @@ impl<B, P> Problem<'_, B, P> {
         let t = a.lu().solve(&rhs)?;
         let n = t.norm();
         (n.is_finite() && n > 0.0).then(|| t / n)
+    }
+
+    /// The unit tangent at the first orbit `x` at `p`, oriented to the settings' step in
+    /// `p` (increasing `p` for `step > 0`).
+    ///
+    /// # Errors
+    /// Those of [`residual`](Self::residual); [`FilippovError::Singular`](
+    /// crate::filippov::FilippovError::Singular) without a tangent.
+    fn first_tangent<Sys, St, const N: usize, const S: usize, const M: usize>(
+        &self,
+        x: &SVector<f64, N>,
+        p: f64,
+        tol: Tolerances<f64, M>,
+    ) -> Result<nalgebra::DVector<f64>>
+    where
+        B: Fn(f64) -> Result<FilippovSimulation<f64, Sys, St>>,
+        P: Fn(f64) -> f64,
+        Sys: Filippov<f64, N, S>,
+        St: Stepper<f64, N>,
+    {
+        let (_, j, _) = self.residual::<Sys, St, N, S, M>(x, p, tol)?;
+        let mut along_p = nalgebra::DVector::<f64>::zeros(N + 1);
+        along_p[N] = self.settings.step.signum();
+        match Self::tangent::<N>(&j, &along_p) {
+            Some(tangent) => Ok(tangent),
+            None => Err(crate::filippov::FilippovError::Singular { iteration: 0 }.into()),
+        }
     }
 
     /// Newton's method on `φ(x; p) − x = 0`, `τ·(z − z_pred) = 0` from the prediction
@@ -1133,23 +1204,7 @@ where
         settings,
     };
     let first = problem.evaluate::<Sys, St, N, S, M>(p0, (guess, period(p0)), tol)?;
-    let (_, j, _) = problem.residual::<Sys, St, N, S, M>(&first.point.state, p0, tol)?;
-    let mut along_p = nalgebra::DVector::<f64>::zeros(N + 1);
-    along_p[N] = settings.step.signum();
-    let Some(tangent) = Problem::<B, P>::tangent::<N>(&j, &along_p) else {
-        return Err(crate::filippov::FilippovError::Singular { iteration: 0 }.into());
-    };
-    let point_of = |c: &ArcPoint<N>| -> Result<SlidingBranchPoint<N>> {
-        let mut sim = build(c.p)?;
-        let tests = sliding_tests(&mut sim, settings.surface, t0, c.x, period(c.p))?;
-        Ok(SlidingBranchPoint {
-            p: c.p,
-            state: c.x,
-            period: period(c.p),
-            multipliers: c.multipliers.clone(),
-            tests,
-        })
-    };
+    let tangent = problem.first_tangent::<Sys, St, N, S, M>(&first.point.state, p0, tol)?;
     let mut current = ArcPoint {
         x: first.point.state,
         p: p0,
@@ -1159,18 +1214,16 @@ where
     let mut points = vec![first.point];
     let mut folds = Vec::new();
     let mut bifurcations = Vec::new();
-    let ds_max = 4.0 * settings.step.abs();
-    let ds_min = 1e-4 * settings.step.abs();
-    let mut ds = settings.step.abs();
+    let mut step = ArcStep::new(settings.step);
     let end = loop {
         if points.len() >= settings.max_points {
             break BranchEnd::MaxPoints;
         }
+        let ds = step.ds;
         let (next, iterations) = match problem.correct::<Sys, St, N, S, M>(&current, ds, tol) {
             Ok(c) => c,
             Err(_) => {
-                ds *= 0.5;
-                if ds < ds_min {
+                if !step.halve() {
                     break BranchEnd::StepTooSmall { p: current.p };
                 }
                 continue;
@@ -1179,7 +1232,9 @@ where
         if next.p < settings.lo || next.p > settings.hi {
             break BranchEnd::ParameterRange;
         }
-        let b = point_of(&next)?;
+        let mut sim = build(next.p)?;
+        let multipliers = next.multipliers.clone();
+        let b = problem.point_on(&mut sim, next.p, next.x, period(next.p), multipliers)?;
         if next.tangent[N].signum() != current.tangent[N].signum() {
             let fold = problem.locate_fold::<Sys, St, N, S, M>(&current, &next, ds, tol)?;
             folds.push(SlidingFold {
@@ -1194,9 +1249,7 @@ where
         }
         points.push(b);
         current = next;
-        if iterations <= 3 {
-            ds = (ds * 1.5).min(ds_max);
-        }
+        step.grow(iterations);
     };
     Ok(SlidingArcBranch {
         points,

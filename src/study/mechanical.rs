@@ -340,118 +340,28 @@ impl Described {
                 ),
             ));
         }
-        let mut names: Vec<String> = Vec::new();
-        let mut note = |field: String, v: &SpecValue| -> Result<(), StudyError> {
-            match v {
-                SpecValue::Number(x) if !x.is_finite() => {
-                    Err(invalid(field, format!("must be finite (got {x})")))
-                }
-                SpecValue::Number(_) => Ok(()),
-                SpecValue::Parameter(p) => {
-                    let p = p.strip_prefix('-').unwrap_or(p);
-                    if !is_identifier(p) || is_initial_name(p) {
-                        return Err(invalid(
-                            field,
-                            format!(
-                                "{p:?} is neither a number nor a parameter name (letters, \
-                                 digits, '_'; not an initial-condition name such as x0)"
-                            ),
-                        ));
-                    }
-                    if p != "omega" && p != "amplitude_factor" && !names.iter().any(|n| n == p) {
-                        names.push(p.to_string());
-                    }
-                    Ok(())
-                }
-            }
-        };
+        let mut names = ParameterNames::default();
         for (k, m) in d.masses.iter().enumerate() {
-            note(format!("system.masses[{k}]"), m)?;
+            names.note(format!("system.masses[{k}]"), m)?;
         }
         for (i, e) in d.elements.iter().enumerate() {
-            let f = format!("system.elements[{i}]");
-            let Some((_, params)) = LAWS.iter().find(|(l, _)| *l == e.law) else {
-                let known: Vec<&str> = LAWS.iter().map(|(l, _)| *l).collect();
-                return Err(invalid(
-                    format!("{f}.law"),
-                    format!("unknown law {:?}; known: {}", e.law, known.join(", ")),
-                ));
-            };
-            check_coordinate(&f, e.dof, e.between, n)?;
-            check_side(&format!("{f}.side"), e.side.as_deref())?;
-            if e.side.is_some() && e.law != "hertz" {
-                return Err(invalid(
-                    format!("{f}.side"),
-                    format!("only a hertz stop has a side, not {:?}", e.law),
-                ));
-            }
-            for name in e.parameters.keys() {
-                if !params.iter().any(|(p, _)| p == name) {
-                    let known: Vec<&str> = params.iter().map(|(p, _)| *p).collect();
-                    return Err(invalid(
-                        format!("{f}.{name}"),
-                        format!(
-                            "unknown parameter of law {:?}; known: {}",
-                            e.law,
-                            known.join(", ")
-                        ),
-                    ));
-                }
-            }
-            for (p, default) in params.iter() {
-                match e.parameters.get(*p) {
-                    Some(v) => note(format!("{f}.{p}"), v)?,
-                    None if default.is_none() => {
-                        return Err(invalid(
-                            format!("{f}.{p}"),
-                            format!("is missing (law {:?})", e.law),
-                        ));
-                    }
-                    None => {}
-                }
-            }
+            check_element(&format!("system.elements[{i}]"), e, n, &mut names)?;
         }
         for (i, l) in d.loads.iter().enumerate() {
             let f = format!("system.loads[{i}]");
             check_coordinate(&f, Some(l.dof), None, n)?;
-            note(format!("{f}.amplitude"), &l.amplitude)?;
+            names.note(format!("{f}.amplitude"), &l.amplitude)?;
             if let Some(p) = &l.phase {
-                note(format!("{f}.phase"), p)?;
+                names.note(format!("{f}.phase"), p)?;
             }
         }
-        if d.surfaces.len() > MAX_SURFACES {
-            return Err(invalid(
-                "system.surfaces",
-                format!("{} surfaces; at most {MAX_SURFACES}", d.surfaces.len()),
-            ));
-        }
-        for (i, s) in d.surfaces.iter().enumerate() {
-            let f = format!("system.surfaces[{i}]");
-            check_coordinate(&f, s.dof, s.between, n)?;
-            check_side(&format!("{f}.side"), s.side.as_deref())?;
-            note(format!("{f}.position"), &s.position)?;
-            if let Some(e) = &s.restitution {
-                note(format!("{f}.restitution"), e)?;
-                if d.surfaces.len() > 1 {
-                    return Err(invalid(
-                        format!("{f}.restitution"),
-                        "a rigid stop must be the only surface (the drive runs one rigid \
-                         contact, with chattering and sticking)",
-                    ));
-                }
-            }
-        }
-        let mut params = vec![
-            ParameterDef::required("omega"),
-            ParameterDef::new("amplitude_factor", 1.0),
-        ];
-        params.extend(names.iter().map(|p| ParameterDef::required(p)));
+        check_surfaces(d.surfaces, n, &mut names)?;
         Ok(Self {
             masses: d.masses.to_vec(),
             elements: d.elements.to_vec(),
             loads: d.loads.to_vec(),
             surfaces: d.surfaces.to_vec(),
-            params,
+            params: names.definitions(),
         })
     }
 
@@ -694,6 +604,146 @@ fn value(p: &ParameterPoint, v: &SpecValue) -> f64 {
             None => p.get(name),
         },
     }
+}
+
+/// The parameters a description names, in the order first met (`omega` and
+/// `amplitude_factor` are always parameters and are not listed).
+#[derive(Debug, Default)]
+struct ParameterNames(Vec<String>);
+
+impl ParameterNames {
+    /// Checks the value `v` at `field`: a finite number, or the name of a parameter (then
+    /// noted; `"-name"` names `name`).
+    fn note(&mut self, field: String, v: &SpecValue) -> Result<(), StudyError> {
+        match v {
+            SpecValue::Number(x) if !x.is_finite() => {
+                Err(invalid(field, format!("must be finite (got {x})")))
+            }
+            SpecValue::Number(_) => Ok(()),
+            SpecValue::Parameter(p) => {
+                let p = p.strip_prefix('-').unwrap_or(p);
+                if !is_identifier(p) || is_initial_name(p) {
+                    return Err(invalid(
+                        field,
+                        format!(
+                            "{p:?} is neither a number nor a parameter name (letters, \
+                             digits, '_'; not an initial-condition name such as x0)"
+                        ),
+                    ));
+                }
+                if p != "omega" && p != "amplitude_factor" && !self.0.iter().any(|n| n == p) {
+                    self.0.push(p.to_string());
+                }
+                Ok(())
+            }
+        }
+    }
+
+    /// The system's parameters: `omega` (required), `amplitude_factor` (default 1), then
+    /// each name noted (required).
+    fn definitions(self) -> Vec<ParameterDef> {
+        let mut params = vec![
+            ParameterDef::required("omega"),
+            ParameterDef::new("amplitude_factor", 1.0),
+        ];
+        params.extend(self.0.iter().map(|p| ParameterDef::required(p)));
+        params
+    }
+}
+
+/// Checks element `e` (field `f`) of a system of `n` degrees of freedom: a known law on one
+/// coordinate, a side only for a `hertz` stop, and the law's parameters.
+fn check_element(
+    f: &str,
+    e: &ElementSpec,
+    n: usize,
+    names: &mut ParameterNames,
+) -> Result<(), StudyError> {
+    let Some((_, params)) = LAWS.iter().find(|(l, _)| *l == e.law) else {
+        let known: Vec<&str> = LAWS.iter().map(|(l, _)| *l).collect();
+        return Err(invalid(
+            format!("{f}.law"),
+            format!("unknown law {:?}; known: {}", e.law, known.join(", ")),
+        ));
+    };
+    check_coordinate(f, e.dof, e.between, n)?;
+    check_side(&format!("{f}.side"), e.side.as_deref())?;
+    if e.side.is_some() && e.law != "hertz" {
+        return Err(invalid(
+            format!("{f}.side"),
+            format!("only a hertz stop has a side, not {:?}", e.law),
+        ));
+    }
+    check_law_parameters(f, e, params, names)
+}
+
+/// Checks the parameters of element `e` (field `f`) against its law's `params`: each one
+/// given is the law's, each one without a default is given, and each value is valid.
+fn check_law_parameters(
+    f: &str,
+    e: &ElementSpec,
+    params: LawParameters,
+    names: &mut ParameterNames,
+) -> Result<(), StudyError> {
+    for name in e.parameters.keys() {
+        if !params.iter().any(|(p, _)| p == name) {
+            let known: Vec<&str> = params.iter().map(|(p, _)| *p).collect();
+            return Err(invalid(
+                format!("{f}.{name}"),
+                format!(
+                    "unknown parameter of law {:?}; known: {}",
+                    e.law,
+                    known.join(", ")
+                ),
+            ));
+        }
+    }
+    for (p, default) in params.iter() {
+        match e.parameters.get(*p) {
+            Some(v) => names.note(format!("{f}.{p}"), v)?,
+            None if default.is_none() => {
+                return Err(invalid(
+                    format!("{f}.{p}"),
+                    format!("is missing (law {:?})", e.law),
+                ));
+            }
+            None => {}
+        }
+    }
+    Ok(())
+}
+
+/// Checks the surfaces of a system of `n` degrees of freedom: at most [`MAX_SURFACES`],
+/// each on one coordinate with a valid side and position, and a rigid stop (one with a
+/// restitution) only as the only surface.
+fn check_surfaces(
+    surfaces: &[SurfaceSpec],
+    n: usize,
+    names: &mut ParameterNames,
+) -> Result<(), StudyError> {
+    if surfaces.len() > MAX_SURFACES {
+        return Err(invalid(
+            "system.surfaces",
+            format!("{} surfaces; at most {MAX_SURFACES}", surfaces.len()),
+        ));
+    }
+    for (i, s) in surfaces.iter().enumerate() {
+        let f = format!("system.surfaces[{i}]");
+        check_coordinate(&f, s.dof, s.between, n)?;
+        check_side(&format!("{f}.side"), s.side.as_deref())?;
+        names.note(format!("{f}.position"), &s.position)?;
+        if let Some(e) = &s.restitution {
+            names.note(format!("{f}.restitution"), e)?;
+            if surfaces.len() > 1 {
+                return Err(invalid(
+                    format!("{f}.restitution"),
+                    "a rigid stop must be the only surface (the drive runs one rigid \
+                     contact, with chattering and sticking)",
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// A build error of the value `v` at `field`.
