@@ -629,7 +629,7 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
     ) {
         let mut step = Box::new(StepOut::new(M, E::LEN));
         // The events' ends are wanted where a lane's step may be quiet (quiet_lanes).
-        step.want_events = E::LEN > 0 && observers.iter().any(|o| !o.wants_steps());
+        let want_events = E::LEN > 0 && observers.iter().any(|o| !o.wants_steps());
         while self.st.active.bits() != 0 {
             if self.next >= self.queue.len()
                 && <V::Half as Lanes>::LANES < V::LANES
@@ -638,7 +638,15 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
                 self.compact().drive(observers, out);
                 return;
             }
-            super::kernel::step(&mut self.st, &self.consts, &self.cfg.events, &mut step);
+            super::kernel::step(&mut self.st, &self.consts, &mut step);
+            step.events = false;
+            if want_events && step.accepted != 0 {
+                super::kernel::event_ends::<V, E, M>(
+                    &self.cfg.events,
+                    self.consts.simd(),
+                    &mut step,
+                );
+            }
             if step.too_small != 0 {
                 for i in lanes_of(step.too_small) {
                     let e = IntegrateError::StepSizeTooSmall {

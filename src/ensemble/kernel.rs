@@ -67,6 +67,11 @@ impl<const M: usize> StepConsts<M> {
             simd: simd.resolve(),
         }
     }
+
+    /// The instruction set of the run (already resolved for this CPU).
+    pub(crate) fn simd(&self) -> Simd {
+        self.simd
+    }
 }
 
 /// The rows of [`StepOut::buf`]: lane `i` of each vector is `buf[row][i]`; a vector
@@ -114,11 +119,8 @@ pub(crate) struct StepOut {
     pub(crate) accepted: u32,
     /// Lanes whose trial step was not finite (rejected; `buf[T0]` holds their `t`).
     pub(crate) non_finite: u32,
-    /// Set by the caller: evaluate the events' lane forms at both ends of the accepted
-    /// steps (into the rows [`row::event`]).
-    pub(crate) want_events: bool,
-    /// Whether every event has a lane form and its values are in `buf` (when wanted and
-    /// some lane was accepted).
+    /// Whether every event has a lane form and its values at the ends of this pass's
+    /// steps are in `buf` ([`event_ends`]).
     pub(crate) events: bool,
     /// Bit `2e` (`2e + 1`): event `e`'s rate at the start (end) is in `buf`.
     pub(crate) rates: u32,
@@ -135,7 +137,6 @@ impl StepOut {
             rejected: 0,
             accepted: 0,
             non_finite: 0,
-            want_events: false,
             events: false,
             rates: 0,
             buf: vec![[0.0; 16]; row::count(m) + 4 * events],
@@ -145,47 +146,43 @@ impl StepOut {
 
 /// One pass of the lane loop in the instruction set `k.simd`.
 #[inline(never)]
-pub(crate) fn step<V: Lanes, D: LaneDynamics<M>, E: EventSet<f64, M>, const M: usize>(
+pub(crate) fn step<V: Lanes, D: LaneDynamics<M>, const M: usize>(
     st: &mut LaneState<V, D, M>,
     k: &StepConsts<M>,
-    events: &E,
     out: &mut StepOut,
 ) {
     #[cfg(target_arch = "x86_64")]
     match k.simd {
         Simd::Avx512 => {
             if let Some(v4) = pulp::x86::V4::try_new() {
-                return pulp::Simd::vectorize(v4, Pass { st, k, events, out });
+                return pulp::Simd::vectorize(v4, Pass { st, k, out });
             }
         }
         Simd::Avx2 => {
             if let Some(v3) = pulp::x86::V3::try_new() {
-                return pulp::Simd::vectorize(v3, Pass { st, k, events, out });
+                return pulp::Simd::vectorize(v3, Pass { st, k, out });
             }
         }
         _ => {}
     }
-    body(st, k, events, out)
+    body(st, k, out)
 }
 
 /// One pass, handed to `pulp` to be compiled with the instruction set's target features.
 #[cfg(target_arch = "x86_64")]
-struct Pass<'a, V: Lanes, D: LaneDynamics<M>, E, const M: usize> {
+struct Pass<'a, V: Lanes, D: LaneDynamics<M>, const M: usize> {
     st: &'a mut LaneState<V, D, M>,
     k: &'a StepConsts<M>,
-    events: &'a E,
     out: &'a mut StepOut,
 }
 
 #[cfg(target_arch = "x86_64")]
-impl<V: Lanes, D: LaneDynamics<M>, E: EventSet<f64, M>, const M: usize> pulp::WithSimd
-    for Pass<'_, V, D, E, M>
-{
+impl<V: Lanes, D: LaneDynamics<M>, const M: usize> pulp::WithSimd for Pass<'_, V, D, M> {
     type Output = ();
 
     #[inline(always)]
     fn with_simd<S: pulp::Simd>(self, _simd: S) {
-        body(self.st, self.k, self.events, self.out)
+        body(self.st, self.k, self.out)
     }
 }
 
@@ -310,10 +307,9 @@ fn combo<V: Lanes, const M: usize>(k: &[[V; M]; 7], terms: &[(usize, V)], c: usi
 /// [`Dopri5`](crate::integrate::Dopri5) and its controller), the masked update of the
 /// accepted and rejected lanes, and the accepted lanes' step data in `out.buf`.
 #[inline(always)]
-fn body<V: Lanes, D: LaneDynamics<M>, E: EventSet<f64, M>, const M: usize>(
+fn body<V: Lanes, D: LaneDynamics<M>, const M: usize>(
     st: &mut LaneState<V, D, M>,
     k: &StepConsts<M>,
-    events: &E,
     out: &mut StepOut,
 ) {
     let s = V::splat;
@@ -332,7 +328,6 @@ fn body<V: Lanes, D: LaneDynamics<M>, E: EventSet<f64, M>, const M: usize>(
     out.rejected = 0;
     out.accepted = 0;
     out.non_finite = 0;
-    out.events = false;
     let (t, y, h) = (st.t, st.y, st.h);
     // The trial step, cut to land on the lane's limit (clamp_to_limit).
     let rest = st.limit - t;
@@ -401,24 +396,84 @@ fn body<V: Lanes, D: LaneDynamics<M>, E: EventSet<f64, M>, const M: usize>(
             w.store(&mut out.buf[row::vector(q, M) + c]);
         }
     }
-    if out.want_events {
-        event_ends(events, out, (t, &y, &k1), (t_new, &yn, &k7));
+}
+
+/// Every event's value and rate at both ends of the accepted steps of a pass (from the
+/// rows `T0, T1, X0, X1, F0, F1` of `out`), from its lane form, into the rows
+/// [`row::event`]; `out.events` tells whether every event has one. Compiled, like
+/// [`step`], for the instruction set `simd` (and apart from it, so that the step is not
+/// compiled again for each event set).
+#[inline(never)]
+pub(crate) fn event_ends<V: Lanes, E: EventSet<f64, M>, const M: usize>(
+    events: &E,
+    simd: Simd,
+    out: &mut StepOut,
+) {
+    #[cfg(target_arch = "x86_64")]
+    match simd {
+        Simd::Avx512 => {
+            if let Some(v4) = pulp::x86::V4::try_new() {
+                return pulp::Simd::vectorize(v4, Ends::<V, E, M>::new(events, out));
+            }
+        }
+        Simd::Avx2 => {
+            if let Some(v3) = pulp::x86::V3::try_new() {
+                return pulp::Simd::vectorize(v3, Ends::<V, E, M>::new(events, out));
+            }
+        }
+        _ => {}
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = simd;
+    ends_body::<V, E, M>(events, out)
+}
+
+/// The events' ends, handed to `pulp` like [`Pass`].
+#[cfg(target_arch = "x86_64")]
+struct Ends<'a, V, E, const M: usize> {
+    events: &'a E,
+    out: &'a mut StepOut,
+    lanes: core::marker::PhantomData<V>,
+}
+
+#[cfg(target_arch = "x86_64")]
+impl<'a, V, E, const M: usize> Ends<'a, V, E, M> {
+    fn new(events: &'a E, out: &'a mut StepOut) -> Self {
+        Self {
+            events,
+            out,
+            lanes: core::marker::PhantomData,
+        }
     }
 }
 
-/// Every event's value and rate at both ends of the step, from its lane form, into the
-/// rows [`row::event`]; `out.events` tells whether every event has one.
+#[cfg(target_arch = "x86_64")]
+impl<V: Lanes, E: EventSet<f64, M>, const M: usize> pulp::WithSimd for Ends<'_, V, E, M> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) {
+        ends_body::<V, E, M>(self.events, self.out)
+    }
+}
+
 #[inline(always)]
-fn event_ends<V: Lanes, E: EventSet<f64, M>, const M: usize>(
-    events: &E,
-    out: &mut StepOut,
-    (t0, y0, f0): (V, &[V; M], &[V; M]),
-    (t1, y1, f1): (V, &[V; M], &[V; M]),
-) {
+fn ends_body<V: Lanes, E: EventSet<f64, M>, const M: usize>(events: &E, out: &mut StepOut) {
+    out.events = false;
     out.rates = 0;
+    let buf = &out.buf;
+    let load = |r: usize| V::load(&buf[r]);
+    let vector = |q: usize| -> [V; M] { core::array::from_fn(|c| load(row::vector(q, M) + c)) };
+    let (t0, t1) = (load(row::T0), load(row::T1));
+    let (y0, y1, f0, f1) = (
+        vector(row::X0),
+        vector(row::X1),
+        vector(row::F0),
+        vector(row::F1),
+    );
     for e in 0..E::LEN {
         let (Some((g0, r0)), Some((g1, r1))) =
-            (events.lanes(e, t0, y0, f0), events.lanes(e, t1, y1, f1))
+            (events.lanes(e, t0, &y0, &f0), events.lanes(e, t1, &y1, &f1))
         else {
             return;
         };
