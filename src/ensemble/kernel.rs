@@ -125,7 +125,8 @@ pub(crate) struct StepOut {
     /// Bit `2e` (`2e + 1`): event `e`'s rate at the start (end) is in `buf`.
     pub(crate) rates: u32,
     /// For accepted lanes: `t₀, t₁, h`, then `y₀, y₁, f₀, f₁` and the dense output's
-    /// `r₂…r₅`, `M` rows each (see [`row`]). Allocated once per run.
+    /// `r₂…r₅`, `M` rows each, then four rows per event ([`row::event`], filled by
+    /// [`event_ends`]). Allocated once per run.
     pub(crate) buf: Vec<[f64; 16]>,
 }
 
