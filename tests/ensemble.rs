@@ -773,19 +773,82 @@ impl<const M: usize> Observer<f64, M> for EventsOnly<M> {
     }
 }
 
-/// The ensemble against the driver, both with an observer that does not want steps:
-/// outcomes, statistics and every event record equal to the bit.
+/// Every step view (its ends and the dense output at its middle) and every event of a
+/// run, to the bit; stops the run at its `stop_at`-th view if set. It wants steps: the
+/// ensemble shows it the quiet steps without the scalar event search.
+#[derive(Debug, Clone, Default, PartialEq)]
+struct StepsAndEvents<const M: usize> {
+    views: Vec<[u64; 3]>,
+    events: EventsOnly<M>,
+    stop_at: Option<usize>,
+}
+
+impl<const M: usize> Observer<f64, M> for StepsAndEvents<M> {
+    fn on_step<D: nonsmooth::integrate::DenseOutput<f64, M>>(
+        &mut self,
+        s: &nonsmooth::drive::StepView<'_, f64, M, D>,
+    ) -> Control {
+        let mid = s.dense.interpolate(0.5 * (s.t0 + s.t1)).unwrap();
+        let sum = |y: &nalgebra::SVector<f64, M>| {
+            y.iter().fold(0u64, |h, v| h.rotate_left(7) ^ v.to_bits())
+        };
+        let ends = s.t0.to_bits() ^ s.t1.to_bits().rotate_left(1);
+        self.views.push([ends, sum(&s.y0) ^ sum(&s.y1), sum(&mid)]);
+        if self.stop_at == Some(self.views.len()) {
+            Control::Stop
+        } else {
+            Control::Continue
+        }
+    }
+    fn on_event(&mut self, e: &EventRecord<f64, M>) -> Control {
+        self.events.on_event(e)
+    }
+}
+
+/// The ensemble against the driver, with an observer that does not want steps and with
+/// one that does (running to the end, and stopping at a step): outcomes, statistics,
+/// every step view and every event record equal to the bit.
 fn same_as_driver<D, E, const M: usize>(jobs: &[MemberRun<D, M>], tol: Tolerances<f64, M>, ev: E)
 where
     D: nonsmooth::LaneDynamics<M>,
     E: nonsmooth::event::EventSet<f64, M> + Clone,
 {
+    let n = jobs.len();
+    let (events, _) = same_as_driver_with(jobs, tol, ev.clone(), |_| EventsOnly::<M>::default());
+    assert!(events > 10 * n, "{events} events");
+    let (events, _) =
+        same_as_driver_with(jobs, tol, ev.clone(), |_| StepsAndEvents::<M>::default());
+    assert!(events > 10 * n, "{events} events");
+    let (_, stopped) = same_as_driver_with(jobs, tol, ev, |j| StepsAndEvents::<M> {
+        stop_at: Some(40 + 7 * j),
+        ..StepsAndEvents::default()
+    });
+    assert!(
+        stopped > n / 2,
+        "{stopped} of {n} runs stopped by their observer"
+    );
+}
+
+/// [`same_as_driver`] with one observer kind; returns the number of events recorded and
+/// of runs that their observer stopped.
+fn same_as_driver_with<D, E, O, const M: usize>(
+    jobs: &[MemberRun<D, M>],
+    tol: Tolerances<f64, M>,
+    ev: E,
+    observer: impl Fn(usize) -> O,
+) -> (usize, usize)
+where
+    D: nonsmooth::LaneDynamics<M>,
+    E: nonsmooth::event::EventSet<f64, M> + Clone,
+    O: Observer<f64, M> + PartialEq + core::fmt::Debug + EventCount,
+{
+    use nonsmooth::drive::Termination;
     let ens = Ensemble::new(tol).unwrap().with_events(ev.clone()).unwrap();
-    let mut lanes = vec![EventsOnly::<M>::default(); jobs.len()];
+    let mut lanes: Vec<O> = (0..jobs.len()).map(&observer).collect();
     let out = ens.run::<F64x4, _, _>(jobs, &mut lanes).unwrap();
-    let mut events = 0;
-    for ((j, o), rec) in jobs.iter().zip(&out).zip(&lanes) {
-        let mut want_rec = EventsOnly::<M>::default();
+    let (mut events, mut stopped) = (0, 0);
+    for (k, ((j, o), rec)) in jobs.iter().zip(&out).zip(&lanes).enumerate() {
+        let mut want_rec = observer(k);
         let want = Simulation::new(j.member.clone(), Dopri5::new(tol))
             .with_events(ev.clone())
             .landing_grid(j.grid)
@@ -800,9 +863,31 @@ where
             (a, b) => panic!("lanes {a:?}, driver {b:?}"),
         }
         assert_eq!(rec, &want_rec);
-        events += rec.0.len();
+        events += rec.event_count();
+        if o.as_ref()
+            .is_ok_and(|o| o.termination == Termination::ObserverStopped)
+        {
+            stopped += 1;
+        }
     }
-    assert!(events > 10 * jobs.len(), "{events} events");
+    (events, stopped)
+}
+
+/// The number of events an observer recorded.
+trait EventCount {
+    fn event_count(&self) -> usize;
+}
+
+impl<const M: usize> EventCount for EventsOnly<M> {
+    fn event_count(&self) -> usize {
+        self.0.len()
+    }
+}
+
+impl<const M: usize> EventCount for StepsAndEvents<M> {
+    fn event_count(&self) -> usize {
+        self.events.0.len()
+    }
 }
 
 #[test]

@@ -4,7 +4,7 @@ use nalgebra::SVector;
 
 use super::kernel::{LaneState, StepConsts, StepOut, row};
 use crate::LaneDynamics;
-use crate::drive::{Observer, Outcome, RunError, Termination};
+use crate::drive::{Control, Observer, Outcome, RunError, StepView, Termination};
 use crate::drive::{Scan, Sides, check_work, step_limit, time_scale};
 use crate::event::{Event, EventFunction, EventHistory, EventSet, MAX_EVENTS, ZenoGuard};
 use crate::integrate::{DenseOutput, IntegrateError, Stats, StepOptions, Tolerances};
@@ -628,8 +628,8 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
         out: &mut [Option<Result<Outcome<f64, M>>>],
     ) {
         let mut step = Box::new(StepOut::new(M, E::LEN));
-        // The events' ends are wanted where a lane's step may be quiet (quiet_lanes).
-        let want_events = E::LEN > 0 && observers.iter().any(|o| !o.wants_steps());
+        // The events' ends tell which lanes' steps are quiet (quiet_lanes).
+        let want_events = E::LEN > 0;
         while self.st.active.bits() != 0 {
             if self.next >= self.queue.len()
                 && <V::Half as Lanes>::LANES < V::LANES
@@ -673,10 +673,10 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
                     }
                 }
             }
-            let quiet = self.quiet_lanes(&step, observers);
+            let quiet = self.quiet_lanes(&step);
             for i in lanes_of(step.accepted) {
                 if quiet & (1 << i) != 0 {
-                    self.after_quiet_step(i, &step.buf);
+                    self.after_quiet_step(i, &step.buf, observers, out);
                 } else {
                     let dense = LaneDense::<M>::from_rows(&step.buf, i);
                     self.after_step(i, &dense, observers, out);
@@ -828,22 +828,19 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
     }
 
     /// The accepted lanes whose step the driver's event handling would pass through
-    /// without doing anything but moving the events' sides: every event's step is quiet
-    /// ([`Sides::is_quiet`], from the events' lane forms, which the kernel evaluates at
-    /// both ends of every lane's step at once, under the run's instruction set), the
-    /// observer does not want steps
-    /// ([`Observer::wants_steps`]), and the trajectory does not end with this step. Empty
-    /// if an event has no lane form.
-    fn quiet_lanes<O: Observer<f64, M>>(&mut self, step: &StepOut, observers: &[O]) -> u32 {
+    /// without doing anything but moving the events' sides and showing the whole step to
+    /// the observer: every event's step is quiet ([`Sides::is_quiet`], from the events'
+    /// lane forms, which the kernel evaluates at both ends of every lane's step at once,
+    /// under the run's instruction set) and the trajectory does not end with this step.
+    /// Empty if an event has no lane form.
+    fn quiet_lanes(&mut self, step: &StepOut) -> u32 {
         let buf = &step.buf;
         let mut quiet = 0;
         for i in lanes_of(step.accepted) {
             let slot = &self.slots[i];
             let ends = buf[row::T1][i] >= slot.t_end || slot.steps + 1 >= self.cfg.max_steps;
-            if let (Some(j), false) = (slot.job, ends) {
-                if !observers[j].wants_steps() {
-                    quiet |= 1 << i;
-                }
+            if slot.job.is_some() && !ends {
+                quiet |= 1 << i;
             }
         }
         if quiet == 0 || E::LEN == 0 {
@@ -877,14 +874,38 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
     }
 
     /// A lane's accepted quiet step ([`quiet_lanes`](Self::quiet_lanes)): what
-    /// [`after_step`](Self::after_step) does for it, without building the step.
-    fn after_quiet_step(&mut self, i: usize, buf: &[[f64; 16]]) {
+    /// [`after_step`](Self::after_step) does for it, without the events' scan: the
+    /// observer's view of the whole step (built only for an observer that
+    /// [wants steps](Observer::wants_steps)), the sides, the next limit.
+    fn after_quiet_step<O: Observer<f64, M>>(
+        &mut self,
+        i: usize,
+        buf: &[[f64; 16]],
+        observers: &mut [O],
+        out: &mut [Option<Result<Outcome<f64, M>>>],
+    ) {
         let slot = &mut self.slots[i];
         slot.stats.rhs_evals += 6;
         slot.stats.accepted += 1;
         slot.steps += 1;
         slot.nonfinite = 0;
         let t1 = buf[row::T1][i];
+        if let Some(j) = slot.job.filter(|&j| observers[j].wants_steps()) {
+            let dense = LaneDense::<M>::from_rows(buf, i);
+            let view = StepView {
+                t0: dense.t0,
+                t1: dense.t1,
+                y0: dense.y0,
+                y1: dense.y1,
+                dense: &dense,
+            };
+            if observers[j].on_step(&view) == Control::Stop {
+                let end = Ok((dense.t1, dense.y1, Termination::ObserverStopped));
+                self.finish(i, end, observers, out);
+                return;
+            }
+        }
+        let slot = &mut self.slots[i];
         if let Some(sides) = &mut slot.sides {
             for (e, g1) in self.quiet_ends.iter().enumerate().take(E::LEN) {
                 sides.quiet_step(e, g1[i]);
