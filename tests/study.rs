@@ -1185,6 +1185,15 @@ fn a_described_two_dof_impact_damper_runs_whole_and_in_shards_and_draws_its_map(
         let d = scratch(&format!("damper-{n}"));
         run_in_shards(&study, &d, n);
         results.push(merged_bytes(&d));
+        // The shards run the described system's points in lanes: each record is the
+        // scalar path's, point by point, to the bit.
+        let (_, recs) = read_shards(&d).unwrap();
+        for r in &recs {
+            assert_eq!(
+                format!("{r:?}"),
+                format!("{:?}", compute_point(&study, r.index))
+            );
+        }
         if n == 3 {
             let m = Merged::from_dir(&d).unwrap();
             let files = m.write(&d.join("map.csv")).unwrap();

@@ -443,7 +443,7 @@ impl StudySystem for Duffing {
             let model = d.model::<f64>().map_err(|e| e.to_string())?;
             Ok((model, Vec::<Stop>::new(), d.period(), y0.clone()))
         });
-        lanes::run_smooth_batch::<2, 4, _, _>(s, starts.collect())
+        lanes::run_smooth_batch::<2, 4, lanes::ByMachine, _, _>(s, starts.collect())
     }
 }
 
@@ -548,7 +548,7 @@ impl StudySystem for TwoDof {
             let stop = d.stop::<f64>().map_err(e)?;
             Ok((model, vec![stop], TwoDofImpact::period(omega), y0.clone()))
         });
-        lanes::run_smooth_batch::<4, 8, _, _>(s, starts.collect())
+        lanes::run_smooth_batch::<4, 8, lanes::ByMachine, _, _>(s, starts.collect())
     }
 }
 

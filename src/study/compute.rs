@@ -172,7 +172,8 @@ const BATCH: usize = 64;
 /// number of threads: each point depends only on the spec and its index.
 ///
 /// The points of a system with a lane form (the paper's model, Duffing–Ueda, the 2-DOF
-/// impact oscillator) run in SIMD lanes, 64 points per task, with
+/// impact oscillator, a described system without a rigid surface) run in SIMD lanes, 64
+/// points per task, with
 /// [`LaneMath::Exact`](crate::lanes::LaneMath::Exact): each point's record is
 /// [`compute_point`]'s to the bit (tested), failure messages included; the Lyapunov
 /// exponent, where recorded, is the scalar two-trajectory estimate from the run's end

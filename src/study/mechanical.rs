@@ -50,6 +50,12 @@
 //! and sticking ([`run_with_sticking`](crate::drive::run_with_sticking)), which drives one
 //! rigid contact: such a surface must be the only one.
 //!
+//! A shard runs the points of a system without a rigid surface (and with at most 16
+//! elements and 8 loads) together in SIMD lanes, as it runs the catalogue's: each law's
+//! lane form, chosen by the law's kind once per stage for all lanes; every point's record
+//! is the one-by-one run's to the bit. A system with a rigid surface runs its points one by
+//! one.
+//!
 //! [`model::Mechanical`]: crate::model::Mechanical
 
 use std::collections::BTreeMap;
@@ -59,7 +65,7 @@ use serde::{Deserialize, Serialize};
 use super::StudyError;
 use super::scalar::{self, MAX_SURFACES};
 use super::system::{
-    ParameterDef, ParameterPoint, PointRun, RunSettings, StudySystem, is_initial_name,
+    ParameterDef, ParameterPoint, PointRun, PointStart, RunSettings, StudySystem, is_initial_name,
 };
 use crate::event::{Gap, NewtonImpact};
 use crate::excite::Harmonic;
@@ -68,6 +74,8 @@ use crate::force::{
 };
 use crate::model::{Coordinate, Element, Elements, Load, Loads, Mechanical};
 use crate::{Dynamics, ForceLaw, ParameterError};
+
+mod lanes;
 
 /// The most degrees of freedom of a described system.
 pub const MAX_DESCRIBED_DOFS: usize = 4;
@@ -871,6 +879,56 @@ impl StudySystem for Described {
             4 => self.run_n::<4, 8, 16>(p, y0, s),
             n => Err(format!("{n} masses; at most {MAX_DESCRIBED_DOFS}")),
         }
+    }
+    /// A smooth system (no rigid surface) with at most
+    /// [`MAX_LANE_ELEMENTS`](lanes::MAX_LANE_ELEMENTS) elements and
+    /// [`MAX_LANE_LOADS`](lanes::MAX_LANE_LOADS) loads runs in lanes.
+    fn in_lanes(&self) -> bool {
+        self.surfaces.iter().all(|s| s.restitution.is_none())
+            && self.elements.len() <= lanes::MAX_LANE_ELEMENTS
+            && self.loads.len() <= lanes::MAX_LANE_LOADS
+    }
+    fn run_batch(&self, points: &[PointStart], s: &RunSettings) -> Vec<Result<PointRun, String>> {
+        if !self.in_lanes() {
+            return points
+                .iter()
+                .map(|p| match p {
+                    Ok((p, y0)) => self.run(p, y0, s),
+                    Err(m) => Err(m.clone()),
+                })
+                .collect();
+        }
+        match self.masses.len() {
+            1 => self.batch_n::<1, 2, 4>(points, s),
+            2 => self.batch_n::<2, 4, 8>(points, s),
+            3 => self.batch_n::<3, 6, 12>(points, s),
+            4 => self.batch_n::<4, 8, 16>(points, s),
+            n => vec![Err(format!("{n} masses; at most {MAX_DESCRIBED_DOFS}")); points.len()],
+        }
+    }
+}
+
+impl Described {
+    /// The points of a smooth system in lanes ([`run_smooth_batch`](super::lanes)): what
+    /// [`run_n`](Self::run_n) gives for each, to the bit.
+    fn batch_n<const N: usize, const M: usize, const M2: usize>(
+        &self,
+        points: &[PointStart],
+        s: &RunSettings,
+    ) -> Vec<Result<PointRun, String>>
+    where
+        Model<N>: Dynamics<f64, M> + crate::LaneDynamics<M>,
+        Gap<f64, N>: crate::event::EventFunction<f64, M>,
+    {
+        let starts = points.iter().map(|p| {
+            let (p, y0) = p.as_ref().map_err(Clone::clone)?;
+            let e = |e: BuildError| e.to_string();
+            let model = self.model::<N>(p).map_err(e)?;
+            let gaps = self.gaps::<N>(p).map_err(e)?;
+            let period = std::f64::consts::TAU / p.get("omega");
+            Ok((model, gaps, period, y0.clone()))
+        });
+        super::lanes::run_smooth_batch::<M, M2, super::lanes::Eight, _, _>(s, starts.collect())
     }
 }
 
