@@ -890,13 +890,8 @@ impl StudySystem for Described {
     }
     fn run_batch(&self, points: &[PointStart], s: &RunSettings) -> Vec<Result<PointRun, String>> {
         if !self.in_lanes() {
-            return points
-                .iter()
-                .map(|p| match p {
-                    Ok((p, y0)) => self.run(p, y0, s),
-                    Err(m) => Err(m.clone()),
-                })
-                .collect();
+            // A rigid surface, or more elements or loads than the lane form holds.
+            return super::system::one_by_one(self, points, s);
         }
         match self.masses.len() {
             1 => self.batch_n::<1, 2, 4>(points, s),

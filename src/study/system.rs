@@ -108,6 +108,22 @@ pub(crate) struct PointRun {
 /// The start of one point: its parameters and initial state, or why it has none.
 pub(crate) type PointStart = Result<(ParameterPoint, Vec<f64>), String>;
 
+/// `points` run one by one through `system`'s [`run`](StudySystem::run) (the default
+/// [`run_batch`](StudySystem::run_batch)).
+pub(crate) fn one_by_one<S: StudySystem + ?Sized>(
+    system: &S,
+    points: &[PointStart],
+    s: &RunSettings,
+) -> Vec<Result<PointRun, String>> {
+    points
+        .iter()
+        .map(|p| match p {
+            Ok((p, y0)) => system.run(p, y0, s),
+            Err(m) => Err(m.clone()),
+        })
+        .collect()
+}
+
 /// A system a study can run: a model of the catalogue or one described in the study file.
 ///
 /// The study asks it for its parameters (names and defaults), builds a [`ParameterPoint`]
@@ -182,13 +198,7 @@ pub(crate) trait StudySystem: std::fmt::Debug + Send + Sync {
     /// the same messages. Default: one by one through [`run`](Self::run); a system with a
     /// lane form runs them in SIMD lanes (and says so in [`in_lanes`](Self::in_lanes)).
     fn run_batch(&self, points: &[PointStart], s: &RunSettings) -> Vec<Result<PointRun, String>> {
-        points
-            .iter()
-            .map(|p| match p {
-                Ok((p, y0)) => self.run(p, y0, s),
-                Err(m) => Err(m.clone()),
-            })
-            .collect()
+        one_by_one(self, points, s)
     }
 
     /// The names of the state components: `x, v` for one degree of freedom, `x1 … xN,
