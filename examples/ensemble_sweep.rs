@@ -5,8 +5,8 @@
 //! 100/50) on the scalar path for reference. All on the default rayon pool.
 //!
 //! ```sh
-//! cargo run --release --example ensemble_sweep              # full grid
-//! cargo run --release --example ensemble_sweep -- --quick   # step 0.05
+//! cargo run --release --features timing --example ensemble_sweep              # full grid
+//! cargo run --release --features timing --example ensemble_sweep -- --quick   # step 0.05
 //! ```
 
 use std::time::Instant;

@@ -13,9 +13,9 @@
 //! interference only adds time.
 //!
 //! ```sh
-//! cargo run --release --example ensemble_throughput            # 64 × 200 periods
-//! cargo run --release --example ensemble_throughput -- --quick # 16 × 100 periods
-//! cargo run --release --example ensemble_throughput -- --simd avx2  # cap the dispatch
+//! cargo run --release --features timing --example ensemble_throughput            # 64 × 200 periods
+//! cargo run --release --features timing --example ensemble_throughput -- --quick # 16 × 100 periods
+//! cargo run --release --features timing --example ensemble_throughput -- --simd avx2  # cap the dispatch
 //! ```
 //!
 //! The lane loop is compiled for the baseline, AVX2+FMA and AVX-512F and picked at run time

@@ -6,8 +6,8 @@
 //! `--every`-th value (default 25) for the ratio and compared value by value.
 //!
 //! ```sh
-//! cargo run --release --example ensemble_tle                 # full grid
-//! cargo run --release --example ensemble_tle -- --quick      # step 0.1, 300 periods
+//! cargo run --release --features timing --example ensemble_tle                 # full grid
+//! cargo run --release --features timing --example ensemble_tle -- --quick      # step 0.1, 300 periods
 //! ```
 
 use std::time::Instant;

@@ -160,16 +160,7 @@ pub fn pow_masked<V: Lanes>(math: LaneMath, mask: V, x: V, c: V) -> V {
             if bits == 0 {
                 return V::splat(0.0);
             }
-            let (mut xa, mut ca) = ([0.0f64; 16], [0.0f64; 16]);
-            x.store(&mut xa);
-            c.store(&mut ca);
-            let mut out = [0.0f64; 16];
-            for i in 0..V::LANES {
-                if bits & (1 << i) != 0 {
-                    out[i] = (ca[i] * xa[i].ln()).exp();
-                }
-            }
-            V::load(&out)
+            pow_lanes(bits, x, c)
         }
         LaneMath::Vector => {
             if mask.bits() == 0 {
@@ -180,6 +171,24 @@ pub fn pow_masked<V: Lanes>(math: LaneMath, mask: V, x: V, c: V) -> V {
             }
         }
     }
+}
+
+/// `e^{c·ln x}` in the lanes of `bits` (others: 0), by the platform's functions one lane
+/// at a time. Out of line: scalar calls gain nothing from the lane step's instruction set,
+/// and a copy inlined at every power of every kernel (per width, model and instruction
+/// set) would only make the kernels larger and slower to compile.
+#[inline(never)]
+fn pow_lanes<V: Lanes>(bits: u32, x: V, c: V) -> V {
+    let (mut xa, mut ca) = ([0.0f64; 16], [0.0f64; 16]);
+    x.store(&mut xa);
+    c.store(&mut ca);
+    let mut out = [0.0f64; 16];
+    for i in 0..V::LANES {
+        if bits & (1 << i) != 0 {
+            out[i] = (ca[i] * xa[i].ln()).exp();
+        }
+    }
+    V::load(&out)
 }
 
 const LN2_HI: f64 = 6.931_471_803_691_238_164_90e-01;
@@ -255,19 +264,29 @@ pub fn ln_vector<V: Lanes>(x: V) -> V {
 /// `v` with the lanes of `mask` replaced by `f` of the same lanes of `x` (the slow lanes of
 /// the vector functions, computed one by one).
 #[inline(always)]
-fn patch<V: Lanes>(mut v: V, mask: V, x: V, f: fn(f64) -> f64) -> V {
+fn patch<V: Lanes>(v: V, mask: V, x: V, f: fn(f64) -> f64) -> V {
     let bits = mask.bits();
     if bits != 0 {
-        for i in 0..V::LANES {
-            if bits & (1 << i) != 0 {
-                v = v.with_lane(i, f(x.lane(i)));
-            }
+        patch_lanes(v, bits, x, f)
+    } else {
+        v
+    }
+}
+
+/// [`patch`]'s rare path, out of line (see [`pow_lanes`]).
+#[cold]
+#[inline(never)]
+fn patch_lanes<V: Lanes>(mut v: V, bits: u32, x: V, f: fn(f64) -> f64) -> V {
+    for i in 0..V::LANES {
+        if bits & (1 << i) != 0 {
+            v = v.with_lane(i, f(x.lane(i)));
         }
     }
     v
 }
 
-#[inline(always)]
+/// `f` in every lane, one lane at a time (out of line, see [`pow_lanes`]).
+#[inline(never)]
 fn map<V: Lanes>(x: V, f: fn(f64) -> f64) -> V {
     let mut a = [0.0f64; 16];
     x.store(&mut a);
