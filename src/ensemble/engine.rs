@@ -490,6 +490,7 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
                 ln_err_old: V::splat(1e-4f64.ln()),
                 rej_last: z,
                 active: z,
+                kk: [[z; M]; 7],
             }),
             consts: StepConsts::new(&cfg.tol, &cfg.opts, cfg.math, cfg.simd),
             quiet_ends: [[0.0; 16]; MAX_EVENTS],
@@ -707,6 +708,7 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
             ln_err_old: splat(st.ln_err_old),
             rej_last: splat(st.rej_last),
             active: <H<V> as Lanes>::splat(0.0),
+            kk: [[<H<V> as Lanes>::splat(0.0); M]; 7],
         });
         let mut slots: Vec<Slot<D>> = (0..<H<V> as Lanes>::LANES).map(|_| Slot::idle()).collect();
         for (k, &i) in busy.iter().enumerate() {
