@@ -2,7 +2,9 @@
 //! user's own) run through `ensemble::Ensemble`, each checked against the scalar
 //! `Simulation` + `Dopri5` and timed against it on one thread.
 //!
-//! `cargo run --release --features timing --example ensemble_any [-- --quick]`
+//! `cargo run --release --features timing --example ensemble_any [-- --quick] [--only NAME]`
+//! (`--only duffing_ueda`, `two_dof_impact`, `bouncing_ball` or `user_law_fallback`: that
+//! model alone, e.g. under a profiler)
 //!
 //! * (a) the Duffing–Ueda oscillator (`systems::DuffingUeda`), 64 forcing amplitudes;
 //! * (b) the 2-DOF impact system of the catalogue (`systems::TwoDofImpact`, state of
@@ -230,90 +232,114 @@ fn main() -> ExitCode {
 }
 
 fn run() -> nonsmooth::Result<bool> {
-    let quick = std::env::args().any(|a| a == "--quick");
+    let args: Vec<String> = std::env::args().collect();
+    let quick = args.iter().any(|a| a == "--quick");
+    let only = args
+        .iter()
+        .position(|a| a == "--only")
+        .map(|k| args.get(k + 1).map_or("", String::as_str));
+    let names = [
+        "duffing_ueda",
+        "two_dof_impact",
+        "bouncing_ball",
+        "user_law_fallback",
+    ];
+    if let Some(o) = only.filter(|o| !names.contains(o)) {
+        eprintln!("ensemble_any: --only takes one of {names:?}, not {o:?}");
+        return Ok(false);
+    }
+    let runs = |name: &str| only.is_none_or(|o| o == name);
     let n = 64;
     let periods = if quick { 10.0 } else { 200.0 };
     let mut ok = true;
 
     // (a) Duffing–Ueda, B from 5 to 12.
-    let tol = Tolerances::new(1e-8, 1e-10)?;
-    let jobs = (0..n)
-        .map(|i| {
-            let p = DuffingUeda {
-                b: 5.0 + 7.0 * i as f64 / (n - 1) as f64,
-                ..DuffingUeda::default()
-            };
-            Ok(MemberRun::<_, 2>::periods_of(
-                p.model::<f64>()?,
-                SVector::from([1.0, 0.0]),
-                p.period(),
-                periods,
-            )?)
-        })
-        .collect::<nonsmooth::Result<Vec<_>>>()?;
-    ok &= compare("duffing_ueda", &jobs, tol, ())?;
+    if runs(names[0]) {
+        let tol = Tolerances::new(1e-8, 1e-10)?;
+        let jobs = (0..n)
+            .map(|i| {
+                let p = DuffingUeda {
+                    b: 5.0 + 7.0 * i as f64 / (n - 1) as f64,
+                    ..DuffingUeda::default()
+                };
+                Ok(MemberRun::<_, 2>::periods_of(
+                    p.model::<f64>()?,
+                    SVector::from([1.0, 0.0]),
+                    p.period(),
+                    periods,
+                )?)
+            })
+            .collect::<nonsmooth::Result<Vec<_>>>()?;
+        ok &= compare(names[0], &jobs, tol, ())?;
+    }
 
     // (b) The 2-DOF impact system, ω from 0.3 to 1.3, its stop as a detection event.
-    let p = TwoDofImpact::default();
-    let tol = Tolerances::new(1e-8, 1e-10)?;
-    let jobs = (0..n)
-        .map(|i| {
-            let w = 0.3 + i as f64 / (n - 1) as f64;
-            Ok(MemberRun::<_, 4>::periods_of(
-                p.model::<f64>(w)?,
-                SVector::zeros(),
-                TwoDofImpact::period(w),
-                periods,
-            )?)
-        })
-        .collect::<nonsmooth::Result<Vec<_>>>()?;
-    let stop = Event::new(p.stop::<f64>()?, Direction::Rising);
-    ok &= compare("two_dof_impact", &jobs, tol, stop)?;
+    if runs(names[1]) {
+        let p = TwoDofImpact::default();
+        let tol = Tolerances::new(1e-8, 1e-10)?;
+        let jobs = (0..n)
+            .map(|i| {
+                let w = 0.3 + i as f64 / (n - 1) as f64;
+                Ok(MemberRun::<_, 4>::periods_of(
+                    p.model::<f64>(w)?,
+                    SVector::zeros(),
+                    TwoDofImpact::period(w),
+                    periods,
+                )?)
+            })
+            .collect::<nonsmooth::Result<Vec<_>>>()?;
+        let stop = Event::new(p.stop::<f64>()?, Direction::Rising);
+        ok &= compare(names[1], &jobs, tol, stop)?;
+    }
 
     // (c) The bouncing ball, Γ from 2.5 to 4 at e = 0.8: restitution on the moving table.
     // Each lane has its own table (Γ), so the event's surface differs per trajectory: one
     // ensemble per table would lose the lanes; instead the table amplitude is the same and
     // the ball's gravity varies (Γ = Aω²/g).
-    let base = BouncingBallTable::with_gamma(3.0, 0.8)?;
-    let tol = Tolerances::new(1e-10, 1e-12)?;
-    let jobs = (0..n)
-        .map(|i| {
-            let gamma = 2.5 + 1.5 * i as f64 / (n - 1) as f64;
-            let ball = BouncingBallTable {
-                g: base.amplitude * base.omega * base.omega / gamma,
-                ..base
-            };
-            let v0 = ball.table_motion(0.0).1 + 2.0;
-            Ok(MemberRun::<_, 2>::periods_of(
-                ball.model::<f64>()?,
-                SVector::from([0.0, v0]),
-                ball.period(),
-                periods,
-            )?)
-        })
-        .collect::<nonsmooth::Result<Vec<_>>>()?;
-    let impact =
-        Event::new(base.table::<f64>()?, Direction::Rising).with_reset(base.impact::<f64>()?);
-    ok &= compare("bouncing_ball", &jobs, tol, impact)?;
+    if runs(names[2]) {
+        let base = BouncingBallTable::with_gamma(3.0, 0.8)?;
+        let tol = Tolerances::new(1e-10, 1e-12)?;
+        let jobs = (0..n)
+            .map(|i| {
+                let gamma = 2.5 + 1.5 * i as f64 / (n - 1) as f64;
+                let ball = BouncingBallTable {
+                    g: base.amplitude * base.omega * base.omega / gamma,
+                    ..base
+                };
+                let v0 = ball.table_motion(0.0).1 + 2.0;
+                Ok(MemberRun::<_, 2>::periods_of(
+                    ball.model::<f64>()?,
+                    SVector::from([0.0, v0]),
+                    ball.period(),
+                    periods,
+                )?)
+            })
+            .collect::<nonsmooth::Result<Vec<_>>>()?;
+        let impact =
+            Event::new(base.table::<f64>()?, Direction::Rising).with_reset(base.impact::<f64>()?);
+        ok &= compare(names[2], &jobs, tol, impact)?;
+    }
 
     // (d) A law of one's own: the fallback evaluates the right-hand side lane by lane.
-    let tol = Tolerances::new(1e-8, 1e-10)?;
-    let jobs = (0..n)
-        .map(|i| {
-            let w = 0.5 + i as f64 / (n - 1) as f64;
-            let osc = Oscillator::new(
-                1.0,
-                (Softening { k: 1.0 }, ViscousDamper::new(0.1)?),
-                Harmonic::new(0.5, w, 0.0)?,
-            )?;
-            Ok(MemberRun::periods_of(
-                LaneByLane(osc),
-                SVector::from([0.1, 0.0]),
-                std::f64::consts::TAU / w,
-                periods,
-            )?)
-        })
-        .collect::<nonsmooth::Result<Vec<_>>>()?;
-    ok &= compare("user_law_fallback", &jobs, tol, ())?;
+    if runs(names[3]) {
+        let tol = Tolerances::new(1e-8, 1e-10)?;
+        let jobs = (0..n)
+            .map(|i| {
+                let w = 0.5 + i as f64 / (n - 1) as f64;
+                let osc = Oscillator::new(
+                    1.0,
+                    (Softening { k: 1.0 }, ViscousDamper::new(0.1)?),
+                    Harmonic::new(0.5, w, 0.0)?,
+                )?;
+                Ok(MemberRun::periods_of(
+                    LaneByLane(osc),
+                    SVector::from([0.1, 0.0]),
+                    std::f64::consts::TAU / w,
+                    periods,
+                )?)
+            })
+            .collect::<nonsmooth::Result<Vec<_>>>()?;
+        ok &= compare(names[3], &jobs, tol, ())?;
+    }
     Ok(ok)
 }

@@ -330,11 +330,8 @@ impl<T: Real> Excitation<T> for Harmonic<T> {
             return None;
         }
         let [a, w, p] = [self.amplitude, self.omega, self.phase0].map(|x| V::splat(to_f64(x)));
-        let phase = saturate_lanes(w * t + p);
-        Some((
-            a * crate::lanes::math::sin(phase),
-            a * w * crate::lanes::math::cos(phase),
-        ))
+        let (sin, cos) = crate::lanes::math::sin_cos(saturate_lanes(w * t + p));
+        Some((a * sin, a * w * cos))
     }
     fn force_acceleration(&self, t: T) -> T {
         -self.amplitude * self.omega * self.omega * fastmath::sin(self.omega * t + self.phase0)
@@ -431,11 +428,8 @@ impl<T: Real> Excitation<T> for UnbalancedRotor<T> {
             return None;
         }
         let [a, w] = [self.amp, self.omega].map(|x| V::splat(to_f64(x)));
-        let phase = saturate_lanes(w * t);
-        Some((
-            a * crate::lanes::math::sin(phase),
-            a * w * crate::lanes::math::cos(phase),
-        ))
+        let (sin, cos) = crate::lanes::math::sin_cos(saturate_lanes(w * t));
+        Some((a * sin, a * w * cos))
     }
     fn force_acceleration(&self, t: T) -> T {
         -self.amp * self.omega * self.omega * fastmath::sin(self.omega * t)

@@ -480,7 +480,7 @@ fn lcg(n: usize) -> impl Iterator<Item = f64> {
 }
 
 #[test]
-fn lane_sin_and_cos_are_the_scalar_kernels_to_the_bit() {
+fn lane_sin_cos_and_sin_cos_are_the_scalar_kernels_to_the_bit() {
     let mut xs: Vec<f64> = lcg(40_000)
         .flat_map(|u| [u * 8.0 - 4.0, (u - 0.5) * 1.1e6, u * 2e4, (u - 0.5) * 1e-8])
         .collect();
@@ -498,8 +498,27 @@ fn lane_sin_and_cos_are_the_scalar_kernels_to_the_bit() {
     for c in xs.chunks(4) {
         let v = F64x4::load(c);
         let (s, co) = (math::sin(v), math::cos(v));
+        let (s2, co2) = math::sin_cos(v);
         for (i, &x) in c.iter().enumerate() {
             let (want, want_cos) = (nonsmooth::util::sin_f64(x), nonsmooth::util::cos_f64(x));
+            // One reduction for both: the same bits as each alone, and as the scalar pair.
+            let pair = nonsmooth::util::sin_cos_f64(x);
+            assert!(
+                s2.lane(i).to_bits() == s.lane(i).to_bits()
+                    || (s2.lane(i).is_nan() && s.lane(i).is_nan())
+            );
+            assert!(
+                co2.lane(i).to_bits() == co.lane(i).to_bits()
+                    || (co2.lane(i).is_nan() && co.lane(i).is_nan())
+            );
+            assert!(
+                pair.0.to_bits() == want.to_bits() || (pair.0.is_nan() && want.is_nan()),
+                "sin_cos_f64({x})"
+            );
+            assert!(
+                pair.1.to_bits() == want_cos.to_bits() || (pair.1.is_nan() && want_cos.is_nan()),
+                "sin_cos_f64({x})"
+            );
             let (got, got_cos) = (s.lane(i), co.lane(i));
             assert!(
                 got.to_bits() == want.to_bits() || (got.is_nan() && want.is_nan()),

@@ -44,7 +44,7 @@ use crate::scalar::{lit, to_f64};
 use crate::validate::ParameterError;
 use crate::{Dynamics, Real};
 use error::Result;
-pub(crate) use scan::{Scan, Sides, initial_sides};
+pub(crate) use scan::{QuietEnds, Scan, Sides, initial_sides};
 
 /// Whether a run goes on.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

@@ -10,6 +10,7 @@ use super::error::Result;
 use super::{Control, EventRecord, Observer, RunError, StepView, Termination};
 use crate::event::{Direction, EventError, EventHistory, EventSet, MAX_EVENTS, ZenoGuard, locate};
 use crate::integrate::{DenseOutput, Stats};
+use crate::lanes::Lanes;
 use crate::scalar::{lit, to_f64};
 use crate::{Dynamics, Real};
 
@@ -541,32 +542,68 @@ pub(crate) struct Sides {
 
 impl Sides {
     /// Whether [`Scan::scan_step`] would find nothing in a step where event `i` goes from
-    /// `g0` to `g1` with rates `r0`, `r1` at the ends (the event's own values): both ends
-    /// finite and on one side of the surface, a known side, no interior samples, no
-    /// grazing pair in the rates (one end moving towards the surface and the other away),
-    /// and no sticking (the conditions of `start_scan`, `crossing_between` and
-    /// `check_sticking`, in which any doubt means "not quiet"). The scan of such a step
-    /// only moves the side to the sign of `g1` ([`quiet_step`](Self::quiet_step)); the
-    /// ensemble skips it where every event's step is quiet.
+    /// `g0` to `g1` with rates `r0`, `r1` at the ends (the event's own values), given the
+    /// ends' part `q = QuietEnds::of((g0, g1), (r0, r1))`: both ends finite and on one
+    /// side of the surface, no grazing pair in the rates (one end moving towards the
+    /// surface and the other away) — that is `q` — and here a known side, no interior
+    /// samples, and no sticking (the conditions of `start_scan`, `crossing_between` and
+    /// `check_sticking`, in which any doubt means "not quiet"): not disarmed, or on the
+    /// wrong side of a resetting event, while moving into its side. The scan of such a
+    /// step only moves the side to that of the ends ([`quiet_step`](Self::quiet_step));
+    /// the ensemble skips it where every event's step is quiet, with `q` from
+    /// [`QuietEnds::lanes`].
     #[inline(always)]
-    pub(crate) fn is_quiet<T: Real, const N: usize, E: EventSet<T, N>>(
+    pub(crate) fn is_quiet_with<T: Real, const N: usize, E: EventSet<T, N>>(
         &self,
         events: &E,
         i: usize,
-        (g0, g1): (T, T),
-        (r0, r1): (Option<T>, Option<T>),
+        q: QuietEnds,
     ) -> bool {
-        if !(g0.is_finite() && g1.is_finite())
-            || g0 == T::zero()
-            || g1 == T::zero()
-            || self.side[i] == 0
-            || events.interior_samples(i) > 0
-        {
+        if self.side[i] == 0 || events.interior_samples(i) > 0 {
             return false;
+        }
+        let s = if q.positive { 1 } else { -1 };
+        let wrong_side = match events.direction(i) {
+            Direction::Rising => 1,
+            Direction::Falling => -1,
+            Direction::Either => 0,
+        };
+        let stuck = !self.armed[i] || (events.resets(i) && s == wrong_side);
+        !(stuck && q.rate_on_side)
+    }
+
+    /// What the scan of a quiet step ([`is_quiet_with`](Self::is_quiet_with)) does to
+    /// event `i`: its side becomes that of the step's ends (`positive`: `g > 0` there).
+    #[inline(always)]
+    pub(crate) fn quiet_step(&mut self, i: usize, positive: bool) {
+        self.side[i] = if positive { 1 } else { -1 };
+    }
+}
+
+/// What a quiet step's ends say about one event ([`QuietEnds::of`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct QuietEnds {
+    /// The side of both ends: `g > 0` (else `g < 0`).
+    pub(crate) positive: bool,
+    /// The rate at the end is known, non-zero and points into that side (`ġ > 0` on the
+    /// positive side): moving away from the surface.
+    pub(crate) rate_on_side: bool,
+}
+
+impl QuietEnds {
+    /// The ends' part of [`Sides::is_quiet_with`]: `None` unless `g0`, `g1` are finite,
+    /// non-zero and of one sign, and the rates (where both are known) are not a grazing
+    /// pair (the start moving towards the surface, the end away from it). The rule as the
+    /// scan states it, for one lane; the ensemble uses its lane form
+    /// [`lanes`](Self::lanes), which the tests hold to it.
+    #[cfg(test)]
+    pub(crate) fn of<T: Real>((g0, g1): (T, T), (r0, r1): (Option<T>, Option<T>)) -> Option<Self> {
+        if !(g0.is_finite() && g1.is_finite()) || g0 == T::zero() || g1 == T::zero() {
+            return None;
         }
         let s = sign_of(g0);
         if sign_of(g1) != s {
-            return false;
+            return None;
         }
         let positive = s > 0;
         let towards = |r: T| {
@@ -585,23 +622,39 @@ impl Sides {
         };
         if let (Some(r0), Some(r1)) = (r0, r1) {
             if towards(r0) && away(r1) {
-                return false;
+                return None;
             }
         }
-        let wrong_side = match events.direction(i) {
-            Direction::Rising => 1,
-            Direction::Falling => -1,
-            Direction::Either => 0,
-        };
-        let stuck = !self.armed[i] || (events.resets(i) && s == wrong_side);
-        !(stuck && r1.is_some_and(|r| r != T::zero() && sign_of(r) == s))
+        Some(Self {
+            positive,
+            rate_on_side: r1.is_some_and(away),
+        })
     }
 
-    /// What the scan of a quiet step ([`is_quiet`](Self::is_quiet)) does to event `i`:
-    /// its side becomes the sign of `g1 ≠ 0`.
+    /// [`of`](Self::of) in every lane, as masks: the lanes where it is `Some`, their
+    /// `positive` and their `rate_on_side` (the last two meaningful where the first is
+    /// set). Where the first mask is set, [`of`](Self::of) of the same values is `Some`
+    /// with the same fields; it may be clear where [`of`](Self::of) is `Some` only when
+    /// `g0·g1` under- or overflows (one rounded product tests both ends' sign and
+    /// finiteness). A lane so reported not quiet goes through the whole scan, which finds
+    /// the same nothing: the answer is conservative, never wrong.
     #[inline(always)]
-    pub(crate) fn quiet_step<T: Real>(&mut self, i: usize, g1: T) {
-        self.side[i] = sign_of(g1);
+    pub(crate) fn lanes<V: Lanes>((g0, g1): (V, V), (r0, r1): (Option<V>, Option<V>)) -> [V; 3] {
+        let z = V::splat(0.0);
+        let p = g0 * g1;
+        let mut quiet = p.gt(z) & p.lt(V::splat(f64::INFINITY));
+        let positive = g0.gt(z);
+        let Some(r1) = r1 else {
+            return [quiet, positive, z];
+        };
+        // Away from the surface at the end: into the side.
+        let away = (positive & r1.gt(z)) | (!positive & r1.lt(z));
+        if let Some(r0) = r0 {
+            // Towards it at the start: a grazing pair.
+            let towards = (positive & r0.lt(z)) | (!positive & r0.gt(z));
+            quiet = quiet & !(towards & away);
+        }
+        [quiet, positive, away]
     }
 }
 
@@ -667,5 +720,84 @@ pub(crate) fn sign_of<T: Real>(x: T) -> i8 {
         -1
     } else {
         0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::QuietEnds;
+    use crate::lanes::{F64x4, Lanes};
+
+    /// `QuietEnds::lanes` is `QuietEnds::of` lane for lane, over signed zeros, tiny, huge,
+    /// ordinary, infinite and NaN values and every combination of known rates, except
+    /// that it may answer "not quiet" where the product of the ends rounds to zero or
+    /// infinity.
+    #[test]
+    fn quiet_ends_in_lanes_is_the_scalar_rule() {
+        let vals = [
+            0.0,
+            -0.0,
+            1e-300,
+            -1e-300,
+            0.5,
+            -2.0,
+            1e200,
+            -1e300,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+        ];
+        let mut cases = Vec::new();
+        for &g0 in &vals {
+            for &g1 in &vals {
+                for &r0 in &vals {
+                    for &r1 in &vals {
+                        cases.push([g0, g1, r0, r1]);
+                    }
+                }
+            }
+        }
+        // Not quiet; quiet on either side; quiet with the rate into the side.
+        let mut seen = [0usize; 4];
+        let mut conservative = 0;
+        for chunk in cases.chunks(4) {
+            let col = |k: usize| F64x4::load(&chunk.iter().map(|c| c[k]).collect::<Vec<_>>());
+            let (g0, g1, r0, r1) = (col(0), col(1), col(2), col(3));
+            for (has0, has1) in [(false, false), (true, false), (false, true), (true, true)] {
+                let r = (has0.then_some(r0), has1.then_some(r1));
+                let [q, pos, on] = QuietEnds::lanes((g0, g1), r);
+                let (q, pos, on) = (q.bits(), pos.bits(), on.bits());
+                for (i, c) in chunk.iter().enumerate() {
+                    let want =
+                        QuietEnds::of((c[0], c[1]), (has0.then_some(c[2]), has1.then_some(c[3])));
+                    let got = (q >> i & 1 == 1).then_some(QuietEnds {
+                        positive: pos >> i & 1 == 1,
+                        rate_on_side: on >> i & 1 == 1,
+                    });
+                    // Conservative only where the product of the ends is not a finite
+                    // non-zero number although both ends are.
+                    let product = c[0] * c[1];
+                    let rounded = !(product != 0.0 && product.is_finite());
+                    assert!(
+                        got == want || (got.is_none() && rounded),
+                        "g = ({}, {}), r = {:?}: {got:?} vs {want:?}",
+                        c[0],
+                        c[1],
+                        (has0, has1, c[2], c[3])
+                    );
+                    conservative += usize::from(got != want);
+                    match want {
+                        None => seen[0] += 1,
+                        Some(w) => {
+                            seen[1 + usize::from(w.positive)] += 1;
+                            seen[3] += usize::from(w.rate_on_side);
+                        }
+                    }
+                }
+            }
+        }
+        assert!(seen.iter().all(|&n| n > 0), "{seen:?}");
+        // The rounded products occur (1e-300², 1e200·1e300) and are the only difference.
+        assert!(conservative > 0);
     }
 }

@@ -2,10 +2,10 @@
 
 use nalgebra::SVector;
 
-use super::kernel::{LaneState, StepConsts, StepOut, row};
+use super::kernel::{EndsCache, LaneState, StepConsts, StepOut, row};
 use crate::LaneDynamics;
 use crate::drive::{Control, Observer, Outcome, RunError, StepView, Termination};
-use crate::drive::{Scan, Sides, check_work, step_limit, time_scale};
+use crate::drive::{QuietEnds, Scan, Sides, check_work, step_limit, time_scale};
 use crate::event::{Event, EventFunction, EventHistory, EventSet, MAX_EVENTS, ZenoGuard};
 use crate::integrate::{DenseOutput, IntegrateError, Stats, StepOptions, Tolerances};
 use crate::lanes::{LaneMath, Lanes, Simd, TRUE};
@@ -445,9 +445,6 @@ struct Engine<'a, V: Lanes, E, D: LaneDynamics<M>, const M: usize> {
     /// stays at the fast end.
     st: Box<LaneState<V, D, M>>,
     consts: StepConsts<M>,
-    /// Each event's value at the end of each lane's quiet step
-    /// ([`quiet_lanes`](Self::quiet_lanes)).
-    quiet_ends: [[f64; 16]; MAX_EVENTS],
 }
 
 /// The lanes whose bit is set in `mask`, in increasing order.
@@ -491,9 +488,10 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
                 rej_last: z,
                 active: z,
                 kk: [[z; M]; 7],
+                accepted: z,
+                ends: EndsCache::new(),
             }),
             consts: StepConsts::new(&cfg.tol, &cfg.opts, cfg.math, cfg.simd),
-            quiet_ends: [[0.0; 16]; MAX_EVENTS],
         }
     }
 
@@ -505,13 +503,13 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
         observers: &mut [O],
         out: &mut [Option<Result<Outcome<f64, M>>>],
     ) {
-        self.st.active = self.st.active.with_lane(i, 0.0);
+        self.st.active.set_lane(i, 0.0);
         self.slots[i].job = None;
         while let Some(&j) = self.queue.get(self.next) {
             self.next += 1;
             match self.start(i, j, &mut observers[j]) {
                 Ok(()) => {
-                    self.st.active = self.st.active.with_lane(i, TRUE);
+                    self.st.active.set_lane(i, TRUE);
                     return;
                 }
                 Err(e) => out[j] = Some(Err(e)),
@@ -561,15 +559,16 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
             ),
         };
         m.pack_lane(&mut self.st.packed, i);
-        self.st.t = self.st.t.with_lane(i, t0);
+        self.st.t.set_lane(i, t0);
         for c in 0..M {
-            self.st.y[c] = self.st.y[c].with_lane(i, y0[c]);
-            self.st.f[c] = self.st.f[c].with_lane(i, f0[c]);
+            self.st.y[c].set_lane(i, y0[c]);
+            self.st.f[c].set_lane(i, f0[c]);
         }
-        self.st.h = self.st.h.with_lane(i, h);
-        self.st.limit = self.st.limit.with_lane(i, limit);
-        self.st.ln_err_old = self.st.ln_err_old.with_lane(i, 1e-4f64.ln());
-        self.st.rej_last = self.st.rej_last.with_lane(i, 0.0);
+        self.st.h.set_lane(i, h);
+        self.st.limit.set_lane(i, limit);
+        self.st.ln_err_old.set_lane(i, 1e-4f64.ln());
+        self.st.rej_last.set_lane(i, 0.0);
+        self.st.ends.fresh.set_lane(i, TRUE);
         let s = &mut self.slots[i];
         *s = Slot::idle();
         s.job = Some(j);
@@ -628,7 +627,7 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
         observers: &mut [O],
         out: &mut [Option<Result<Outcome<f64, M>>>],
     ) {
-        let mut step = Box::new(StepOut::new(M, E::LEN));
+        let mut step = Box::new(StepOut::new(M));
         // The events' ends tell which lanes' steps are quiet (quiet_lanes).
         let want_events = E::LEN > 0;
         while self.st.active.bits() != 0 {
@@ -642,9 +641,11 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
             super::kernel::step(&mut self.st, &self.consts, &mut step);
             step.events = false;
             if want_events && step.accepted != 0 {
+                let st = &mut *self.st;
                 super::kernel::event_ends::<V, E, M>(
                     &self.cfg.events,
                     self.consts.simd(),
+                    (&mut st.ends, st.accepted),
                     &mut step,
                 );
             }
@@ -677,7 +678,7 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
             let quiet = self.quiet_lanes(&step);
             for i in lanes_of(step.accepted) {
                 if quiet & (1 << i) != 0 {
-                    self.after_quiet_step(i, &step.buf, observers, out);
+                    self.after_quiet_step(i, &step, observers, out);
                 } else {
                     let dense = LaneDense::<M>::from_rows(&step.buf, i);
                     self.after_step(i, &dense, observers, out);
@@ -709,6 +710,8 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
             rej_last: splat(st.rej_last),
             active: <H<V> as Lanes>::splat(0.0),
             kk: [[<H<V> as Lanes>::splat(0.0); M]; 7],
+            accepted: <H<V> as Lanes>::splat(0.0),
+            ends: EndsCache::new(),
         });
         let mut slots: Vec<Slot<D>> = (0..<H<V> as Lanes>::LANES).map(|_| Slot::idle()).collect();
         for (k, &i) in busy.iter().enumerate() {
@@ -736,7 +739,6 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
             slots,
             st: half,
             consts: self.consts,
-            quiet_ends: self.quiet_ends,
         }
     }
 
@@ -787,11 +789,12 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
                         self.finish(i, Err(e.into()), observers, out);
                         return;
                     }
-                    self.st.t = self.st.t.with_lane(i, t);
+                    self.st.t.set_lane(i, t);
                     for c in 0..M {
-                        self.st.y[c] = self.st.y[c].with_lane(i, y[c]);
-                        self.st.f[c] = self.st.f[c].with_lane(i, f[c]);
+                        self.st.y[c].set_lane(i, y[c]);
+                        self.st.f[c].set_lane(i, f[c]);
                     }
+                    self.st.ends.fresh.set_lane(i, TRUE);
                 }
                 let slot = &self.slots[i];
                 if t >= slot.t_end {
@@ -817,7 +820,7 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
         // is the current one again, so it is then only recomputed near or on it, or after
         // a restart.
         let slot = &self.slots[i];
-        let limit = self.st.limit.lane(i);
+        let limit = self.st.limit.get_lane(i);
         let scale = t.abs() + slot.grid.map_or(0.0, |(o, dt)| o.abs() + dt);
         if slot.scaled || restarted || limit - t <= 64.0 * f64::EPSILON * scale {
             let bound = match (&slot.member, slot.scaled) {
@@ -825,16 +828,17 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
                 _ => None,
             };
             let l = step_limit(t, slot.t_end, slot.grid, bound);
-            self.st.limit = self.st.limit.with_lane(i, l);
+            self.st.limit.set_lane(i, l);
         }
     }
 
     /// The accepted lanes whose step the driver's event handling would pass through
     /// without doing anything but moving the events' sides and showing the whole step to
-    /// the observer: every event's step is quiet ([`Sides::is_quiet`], from the events'
-    /// lane forms, which the kernel evaluates at both ends of every lane's step at once,
-    /// under the run's instruction set) and the trajectory does not end with this step.
-    /// Empty if an event has no lane form.
+    /// the observer: every event's step is quiet ([`Sides::is_quiet_with`], its ends'
+    /// part [`QuietEnds::lanes`] from the events' lane forms, which the kernel evaluates
+    /// at the ends of every lane's step at once, under the run's instruction set, keeping
+    /// each end as the next step's start) and the trajectory does not end with this
+    /// step. Empty if an event has no lane form.
     fn quiet_lanes(&mut self, step: &StepOut) -> u32 {
         let buf = &step.buf;
         let mut quiet = 0;
@@ -851,20 +855,18 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
         if !step.events {
             return 0;
         }
-        for e in 0..E::LEN {
-            let at = |q: usize| &buf[row::event(e, q, M)];
-            let (g0, g1, r0, r1) = (at(row::G0), at(row::G1), at(row::R0), at(row::R1));
-            let (has0, has1) = (step.rates & (1 << (2 * e)), step.rates & (1 << (2 * e + 1)));
+        for (e, &[ends, positive, rate_on_side]) in step.quiet.iter().enumerate().take(E::LEN) {
+            quiet &= ends;
             for i in lanes_of(quiet) {
-                let Some(sides) = &self.slots[i].sides else {
-                    quiet &= !(1 << i);
-                    continue;
+                let q = QuietEnds {
+                    positive: positive & (1 << i) != 0,
+                    rate_on_side: rate_on_side & (1 << i) != 0,
                 };
-                let g = (g0[i], g1[i]);
-                let r = ((has0 != 0).then(|| r0[i]), (has1 != 0).then(|| r1[i]));
-                if sides.is_quiet(&self.cfg.events, e, g, r) {
-                    self.quiet_ends[e][i] = g.1;
-                } else {
+                let ok = self.slots[i]
+                    .sides
+                    .as_ref()
+                    .is_some_and(|sides| sides.is_quiet_with(&self.cfg.events, e, q));
+                if !ok {
                     quiet &= !(1 << i);
                 }
             }
@@ -882,10 +884,11 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
     fn after_quiet_step<O: Observer<f64, M>>(
         &mut self,
         i: usize,
-        buf: &[[f64; 16]],
+        step: &StepOut,
         observers: &mut [O],
         out: &mut [Option<Result<Outcome<f64, M>>>],
     ) {
+        let (buf, quiet) = (&step.buf, &step.quiet);
         let slot = &mut self.slots[i];
         slot.stats.rhs_evals += 6;
         slot.stats.accepted += 1;
@@ -909,8 +912,8 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
         }
         let slot = &mut self.slots[i];
         if let Some(sides) = &mut slot.sides {
-            for (e, g1) in self.quiet_ends.iter().enumerate().take(E::LEN) {
-                sides.quiet_step(e, g1[i]);
+            for (e, &[_, positive, _]) in quiet.iter().enumerate().take(E::LEN) {
+                sides.quiet_step(e, positive & (1 << i) != 0);
             }
         }
         self.update_limit(i, t1, false);

@@ -9,7 +9,8 @@
 //! AVX-512 target features where the CPU has them.
 
 use crate::LaneDynamics;
-use crate::event::EventSet;
+use crate::drive::QuietEnds;
+use crate::event::{EventSet, MAX_EVENTS};
 use crate::integrate::dopri5::tableau;
 use crate::integrate::{StepOptions, Tolerances};
 use crate::lanes::math::{exp, ln};
@@ -29,6 +30,38 @@ pub(crate) struct LaneState<V: Lanes, D: LaneDynamics<M>, const M: usize> {
     pub(crate) active: V,
     /// The seven stages of the last trial step (scratch of [`stages`]).
     pub(crate) kk: [[V; M]; 7],
+    /// The lanes whose last trial step was accepted.
+    pub(crate) accepted: V,
+    /// The events at each lane's start ([`event_ends`]).
+    pub(crate) ends: EndsCache<V>,
+}
+
+/// Each event's value and rate at each lane's current start, kept from the end of the
+/// lane's last accepted step: [`event_ends`] then evaluates an event once per point of a
+/// trajectory instead of twice (at both ends of every step). The start of a step is
+/// exactly the end of the last accepted one (`t`, the state and its derivative, to the
+/// bit) except after a new start or a restart at an event, which mark the lane fresh.
+#[derive(Debug, Clone)]
+pub(crate) struct EndsCache<V> {
+    /// The lanes whose start is not kept (every lane of a new cache).
+    pub(crate) fresh: V,
+    g: [V; MAX_EVENTS],
+    r: [V; MAX_EVENTS],
+    /// Bit `e`: event `e` had a rate at the last update.
+    has_rate: u32,
+}
+
+impl<V: Lanes> EndsCache<V> {
+    /// A cache with every lane fresh.
+    pub(crate) fn new() -> Self {
+        let z = V::splat(0.0);
+        Self {
+            fresh: V::splat(TRUE),
+            g: [z; MAX_EVENTS],
+            r: [z; MAX_EVENTS],
+            has_rate: 0,
+        }
+    }
 }
 
 /// The scalar settings of a step: tolerances, controller constants, math mode and the
@@ -94,19 +127,10 @@ pub(crate) mod row {
     pub const R3: usize = 5;
     pub const R4: usize = 6;
     pub const R5: usize = 7;
-    /// The number of rows for a state of `m` components (without the events' rows).
+    /// The number of rows for a state of `m` components.
     pub const fn count(m: usize) -> usize {
         3 + 8 * m
     }
-    /// The row of event `e`'s quantity `q` (`G0, G1, R0, R1`: value and rate at the step's
-    /// start and end), after the state's rows.
-    pub const fn event(e: usize, q: usize, m: usize) -> usize {
-        count(m) + 4 * e + q
-    }
-    pub const G0: usize = 0;
-    pub const G1: usize = 1;
-    pub const R0: usize = 2;
-    pub const R1: usize = 3;
 }
 
 /// What one pass did (bit `i` for lane `i`) and the data of the accepted steps.
@@ -121,28 +145,28 @@ pub(crate) struct StepOut {
     pub(crate) accepted: u32,
     /// Lanes whose trial step was not finite (rejected; `buf[T0]` holds their `t`).
     pub(crate) non_finite: u32,
-    /// Whether every event has a lane form and its values at the ends of this pass's
-    /// steps are in `buf` ([`event_ends`]).
+    /// Whether every event has a lane form and `quiet` holds what the ends of this
+    /// pass's steps say about each ([`event_ends`]).
     pub(crate) events: bool,
-    /// Bit `2e` (`2e + 1`): event `e`'s rate at the start (end) is in `buf`.
-    pub(crate) rates: u32,
+    /// Per event, the masks of [`QuietEnds::lanes`] (bit `i` for lane `i`): the lanes
+    /// whose step ends allow a quiet step, their side, and their rate into it.
+    pub(crate) quiet: [[u32; 3]; MAX_EVENTS],
     /// For accepted lanes: `t₀, t₁, h`, then `y₀, y₁, f₀, f₁` and the dense output's
-    /// `r₂…r₅`, `M` rows each, then four rows per event ([`row::event`], filled by
-    /// [`event_ends`]). Allocated once per run.
+    /// `r₂…r₅`, `M` rows each. Allocated once per run.
     pub(crate) buf: Vec<[f64; 16]>,
 }
 
 impl StepOut {
-    /// The output of a state of `m` components with `events` events.
-    pub(crate) fn new(m: usize, events: usize) -> Self {
+    /// The output of a state of `m` components.
+    pub(crate) fn new(m: usize) -> Self {
         Self {
             too_small: 0,
             rejected: 0,
             accepted: 0,
             non_finite: 0,
             events: false,
-            rates: 0,
-            buf: vec![[0.0; 16]; row::count(m) + 4 * events],
+            quiet: [[0; 3]; MAX_EVENTS],
+            buf: vec![[0.0; 16]; row::count(m)],
         }
     }
 }
@@ -366,6 +390,7 @@ fn body<V: Lanes, D: LaneDynamics<M>, const M: usize>(
     let h_rej = hs / (fac_any / safety).min(inv_fac_min);
     let h_next = acc_mask.select(h_acc, err_ok.select(h_rej, hs * s(0.1)));
     let accepted = acc_mask & st.active;
+    st.accepted = accepted;
     let rejected = !accepted & st.active;
     // Rejected lanes retry with the smaller step.
     st.h = rejected.select(h_next, st.h);
@@ -404,50 +429,61 @@ fn body<V: Lanes, D: LaneDynamics<M>, const M: usize>(
 }
 
 /// Every event's value and rate at both ends of the accepted steps of a pass (from the
-/// rows `T0, T1, X0, X1, F0, F1` of `out`), from its lane form, into the rows
-/// [`row::event`]; `out.events` tells whether every event has one. Compiled, like
+/// rows `T0, T1, X0, X1, F0, F1` of `out`; at the start from `cache` where the lane is not
+/// fresh), from its lane form, and what they say about a quiet step
+/// ([`QuietEnds::lanes`], into `out.quiet`); `out.events` tells whether every event has a
+/// lane form. The accepted lanes' ends become their cached starts. Compiled, like
 /// [`step`], for the instruction set `simd` (and apart from it, so that the step is not
 /// compiled again for each event set).
 #[inline(never)]
 pub(crate) fn event_ends<V: Lanes, E: EventSet<f64, M>, const M: usize>(
     events: &E,
     simd: Simd,
+    (cache, accepted): (&mut EndsCache<V>, V),
     out: &mut StepOut,
 ) {
     #[cfg(target_arch = "x86_64")]
     match simd {
         Simd::Avx512 => {
             if let Some(v4) = pulp::x86::V4::try_new() {
-                return pulp::Simd::vectorize(v4, Ends::<V, E, M>::new(events, out));
+                let ends = Ends::<V, E, M>::new(events, (cache, accepted), out);
+                return pulp::Simd::vectorize(v4, ends);
             }
         }
         Simd::Avx2 => {
             if let Some(v3) = pulp::x86::V3::try_new() {
-                return pulp::Simd::vectorize(v3, Ends::<V, E, M>::new(events, out));
+                let ends = Ends::<V, E, M>::new(events, (cache, accepted), out);
+                return pulp::Simd::vectorize(v3, ends);
             }
         }
         _ => {}
     }
     #[cfg(not(target_arch = "x86_64"))]
     let _ = simd;
-    ends_body::<V, E, M>(events, out)
+    ends_body::<V, E, M>(events, (cache, accepted), out)
 }
 
 /// The events' ends, handed to `pulp` like [`Pass`].
 #[cfg(target_arch = "x86_64")]
 struct Ends<'a, V, E, const M: usize> {
     events: &'a E,
+    cache: &'a mut EndsCache<V>,
+    accepted: V,
     out: &'a mut StepOut,
-    lanes: core::marker::PhantomData<V>,
 }
 
 #[cfg(target_arch = "x86_64")]
 impl<'a, V, E, const M: usize> Ends<'a, V, E, M> {
-    fn new(events: &'a E, out: &'a mut StepOut) -> Self {
+    fn new(
+        events: &'a E,
+        (cache, accepted): (&'a mut EndsCache<V>, V),
+        out: &'a mut StepOut,
+    ) -> Self {
         Self {
             events,
+            cache,
+            accepted,
             out,
-            lanes: core::marker::PhantomData,
         }
     }
 }
@@ -458,40 +494,66 @@ impl<V: Lanes, E: EventSet<f64, M>, const M: usize> pulp::WithSimd for Ends<'_, 
 
     #[inline(always)]
     fn with_simd<S: pulp::Simd>(self, _simd: S) {
-        ends_body::<V, E, M>(self.events, self.out)
+        ends_body::<V, E, M>(self.events, (self.cache, self.accepted), self.out)
     }
 }
 
 #[inline(always)]
-fn ends_body<V: Lanes, E: EventSet<f64, M>, const M: usize>(events: &E, out: &mut StepOut) {
+fn ends_body<V: Lanes, E: EventSet<f64, M>, const M: usize>(
+    events: &E,
+    (cache, accepted): (&mut EndsCache<V>, V),
+    out: &mut StepOut,
+) {
     out.events = false;
-    out.rates = 0;
     let buf = &out.buf;
     let load = |r: usize| V::load(&buf[r]);
     let vector = |q: usize| -> [V; M] { core::array::from_fn(|c| load(row::vector(q, M) + c)) };
-    let (t0, t1) = (load(row::T0), load(row::T1));
-    let (y0, y1, f0, f1) = (
-        vector(row::X0),
-        vector(row::X1),
-        vector(row::F0),
-        vector(row::F1),
-    );
-    for e in 0..E::LEN {
-        let (Some((g0, r0)), Some((g1, r1))) =
-            (events.lanes(e, t0, &y0, &f0), events.lanes(e, t1, &y1, &f1))
-        else {
+    let (t1, y1, f1) = (load(row::T1), vector(row::X1), vector(row::F1));
+    let fresh = cache.fresh & accepted;
+    let any_fresh = fresh.bits() != 0;
+    let mut quiet = [[V::splat(0.0); 3]; MAX_EVENTS];
+    for (e, q) in quiet.iter_mut().enumerate().take(E::LEN) {
+        let Some((g1, r1)) = events.lanes(e, t1, &y1, &f1) else {
             return;
         };
-        g0.store(&mut out.buf[row::event(e, row::G0, M)]);
-        g1.store(&mut out.buf[row::event(e, row::G1, M)]);
-        if let Some(r0) = r0 {
-            r0.store(&mut out.buf[row::event(e, row::R0, M)]);
-            out.rates |= 1 << (2 * e);
-        }
+        let kept_r = (cache.has_rate & (1 << e) != 0).then_some(cache.r[e]);
+        // Lanes whose start values are not to be trusted: none, unless the event's rate
+        // came and went between points (then only the fresh lanes are evaluated here).
+        let mut trust = V::splat(TRUE);
+        let (g0, r0) = if any_fresh {
+            let (t0, y0, f0) = (load(row::T0), vector(row::X0), vector(row::F0));
+            let Some((g, r)) = events.lanes(e, t0, &y0, &f0) else {
+                return;
+            };
+            let r0 = match (r, kept_r) {
+                (Some(n), Some(k)) => Some(fresh.select(n, k)),
+                (r, k) => {
+                    if r.is_some() != k.is_some() {
+                        trust = fresh;
+                    }
+                    r
+                }
+            };
+            (fresh.select(g, cache.g[e]), r0)
+        } else {
+            if r1.is_some() != kept_r.is_some() {
+                trust = V::splat(0.0);
+            }
+            (cache.g[e], kept_r)
+        };
+        let [ends, positive, away] = QuietEnds::lanes((g0, g1), (r0, r1));
+        *q = [ends & trust, positive, away];
+        cache.g[e] = accepted.select(g1, cache.g[e]);
         if let Some(r1) = r1 {
-            r1.store(&mut out.buf[row::event(e, row::R1, M)]);
-            out.rates |= 1 << (2 * e + 1);
+            cache.r[e] = accepted.select(r1, cache.r[e]);
+            cache.has_rate |= 1 << e;
+        } else {
+            cache.has_rate &= !(1 << e);
         }
+    }
+    cache.fresh = cache.fresh & !accepted;
+    for (bits, q) in out.quiet.iter_mut().zip(&quiet).take(E::LEN) {
+        *bits = q.map(V::bits);
     }
     out.events = true;
 }

@@ -50,10 +50,11 @@ pub trait EventFunction<T: Real, const N: usize> {
     /// `L` points `(t, y, dy)` at once, one per lane, each lane equal to the scalar
     /// functions at that lane's point to the bit (the rate `None` exactly where `rate` is
     /// `None`). `None` (the default) if the function has none. The ensemble
-    /// ([`Ensemble`](crate::ensemble::Ensemble)) evaluates its events at both ends of every
-    /// lane's step with it and searches a step lane by lane only where it may hold an
-    /// event (the driver's own conditions); without it, every step is searched lane by
-    /// lane: the same results, more time. Implemented by [`Level`](super::Level),
+    /// ([`Ensemble`](crate::ensemble::Ensemble)) evaluates its events at the ends of every
+    /// lane's step with it (once per point: a step's end is the next one's start) and
+    /// searches a step lane by lane only where it may hold an event (the driver's own
+    /// conditions); without it, every step is searched lane by lane: the same results,
+    /// more time. Implemented by [`Level`](super::Level),
     /// [`Stop`](super::Stop) and [`Gap`](super::Gap) (on a surface whose motion has
     /// [`Excitation::motion_lanes`](crate::excite::Excitation::motion_lanes)) in `f64`.
     #[inline(always)]

@@ -99,9 +99,36 @@ fn reduce_pio2<V: Lanes>(x: V) -> (V, V) {
 /// [`fastmath::sin_f64`](crate::fastmath::sin_f64) (see the [module docs](self)).
 #[inline(always)]
 pub fn sin<V: Lanes>(x: V) -> V {
-    let s = V::splat;
+    sin_of(x, quadrant(x))
+}
+
+/// `cos x` in every lane, bit-identical to
+/// [`fastmath::cos_f64`](crate::fastmath::cos_f64) (the reduction and kernels of [`sin`];
+/// `1` for `|x| < 2⁻²⁷`, the platform's `cos` lane by lane outside the kernels' range).
+#[inline(always)]
+pub fn cos<V: Lanes>(x: V) -> V {
+    cos_of(x, quadrant(x))
+}
+
+/// `(sin x, cos x)` in every lane with one reduction: each bit-identical to [`sin`] and
+/// [`cos`] (and so to [`fastmath::sin_cos_f64`](crate::fastmath::sin_cos_f64)).
+#[inline(always)]
+pub fn sin_cos<V: Lanes>(x: V) -> (V, V) {
+    let k = quadrant(x);
+    (sin_of(x, k), cos_of(x, k))
+}
+
+/// The quadrant `q` of `x` ([`reduce_pio2`]) and both kernels at its remainder.
+#[inline(always)]
+fn quadrant<V: Lanes>(x: V) -> (V, V, V) {
     let (r, q) = reduce_pio2(x);
-    let (sn, cs) = (ksin(r), kcos(r));
+    (q, ksin(r), kcos(r))
+}
+
+/// `sin x` from its quadrant and kernels ([`quadrant`]).
+#[inline(always)]
+fn sin_of<V: Lanes>(x: V, (q, sn, cs): (V, V, V)) -> V {
+    let s = V::splat;
     // Quadrants 1, 3 take the cosine kernel; quadrants 2, 3 change the sign.
     let odd = q.eq(s(1.0)) | q.eq(s(-1.0));
     let neg = q.ge(s(2.0)) | q.lt(s(0.0));
@@ -113,14 +140,10 @@ pub fn sin<V: Lanes>(x: V) -> V {
     patch(v, slow, x, f64::sin)
 }
 
-/// `cos x` in every lane, bit-identical to
-/// [`fastmath::cos_f64`](crate::fastmath::cos_f64) (the reduction and kernels of [`sin`];
-/// `1` for `|x| < 2⁻²⁷`, the platform's `cos` lane by lane outside the kernels' range).
+/// `cos x` from its quadrant and kernels ([`quadrant`]).
 #[inline(always)]
-pub fn cos<V: Lanes>(x: V) -> V {
+fn cos_of<V: Lanes>(x: V, (q, sn, cs): (V, V, V)) -> V {
     let s = V::splat;
-    let (r, q) = reduce_pio2(x);
-    let (sn, cs) = (ksin(r), kcos(r));
     // Quadrants 1, 3 take the sine kernel; quadrants 1, 2 change the sign.
     let odd = q.eq(s(1.0)) | q.eq(s(-1.0));
     let neg = q.eq(s(1.0)) | q.eq(s(2.0)) | q.eq(s(-2.0));

@@ -15,6 +15,12 @@ pub(crate) mod sealed {
         fn exponent_field(self) -> Self;
         /// The bits plus `c` (wrapping), as an `f64`, lane-wise.
         fn add_bits(self, c: u64) -> Self;
+        /// Lane `i` set to `x` in place (nothing if `i ≥ L`): the engine's per-lane writes
+        /// into its boxed state, without moving the whole vector through registers as
+        /// [`with_lane`](super::Lanes::with_lane) does.
+        fn set_lane(&mut self, i: usize, x: f64);
+        /// Lane `i` read in place (`0` if `i ≥ L`), like [`set_lane`](Self::set_lane).
+        fn get_lane(&self, i: usize) -> f64;
     }
 }
 
@@ -186,6 +192,16 @@ macro_rules! lanes_type {
             #[inline(always)]
             fn pow2_from_rounded(self) -> Self {
                 self.map(|y| f64::from_bits(y.to_bits().wrapping_add(1023) << 52))
+            }
+            #[inline(always)]
+            fn set_lane(&mut self, i: usize, x: f64) {
+                if let Some(v) = self.0.get_mut(i) {
+                    *v = x;
+                }
+            }
+            #[inline(always)]
+            fn get_lane(&self, i: usize) -> f64 {
+                self.0.get(i).copied().unwrap_or(0.0)
             }
             #[inline(always)]
             fn add_bits(self, c: u64) -> Self {
