@@ -511,8 +511,7 @@ fn ends_body<V: Lanes, E: EventSet<f64, M>, const M: usize>(
     let (t1, y1, f1) = (load(row::T1), vector(row::X1), vector(row::F1));
     let fresh = cache.fresh & accepted;
     let any_fresh = fresh.bits() != 0;
-    let mut quiet = [[V::splat(0.0); 3]; MAX_EVENTS];
-    for (e, q) in quiet.iter_mut().enumerate().take(E::LEN) {
+    for e in 0..E::LEN {
         let Some((g1, r1)) = events.lanes(e, t1, &y1, &f1) else {
             return;
         };
@@ -542,7 +541,7 @@ fn ends_body<V: Lanes, E: EventSet<f64, M>, const M: usize>(
             (cache.g[e], kept_r)
         };
         let [ends, positive, away] = QuietEnds::lanes((g0, g1), (r0, r1));
-        *q = [ends & trust, positive, away];
+        out.quiet[e] = [ends & trust, positive, away].map(V::bits);
         cache.g[e] = accepted.select(g1, cache.g[e]);
         if let Some(r1) = r1 {
             cache.r[e] = accepted.select(r1, cache.r[e]);
@@ -552,8 +551,5 @@ fn ends_body<V: Lanes, E: EventSet<f64, M>, const M: usize>(
         }
     }
     cache.fresh = cache.fresh & !accepted;
-    for (bits, q) in out.quiet.iter_mut().zip(&quiet).take(E::LEN) {
-        *bits = q.map(V::bits);
-    }
     out.events = true;
 }

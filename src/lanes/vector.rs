@@ -240,13 +240,11 @@ macro_rules! lanes_type {
             }
             #[inline(always)]
             fn lane(self, i: usize) -> f64 {
-                self.0.get(i).copied().unwrap_or(0.0)
+                sealed::Sealed::get_lane(&self, i)
             }
             #[inline(always)]
             fn with_lane(mut self, i: usize, x: f64) -> Self {
-                if let Some(v) = self.0.get_mut(i) {
-                    *v = x;
-                }
+                sealed::Sealed::set_lane(&mut self, i, x);
                 self
             }
             #[inline(always)]
