@@ -1068,3 +1068,86 @@ fn lane_forms_of_events_and_motions_are_the_scalar_ones_to_the_bit() {
             .is_none()
     );
 }
+
+/// `ẍ = −ω²x`, with a right-hand side that is NaN for `t > t_bad`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Blowup {
+    w: f64,
+    t_bad: f64,
+}
+
+impl nonsmooth::Dynamics<f64, 2> for Blowup {
+    fn rhs(&self, t: f64, y: &Vector2<f64>, dy: &mut Vector2<f64>) {
+        let bad = if t > self.t_bad { f64::NAN } else { 1.0 };
+        dy[0] = y[1];
+        dy[1] = -self.w * self.w * y[0] * bad;
+    }
+}
+
+/// The ends the lanes count for themselves fail or end each trajectory as the driver does
+/// (same error, or same end, state and statistics), whatever runs in the other lanes: a
+/// right-hand side that is NaN after the start (21 non-finite trial steps in a row), one
+/// that turns NaN later (the step falls below the minimum), the step cap, the end time,
+/// with and without a landing grid, in 4 lanes (and 2 after compaction) and 2.
+#[test]
+fn failures_and_caps_counted_in_lanes_match_the_driver() {
+    let tol = tol(1e-8);
+    let mut jobs = Vec::new();
+    for k in 0..12 {
+        let w = 1.0 + 0.37 * k as f64;
+        let t_bad = [0.0, 3.7, f64::INFINITY][k % 3];
+        let m = nonsmooth::LaneByLane(Blowup { w, t_bad });
+        let job = MemberRun::new(m, 0.0, Vector2::new(1.0, 0.0), 6.0 + k as f64).unwrap();
+        jobs.push(if k % 2 == 0 {
+            job.with_grid(0.0, 0.25).unwrap()
+        } else {
+            job
+        });
+    }
+    for cap in [100_000_000, 150] {
+        let ens = Ensemble::new(tol).unwrap().max_steps(cap).unwrap();
+        let mut kinds = std::collections::BTreeSet::new();
+        for lanes in [4, 2] {
+            let mut obs = vec![(); jobs.len()];
+            let out = match lanes {
+                4 => ens.run::<F64x4, _, _>(&jobs, &mut obs),
+                _ => ens.run::<F64x2, _, _>(&jobs, &mut obs),
+            }
+            .unwrap();
+            for (k, (j, o)) in jobs.iter().zip(&out).enumerate() {
+                let want = Simulation::new(j.member.0, Dopri5::new(tol))
+                    .max_steps(cap)
+                    .unwrap()
+                    .landing_grid(j.grid)
+                    .unwrap()
+                    .run(j.t0, j.y0, j.t_end, &mut ());
+                match (o, want) {
+                    (Ok(o), Ok(w)) => {
+                        assert_eq!((o.t, o.y, o.stats), (w.t, w.y, w.stats), "job {k}");
+                        assert_eq!(o.termination, w.termination, "job {k}");
+                        kinds.insert("ends".to_string());
+                    }
+                    (Err(e), Err(w)) => {
+                        assert_eq!(e.to_string(), w.to_string(), "job {k}");
+                        let e = e.to_string();
+                        let kind = ["not finite", "too small", "maximum number of steps"]
+                            .into_iter()
+                            .find(|k| e.contains(k))
+                            .unwrap_or("other");
+                        kinds.insert(kind.to_string());
+                    }
+                    (o, w) => panic!("job {k}, cap {cap}: lanes {o:?}, driver {w:?}"),
+                }
+            }
+        }
+        // Each kind of end occurs: a non-finite right-hand side, a step below the minimum,
+        // and the end time (the cap of 150 steps stops every trajectory that lives longer).
+        let last = if cap == 150 {
+            "maximum number of steps"
+        } else {
+            "ends"
+        };
+        let want = ["not finite", "too small", last].map(String::from);
+        assert_eq!(kinds, want.into_iter().collect(), "cap {cap}");
+    }
+}

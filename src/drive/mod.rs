@@ -44,7 +44,7 @@ use crate::scalar::{lit, to_f64};
 use crate::validate::ParameterError;
 use crate::{Dynamics, Real};
 use error::Result;
-pub(crate) use scan::{QuietEnds, Scan, Sides, initial_sides};
+pub(crate) use scan::{LaneSides, QuietEnds, Scan, Sides, initial_sides};
 
 /// Whether a run goes on.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -175,7 +175,8 @@ pub trait Observer<T: Real, const N: usize> {
     /// that only reads events and the outcome may return `false`; the ensemble
     /// ([`Ensemble`](crate::ensemble::Ensemble)) then need not build a lane's step for it
     /// where the step holds no event. `on_step` must then be a no-op returning
-    /// [`Control::Continue`]: the drivers may still call it.
+    /// [`Control::Continue`]: the drivers may still call it. The answer must not change
+    /// during a run (the ensemble reads it once, when the trajectory starts).
     fn wants_steps(&self) -> bool {
         true
     }
@@ -615,10 +616,15 @@ pub(crate) fn time_scale<T: Real, const N: usize, S: Dynamics<T, N>, E: EventSet
 /// (constrained modes) bounds the step.
 #[inline(always)]
 pub(crate) fn step_limit<T: Real>(t: T, t_end: T, grid: Option<(T, T)>, scale: Option<T>) -> T {
-    let limit = landing_limit(t, t_end, grid);
+    scaled_limit(landing_limit(t, t_end, grid), t, scale)
+}
+
+/// The step limit from `t` given the next landing point `landing` ([`step_limit`]).
+#[inline(always)]
+pub(crate) fn scaled_limit<T: Real>(landing: T, t: T, scale: Option<T>) -> T {
     match scale {
-        Some(h) => limit.min(t + h),
-        None => limit,
+        Some(h) => landing.min(t + h),
+        None => landing,
     }
 }
 

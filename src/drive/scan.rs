@@ -551,8 +551,9 @@ impl Sides {
     /// wrong side of a resetting event, while moving into its side. The scan of such a
     /// step only moves the side to that of the ends ([`quiet_step`](Self::quiet_step));
     /// the ensemble skips it where every event's step is quiet, with `q` from
-    /// [`QuietEnds::lanes`].
-    #[inline(always)]
+    /// [`QuietEnds::lanes`] and this rule in lanes ([`LaneSides::quiet`], which the tests
+    /// hold to it).
+    #[cfg(test)]
     pub(crate) fn is_quiet_with<T: Real, const N: usize, E: EventSet<T, N>>(
         &self,
         events: &E,
@@ -574,9 +575,92 @@ impl Sides {
 
     /// What the scan of a quiet step ([`is_quiet_with`](Self::is_quiet_with)) does to
     /// event `i`: its side becomes that of the step's ends (`positive`: `g > 0` there).
-    #[inline(always)]
+    /// The ensemble's form: [`LaneSides::quiet_step`].
+    #[cfg(test)]
     pub(crate) fn quiet_step(&mut self, i: usize, positive: bool) {
         self.side[i] = if positive { 1 } else { -1 };
+    }
+}
+
+/// The [`Sides`] of up to 32 trajectories as bit masks (bit `l` for trajectory `l`, the
+/// ensemble's lane `l`): the lane form of the quiet-step rule, so that the ensemble decides
+/// which lanes' steps are quiet, and moves their sides, with a few bit operations per
+/// event instead of a visit to each lane.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct LaneSides {
+    /// Per event: the side is known (`side ≠ 0`).
+    known: [u32; MAX_EVENTS],
+    /// Per event: the side is `+1`.
+    positive: [u32; MAX_EVENTS],
+    /// Per event: armed.
+    armed: [u32; MAX_EVENTS],
+}
+
+impl LaneSides {
+    /// Lane `l`'s sides.
+    #[inline(always)]
+    pub(crate) fn get(&self, l: usize) -> Sides {
+        let bit = |m: u32| m >> l & 1 == 1;
+        Sides {
+            side: core::array::from_fn(|e| match (bit(self.known[e]), bit(self.positive[e])) {
+                (false, _) => 0,
+                (true, true) => 1,
+                (true, false) => -1,
+            }),
+            armed: core::array::from_fn(|e| bit(self.armed[e])),
+        }
+    }
+
+    /// Sets lane `l`'s sides.
+    #[inline(always)]
+    pub(crate) fn set(&mut self, l: usize, sides: &Sides) {
+        let put = |m: &mut u32, on: bool| *m = (*m & !(1 << l)) | (u32::from(on) << l);
+        for e in 0..MAX_EVENTS {
+            put(&mut self.known[e], sides.side[e] != 0);
+            put(&mut self.positive[e], sides.side[e] > 0);
+            put(&mut self.armed[e], sides.armed[e]);
+        }
+    }
+
+    /// The lanes among `lanes` where [`Sides::is_quiet_with`] holds for event `i`, given the
+    /// masks of [`QuietEnds::lanes`] (`[ends, positive, rate_on_side]`): the ends allow a
+    /// quiet step and the lane's side and arming do.
+    #[inline(always)]
+    pub(crate) fn quiet<T: Real, const N: usize, E: EventSet<T, N>>(
+        &self,
+        events: &E,
+        i: usize,
+        lanes: u32,
+        [ends, positive, rate_on_side]: [u32; 3],
+    ) -> u32 {
+        if events.interior_samples(i) > 0 {
+            return 0;
+        }
+        // On the wrong side of a resetting event (its side is that of the ends).
+        let wrong_side = match (events.resets(i), events.direction(i)) {
+            (false, _) | (true, Direction::Either) => 0,
+            (true, Direction::Rising) => positive,
+            (true, Direction::Falling) => !positive,
+        };
+        let stuck = !self.armed[i] | wrong_side;
+        lanes & ends & self.known[i] & !(stuck & rate_on_side)
+    }
+
+    /// [`Sides::quiet_step`] of event `i` in the lanes of `lanes`: their side becomes that
+    /// of their step's ends (`positive`: `g > 0` there).
+    #[inline(always)]
+    pub(crate) fn quiet_step(&mut self, i: usize, lanes: u32, positive: u32) {
+        self.known[i] |= lanes;
+        self.positive[i] = (self.positive[i] & !lanes) | (positive & lanes);
+    }
+
+    /// Every mask mapped by `f` (the ensemble moves lanes with it).
+    pub(crate) fn map(&self, f: impl Fn(u32) -> u32) -> Self {
+        Self {
+            known: self.known.map(&f),
+            positive: self.positive.map(&f),
+            armed: self.armed.map(&f),
+        }
     }
 }
 
@@ -725,8 +809,105 @@ pub(crate) fn sign_of<T: Real>(x: T) -> i8 {
 
 #[cfg(test)]
 mod tests {
-    use super::QuietEnds;
+    use super::{LaneSides, QuietEnds, Sides};
+    use crate::event::{Direction, Event, EventSet, Level, MAX_EVENTS, Restitution};
     use crate::lanes::{F64x4, Lanes};
+
+    /// `LaneSides::quiet` and `quiet_step` are `Sides::is_quiet_with` and `quiet_step` lane
+    /// for lane: every side (unknown, −, +), arming, ends' answer and event (with and
+    /// without a reset, each direction, with interior samples), 30 lanes at once; and
+    /// `get`, `set` and `map` carry the sides unchanged.
+    #[test]
+    fn lane_sides_are_the_scalar_rule() {
+        let level = Level::new(0, 0.0).unwrap();
+        let reset = Restitution::new(1, 0.5).unwrap();
+        let dirs = [Direction::Rising, Direction::Falling, Direction::Either];
+        // Every lane's (side, armed, ends, positive, rate_on_side).
+        let mut lanes = Vec::new();
+        for side in [-1i8, 0, 1] {
+            for armed in [false, true] {
+                for (ends, positive, on) in [
+                    (false, false, false),
+                    (true, false, false),
+                    (true, true, false),
+                    (true, false, true),
+                    (true, true, true),
+                ] {
+                    lanes.push((side, armed, ends, positive, on));
+                }
+            }
+        }
+        let mut quiet_seen = 0;
+        for chunk in lanes.chunks(30) {
+            let mut masks = LaneSides::default();
+            let mut q = [0u32; 3];
+            for (l, &(side, armed, ends, positive, on)) in chunk.iter().enumerate() {
+                let mut sides = Sides {
+                    side: [0; MAX_EVENTS],
+                    armed: [true; MAX_EVENTS],
+                };
+                (sides.side[0], sides.armed[0]) = (side, armed);
+                masks.set(l, &sides);
+                for (m, b) in q.iter_mut().zip([ends, positive, on]) {
+                    *m |= u32::from(b) << l;
+                }
+            }
+            let all = (1u32 << chunk.len()) - 1;
+            for dir in dirs {
+                for samples in [0, 3] {
+                    let plain = Event::new(level, dir).with_interior_samples(samples);
+                    let resetting = plain.with_reset(reset);
+                    quiet_seen += rule(&plain, &masks, all, q, chunk);
+                    quiet_seen += rule(&resetting, &masks, all, q, chunk);
+                }
+            }
+            // The quiet step moves the side to the ends' and keeps the arming.
+            let mut moved = masks;
+            moved.quiet_step(0, all, q[1]);
+            for (l, &(side, armed, _, positive, _)) in chunk.iter().enumerate() {
+                let mut want = Sides {
+                    side: [0; MAX_EVENTS],
+                    armed: [true; MAX_EVENTS],
+                };
+                (want.side[0], want.armed[0]) = (side, armed);
+                assert_eq!(masks.get(l).side, want.side);
+                assert_eq!(masks.get(l).armed, want.armed);
+                want.quiet_step(0, positive);
+                assert_eq!(moved.get(l).side, want.side);
+                assert_eq!(moved.get(l).armed, want.armed);
+            }
+            // Lanes 5, 0, 7 moved to 0, 1, 2.
+            let g = masks.map(|m| (m >> 5 & 1) | (m & 1) << 1 | (m >> 7 & 1) << 2);
+            for (k, l) in [5, 0, 7].into_iter().enumerate() {
+                assert_eq!(g.get(k).side, masks.get(l).side);
+                assert_eq!(g.get(k).armed, masks.get(l).armed);
+            }
+            assert_eq!(g.get(3).side, [0; MAX_EVENTS]);
+        }
+        // The rule is not trivially false.
+        assert!(quiet_seen > 20, "{quiet_seen}");
+    }
+
+    /// The mask rule held to the scalar rule for event 0 of `events` over the lanes of
+    /// `chunk`; the number of quiet lanes.
+    fn rule<E: EventSet<f64, 2>>(
+        events: &E,
+        masks: &LaneSides,
+        all: u32,
+        q: [u32; 3],
+        chunk: &[(i8, bool, bool, bool, bool)],
+    ) -> u32 {
+        let got = masks.quiet(events, 0, all, q);
+        for (l, &(_, _, ends, positive, rate_on_side)) in chunk.iter().enumerate() {
+            let ends_q = QuietEnds {
+                positive,
+                rate_on_side,
+            };
+            let want = ends && masks.get(l).is_quiet_with(events, 0, ends_q);
+            assert_eq!(got >> l & 1 == 1, want, "lane {l}: {:?}", chunk[l]);
+        }
+        got.count_ones()
+    }
 
     /// `QuietEnds::lanes` is `QuietEnds::of` lane for lane, over signed zeros, tiny, huge,
     /// ordinary, infinite and NaN values and every combination of known rates, except

@@ -25,6 +25,13 @@ pub(crate) struct LaneState<V: Lanes, D: LaneDynamics<M>, const M: usize> {
     pub(crate) f: [V; M],
     pub(crate) h: V,
     pub(crate) limit: V,
+    /// The next landing point ([`landing_limit`](crate::drive::landing_limit)), which
+    /// `limit` does not pass.
+    pub(crate) landing: V,
+    /// `|origin| + dt` of the landing grid (0 without one): the scale of the rounding of
+    /// the landing point's computation.
+    pub(crate) grid_scale: V,
+    pub(crate) t_end: V,
     pub(crate) ln_err_old: V,
     pub(crate) rej_last: V,
     pub(crate) active: V,
@@ -32,6 +39,9 @@ pub(crate) struct LaneState<V: Lanes, D: LaneDynamics<M>, const M: usize> {
     pub(crate) kk: [[V; M]; 7],
     /// The lanes whose last trial step was accepted.
     pub(crate) accepted: V,
+    /// Each trajectory's accepted and rejected steps so far, and its non-finite trial steps
+    /// since the last accepted one (counts, exact as `f64`).
+    pub(crate) counts: Counts<V>,
     /// The events at each lane's start ([`event_ends`]).
     pub(crate) ends: EndsCache<V>,
 }
@@ -64,6 +74,33 @@ impl<V: Lanes> EndsCache<V> {
     }
 }
 
+/// The step counters of each lane ([`LaneState::counts`]).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Counts<V> {
+    pub(crate) accepted: V,
+    pub(crate) rejected: V,
+    pub(crate) non_finite: V,
+}
+
+impl<V: Lanes> Counts<V> {
+    /// Every count zero.
+    pub(crate) fn zero() -> Self {
+        let z = V::splat(0.0);
+        Self {
+            accepted: z,
+            rejected: z,
+            non_finite: z,
+        }
+    }
+
+    /// Lane `i`'s counts set to zero (a new trajectory).
+    pub(crate) fn clear_lane(&mut self, i: usize) {
+        for c in [&mut self.accepted, &mut self.rejected, &mut self.non_finite] {
+            c.set_lane(i, 0.0);
+        }
+    }
+}
+
 /// The scalar settings of a step: tolerances, controller constants, math mode and the
 /// instruction set (already resolved for this CPU).
 #[derive(Debug, Clone, Copy)]
@@ -77,6 +114,7 @@ pub(crate) struct StepConsts<const M: usize> {
     inv_fac_min: f64,
     h_max: f64,
     h_min: f64,
+    max_steps: f64,
     math: LaneMath,
     simd: Simd,
 }
@@ -85,8 +123,7 @@ impl<const M: usize> StepConsts<M> {
     pub(crate) fn new(
         tol: &Tolerances<f64, M>,
         opts: &StepOptions<f64>,
-        math: LaneMath,
-        simd: Simd,
+        (max_steps, math, simd): (usize, LaneMath, Simd),
     ) -> Self {
         Self {
             atol: core::array::from_fn(|i| tol.atol[i]),
@@ -98,6 +135,7 @@ impl<const M: usize> StepConsts<M> {
             inv_fac_min: 1.0 / opts.fac_min,
             h_max: opts.h_max,
             h_min: opts.h_min,
+            max_steps: max_steps as f64,
             math,
             simd: simd.resolve(),
         }
@@ -143,8 +181,14 @@ pub(crate) struct StepOut {
     pub(crate) rejected: u32,
     /// Lanes whose trial step was accepted (their step data are in `buf`).
     pub(crate) accepted: u32,
-    /// Lanes whose trial step was not finite (rejected; `buf[T0]` holds their `t`).
-    pub(crate) non_finite: u32,
+    /// Lanes whose trial steps were not finite more than 20 times in a row (rejected;
+    /// `buf[T0]` holds their `t`): their trajectory fails.
+    pub(crate) failing: u32,
+    /// Accepted lanes whose step ends their trajectory: at its end time, or its step cap.
+    pub(crate) ends: u32,
+    /// Accepted lanes whose step ends on or near (within rounding of) their landing point,
+    /// where the next one is computed again.
+    pub(crate) near_landing: u32,
     /// Whether every event has a lane form and `quiet` holds what the ends of this
     /// pass's steps say about each ([`event_ends`]).
     pub(crate) events: bool,
@@ -163,7 +207,9 @@ impl StepOut {
             too_small: 0,
             rejected: 0,
             accepted: 0,
-            non_finite: 0,
+            failing: 0,
+            ends: 0,
+            near_landing: 0,
             events: false,
             quiet: [[0; 3]; MAX_EVENTS],
             buf: vec![[0.0; 16]; row::count(m)],
@@ -356,7 +402,9 @@ fn body<V: Lanes, D: LaneDynamics<M>, const M: usize>(
     out.too_small = 0;
     out.rejected = 0;
     out.accepted = 0;
-    out.non_finite = 0;
+    out.failing = 0;
+    out.ends = 0;
+    out.near_landing = 0;
     let (t, y, h) = (st.t, st.y, st.h);
     // The trial step, cut to land on the lane's limit (clamp_to_limit).
     let rest = st.limit - t;
@@ -398,13 +446,23 @@ fn body<V: Lanes, D: LaneDynamics<M>, const M: usize>(
     st.ln_err_old = accepted.select(ln_err.max(ln_floor), st.ln_err_old);
     out.rejected = rejected.bits();
     out.accepted = accepted.bits();
-    out.non_finite = (!finite & st.active).bits();
-    if out.non_finite != 0 {
+    // The counts (a non-finite trial step is never accepted: its norm is NaN).
+    let n = &mut st.counts;
+    n.accepted = n.accepted + accepted.select(one, zero);
+    n.rejected = n.rejected + rejected.select(one, zero);
+    let bad = !finite & rejected;
+    n.non_finite = accepted.select(zero, n.non_finite + bad.select(one, zero));
+    out.failing = (n.non_finite.gt(s(20.0)) & bad).bits();
+    if out.failing != 0 {
         t.store(&mut out.buf[row::T0]);
     }
     if out.accepted == 0 {
         return;
     }
+    let at_cap = n.accepted.ge(s(k.max_steps));
+    out.ends = ((t_new.ge(st.t_end) | at_cap) & accepted).bits();
+    let rounding = s(64.0 * f64::EPSILON) * (t_new.abs() + st.grid_scale);
+    out.near_landing = ((st.landing - t_new).le(rounding) & accepted).bits();
     // Accepted lanes: the new state, the next step, the dense output.
     st.t = accepted.select(t_new, st.t);
     st.h = accepted.select(lands.select(h_next.max(h), h_next), st.h);

@@ -85,7 +85,9 @@ pub trait Lanes:
     fn eq(self, o: Self) -> Self;
     /// Mask of the finite lanes.
     fn finite(self) -> Self;
-    /// `mask ? a : b`, lane-wise (`self` is the mask).
+    /// `mask ? a : b`, lane-wise (`self` is the mask: every bit of a lane set or clear, as
+    /// the comparisons, [`TRUE`](super::TRUE) and [`mask`](super::mask) give it; the sign
+    /// bit decides).
     fn select(self, a: Self, b: Self) -> Self;
     /// Bit `i` set where lane `i` of the mask is set.
     fn bits(self) -> u32;
@@ -290,7 +292,17 @@ macro_rules! lanes_type {
             }
             #[inline(always)]
             fn select(self, a: Self, b: Self) -> Self {
-                (self & a) | (!self & b)
+                // The mask's sign bit decides (one blend per register instead of three
+                // bit operations); a mask has every bit of a lane set or clear.
+                let mut r = [0.0; $n];
+                for i in 0..$n {
+                    r[i] = if (self.0[i].to_bits() as i64) < 0 {
+                        a.0[i]
+                    } else {
+                        b.0[i]
+                    };
+                }
+                Self(r)
             }
             #[inline(always)]
             fn bits(self) -> u32 {
