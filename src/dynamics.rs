@@ -175,6 +175,16 @@ pub trait LaneDynamics<const M: usize>: Dynamics<f64, M> + Clone {
         true
     }
 
+    /// Whether [`time_scale`](Dynamics::time_scale) has the same value at every `t`
+    /// (`None` everywhere included, as for every model that does not declare one). The
+    /// ensemble then bounds each lane's steps with the value at its start, computed in the
+    /// lanes, instead of asking at every step. Default `false`; `true` for
+    /// [`Oscillator`](crate::model::Oscillator) and
+    /// [`Mechanical`](crate::model::Mechanical), which declare none.
+    fn constant_time_scale(&self) -> bool {
+        false
+    }
+
     /// The terms of the right-hand side that depend on the time only, in every lane.
     fn time_lanes<V: Lanes>(packed: &Self::Packed<V>, math: LaneMath, t: V) -> Self::Time<V>;
 

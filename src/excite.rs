@@ -93,6 +93,15 @@ pub trait Excitation<T: Real> {
         })
     }
 
+    /// Whether [`time_scale`](Excitation::time_scale) has the same value at every `t`
+    /// (`None` everywhere included): an excitation of constant frequency, or one constant
+    /// in time. The ensemble then bounds each lane's steps with the value at its start,
+    /// computed in the lanes, instead of asking at every step. Default `false`;
+    /// implemented by `()`, [`Constant`], [`Harmonic`] and [`UnbalancedRotor`].
+    fn constant_time_scale(&self) -> bool {
+        false
+    }
+
     /// The force and its rate `(f(t), ḟ(t))` at `L` times at once, one per lane, if the
     /// excitation has a lane form (`None`, the default, if not). Each lane must be
     /// [`force`](Excitation::force) and [`force_rate`](Excitation::force_rate) at that
@@ -153,6 +162,9 @@ impl<T: Real, E: Excitation<T> + ?Sized> Excitation<T> for &E {
     fn time_scale(&self, t: T) -> Option<T> {
         (**self).time_scale(t)
     }
+    fn constant_time_scale(&self) -> bool {
+        (**self).constant_time_scale()
+    }
 }
 
 /// No forcing.
@@ -164,6 +176,9 @@ impl<T: Real> Excitation<T> for () {
     #[inline(always)]
     fn motion_lanes<V: Lanes>(&self, _t: V) -> Option<(V, V)> {
         Some((V::splat(0.0), V::splat(0.0)))
+    }
+    fn constant_time_scale(&self) -> bool {
+        true
     }
     #[inline(always)]
     fn force_rate(&self, _t: T) -> T {
@@ -213,6 +228,9 @@ impl<T: Real> Excitation<T> for Constant<T> {
     #[inline(always)]
     fn motion_lanes<V: Lanes>(&self, _t: V) -> Option<(V, V)> {
         fastmath::is_f64::<T>().then(|| (V::splat(to_f64(self.value)), V::splat(0.0)))
+    }
+    fn constant_time_scale(&self) -> bool {
+        true
     }
     #[inline(always)]
     fn force_rate(&self, _t: T) -> T {
@@ -345,6 +363,9 @@ impl<T: Real> Excitation<T> for Harmonic<T> {
     fn angular_frequency(&self, _t: T) -> Option<T> {
         Some(self.omega)
     }
+    fn constant_time_scale(&self) -> bool {
+        true
+    }
 }
 
 /// An unbalanced rotor at constant speed: `m0·e·ω²·sin(ωt)` (the paper's forcing).
@@ -442,6 +463,9 @@ impl<T: Real> Excitation<T> for UnbalancedRotor<T> {
     }
     fn angular_frequency(&self, _t: T) -> Option<T> {
         Some(self.omega)
+    }
+    fn constant_time_scale(&self) -> bool {
+        true
     }
 }
 

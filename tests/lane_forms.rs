@@ -280,3 +280,86 @@ proptest! {
         check_model::<_, 2>(&duffing, &t, &y);
     }
 }
+
+/// What declares a constant time scale has the same one at every time (the ensemble then
+/// bounds the steps in the lanes with the value at the start); what varies does not
+/// declare it.
+#[test]
+fn constant_time_scales_are_constant() {
+    use nonsmooth::Dynamics;
+    use nonsmooth::event::{Direction, Event, EventFunction, EventSet, FnEvent, Gap, Level, Stop};
+    use nonsmooth::excite::Excitation;
+    let ts: Vec<f64> = (0..400)
+        .map(|k| (k as f64 - 200.0) * 0.731 + 1e-3 * k as f64)
+        .collect();
+    let same = |f: &dyn Fn(f64) -> Option<f64>| ts.iter().all(|&t| f(t) == f(ts[0]));
+    fn motion<S: Excitation<f64>>(s: &S) -> (bool, Vec<Option<f64>>) {
+        let ts = (0..400).map(|k| (k as f64 - 200.0) * 0.731);
+        (
+            s.constant_time_scale(),
+            ts.map(|t| s.time_scale(t)).collect(),
+        )
+    }
+    let harmonic = Harmonic::new(0.7, 3.3, 0.4).unwrap();
+    for (flag, values) in [
+        motion(&()),
+        motion(&Constant::new(-9.81).unwrap()),
+        motion(&harmonic),
+        motion(&UnbalancedRotor::new(0.018, 20.465).unwrap()),
+    ] {
+        assert!(flag);
+        assert!(values.iter().all(|v| *v == values[0]), "{values:?}");
+    }
+    assert_eq!(
+        motion(&harmonic).1[0],
+        Some(std::f64::consts::TAU / (16.0 * 3.3))
+    );
+    let ramp = RampedRotor::new(0.018, 10.0, 0.5).unwrap();
+    let (flag, values) = motion(&ramp);
+    assert!(!flag && values.iter().any(|v| *v != values[0]));
+    // Event functions and sets.
+    let coord = Coordinate::<f64, 1>::linear([1.0]).unwrap();
+    let table = Gap::<f64, 1, _>::above(coord, harmonic);
+    let ramped = Gap::<f64, 1, _>::above(coord, ramp);
+    assert!(EventFunction::<f64, 2>::constant_time_scale(&table));
+    assert!(same(&|t| EventFunction::<f64, 2>::time_scale(&table, t)));
+    assert!(!EventFunction::<f64, 2>::constant_time_scale(&ramped));
+    let level = Level::new(0, 0.5).unwrap();
+    let stop = Stop {
+        position: 0,
+        velocity: 1,
+        level: 0.5,
+    };
+    let f = FnEvent(|t: f64, y: &SVector<f64, 2>| y[0] - t.sin());
+    assert!(EventFunction::<f64, 2>::constant_time_scale(&level));
+    assert!(EventFunction::<f64, 2>::constant_time_scale(&stop));
+    assert!(EventFunction::<f64, 2>::constant_time_scale(&f));
+    for g in [
+        EventFunction::<f64, 2>::time_scale(&level, 3.0),
+        EventFunction::<f64, 2>::time_scale(&stop, 3.0),
+        EventFunction::<f64, 2>::time_scale(&f, 3.0),
+    ] {
+        assert_eq!(g, None);
+    }
+    let set = (
+        Event::new(table, Direction::Rising),
+        Event::new(level, Direction::Either),
+    );
+    assert!(EventSet::<f64, 2>::constant_max_step(&set));
+    assert!(same(&|t| EventSet::<f64, 2>::max_step(&set, t)));
+    assert!(EventSet::<f64, 2>::constant_max_step(&()));
+    let varying = (set.0, Event::new(ramped, Direction::Rising));
+    assert!(!EventSet::<f64, 2>::constant_max_step(&varying));
+    // The models declare no time scale.
+    let osc = nonsmooth::systems::paper::PAPER
+        .oscillator::<f64>(20.0)
+        .unwrap();
+    assert!(osc.constant_time_scale() && same(&|t| osc.time_scale(t)));
+    assert_eq!(osc.time_scale(1.0), None);
+    let mech = Mechanical::with_masses([1.0])
+        .unwrap()
+        .with_loads(Load::on_dof(0, harmonic).unwrap());
+    assert!(LaneDynamics::<2>::constant_time_scale(&mech));
+    assert!(same(&|t| Dynamics::<f64, 2>::time_scale(&mech, t)));
+    assert!(!LaneByLane(osc).constant_time_scale());
+}

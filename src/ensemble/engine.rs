@@ -440,9 +440,10 @@ struct Engine<'a, V: Lanes, E, D: LaneDynamics<M>, const M: usize> {
     slots: Vec<Slot<D>>,
     /// Each lane's events' sides (the driver's [`Sides`](crate::drive::Sides), as masks).
     sides: LaneSides,
-    /// The lanes whose events or model bound the step (the limit is then recomputed after
-    /// every step, as the driver does).
-    scaled: u32,
+    /// The lanes whose step bound (the events' and the model's time scale) may change with
+    /// `t`: their limit is computed after every step by the driver's rule, lane by lane.
+    /// The kernel computes the others' (`LaneState::scale`).
+    varying: u32,
     /// The lanes whose observer [wants steps](Observer::wants_steps).
     watch: u32,
     /// On the heap, like the step's output: on the stack, the speed of the vector step
@@ -484,7 +485,7 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
             next: 0,
             slots: (0..V::LANES).map(|_| Slot::idle()).collect(),
             sides: LaneSides::default(),
-            scaled: 0,
+            varying: 0,
             watch: 0,
             st: Box::new(LaneState {
                 packed,
@@ -495,6 +496,7 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
                 limit: V::splat(t + 1.0),
                 landing: V::splat(t + 1.0),
                 grid_scale: z,
+                scale: V::splat(f64::INFINITY),
                 t_end: V::splat(t + 1.0),
                 ln_err_old: V::splat(1e-4f64.ln()),
                 rej_last: z,
@@ -555,7 +557,7 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
         if !f0.iter().all(|v| v.is_finite()) {
             return Err(IntegrateError::NonFiniteRhs { t: t0 }.into());
         }
-        let scaled = scale(t0).is_some();
+        let varying = !(cfg.events.constant_max_step() && m.constant_time_scale());
         let landing = landing_limit(t0, t_end, job.grid);
         let limit = scaled_limit(landing, t0, scale(t0));
         let h = match cfg.opts.h_init {
@@ -583,6 +585,8 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
         self.st.landing.set_lane(i, landing);
         let grid_scale = job.grid.map_or(0.0, |(o, dt)| o.abs() + dt);
         self.st.grid_scale.set_lane(i, grid_scale);
+        let fixed = if varying { None } else { scale(t0) };
+        self.st.scale.set_lane(i, fixed.unwrap_or(f64::INFINITY));
         self.st.t_end.set_lane(i, t_end);
         self.st.ln_err_old.set_lane(i, 1e-4f64.ln());
         self.st.rej_last.set_lane(i, 0.0);
@@ -590,10 +594,10 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
         self.st.counts.clear_lane(i);
         self.sides.set(i, &sides);
         let bit = 1u32 << i;
-        self.scaled = if scaled {
-            self.scaled | bit
+        self.varying = if varying {
+            self.varying | bit
         } else {
-            self.scaled & !bit
+            self.varying & !bit
         };
         self.watch = if obs.wants_steps() {
             self.watch | bit
@@ -740,6 +744,7 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
             limit: splat(st.limit),
             landing: splat(st.landing),
             grid_scale: splat(st.grid_scale),
+            scale: splat(st.scale),
             t_end: splat(st.t_end),
             ln_err_old: splat(st.ln_err_old),
             rej_last: splat(st.rej_last),
@@ -761,6 +766,7 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
             half.limit = mv(half.limit, st.limit);
             half.landing = mv(half.landing, st.landing);
             half.grid_scale = mv(half.grid_scale, st.grid_scale);
+            half.scale = mv(half.scale, st.scale);
             half.t_end = mv(half.t_end, st.t_end);
             let (n, m) = (&mut half.counts, &st.counts);
             n.accepted = mv(n.accepted, m.accepted);
@@ -781,7 +787,7 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
             next: self.next,
             slots,
             sides: self.sides.map(|m| gather_bits(m, &busy)),
-            scaled: gather_bits(self.scaled, &busy),
+            varying: gather_bits(self.varying, &busy),
             watch: gather_bits(self.watch, &busy),
             st: half,
             consts: self.consts,
@@ -866,12 +872,11 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
     /// [`step_limit`](crate::drive::step_limit), which it computes after every step. Its
     /// landing point is computed again only if `near` (on or near the current one, or
     /// after a restart): short of it by more than the rounding of that computation it is
-    /// the current one again. Without a time scale the limit is then the current one too,
-    /// and nothing changes.
+    /// the current one again. With a time scale that does not vary, the kernel has then
+    /// computed the limit of the step's end already, and nothing changes.
     #[inline(always)]
     fn update_limit(&mut self, i: usize, t: f64, near: bool) {
-        let scaled = self.scaled & (1 << i) != 0;
-        if !(scaled || near) {
+        if !(near || self.varying & (1 << i) != 0) {
             return;
         }
         let slot = &self.slots[i];
@@ -880,10 +885,10 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
             landing = landing_limit(t, slot.t_end, slot.grid);
             self.st.landing.set_lane(i, landing);
         }
-        let bound = match (&slot.member, scaled) {
-            (Some(m), true) => time_scale(m, &self.cfg.events, t),
-            _ => None,
-        };
+        let bound = slot
+            .member
+            .as_ref()
+            .and_then(|m| time_scale(m, &self.cfg.events, t));
         self.st.limit.set_lane(i, scaled_limit(landing, t, bound));
     }
 
@@ -922,7 +927,7 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
         for (e, &[_, positive, _]) in step.quiet.iter().enumerate().take(E::LEN) {
             self.sides.quiet_step(e, quiet, positive);
         }
-        for i in lanes_of(quiet & (self.scaled | step.near_landing)) {
+        for i in lanes_of(quiet & (self.varying | step.near_landing)) {
             let near = step.near_landing & (1 << i) != 0;
             self.update_limit(i, step.buf[row::T1][i], near);
         }

@@ -31,6 +31,10 @@ pub(crate) struct LaneState<V: Lanes, D: LaneDynamics<M>, const M: usize> {
     /// `|origin| + dt` of the landing grid (0 without one): the scale of the rounding of
     /// the landing point's computation.
     pub(crate) grid_scale: V,
+    /// The time scale that bounds every step where it is the same at every `t` (the
+    /// events' and the model's, [`EventSet::constant_max_step`]); `+∞` where there is
+    /// none, or where it varies and the engine computes each limit lane by lane.
+    pub(crate) scale: V,
     pub(crate) t_end: V,
     pub(crate) ln_err_old: V,
     pub(crate) rej_last: V,
@@ -274,12 +278,12 @@ fn stages<V: Lanes, D: LaneDynamics<M>, const M: usize>(
 ) -> [V; M] {
     let s = V::splat;
     let a21 = s(1.0 / 5.0);
-    let [a31, a32] = tableau::A3.map(s);
-    let [a41, a42, a43] = tableau::A4.map(s);
-    let [a51, a52, a53, a54] = tableau::A5.map(s);
-    let [a61, a62, a63, a64, a65] = tableau::A6.map(s);
-    let [a71, a73, a74, a75, a76] = tableau::B.map(s);
-    let [c2, c3, c4, c5] = tableau::C.map(s);
+    let [a31, a32] = splats::<V, _>(tableau::A3);
+    let [a41, a42, a43] = splats::<V, _>(tableau::A4);
+    let [a51, a52, a53, a54] = splats::<V, _>(tableau::A5);
+    let [a61, a62, a63, a64, a65] = splats::<V, _>(tableau::A6);
+    let [a71, a73, a74, a75, a76] = splats::<V, _>(tableau::B);
+    let [c2, c3, c4, c5] = splats::<V, _>(tableau::C);
     let math = k.math;
     kk[0] = *f;
     let mut yn = *y;
@@ -350,7 +354,7 @@ fn error_norm<V: Lanes, const M: usize>(
     hs: V,
 ) -> (V, V) {
     let s = V::splat;
-    let [e1, e3, e4, e5, e6, e7] = tableau::E.map(s);
+    let [e1, e3, e4, e5, e6, e7] = splats::<V, _>(tableau::E);
     let mut acc = s(0.0);
     let mut finite = s(TRUE);
     for c in 0..M {
@@ -365,6 +369,17 @@ fn error_norm<V: Lanes, const M: usize>(
     }
     let err = (acc / s(M as f64)).sqrt();
     (finite.select(err, s(f64::NAN)), finite)
+}
+
+/// Every constant of `a` in every lane. A loop the compiler unrolls in place: an array's
+/// `map` of six constants was left out of line, a call in the middle of each pass.
+#[inline(always)]
+fn splats<V: Lanes, const K: usize>(a: [f64; K]) -> [V; K] {
+    let mut r = [V::splat(0.0); K];
+    for (v, x) in r.iter_mut().zip(a) {
+        *v = V::splat(x);
+    }
+    r
 }
 
 /// `Σ_j k_j·a_j` over the given stages, component `c`, in the scalar stepper's order.
@@ -388,7 +403,7 @@ fn body<V: Lanes, D: LaneDynamics<M>, const M: usize>(
     out: &mut StepOut,
 ) {
     let s = V::splat;
-    let [d1, d3, d4, d5, d6, d7] = tableau::D.map(s);
+    let [d1, d3, d4, d5, d6, d7] = splats::<V, _>(tableau::D);
     let (expo_v, beta_v) = (s(k.expo), s(k.beta));
     let (safety, inv_fac_max, inv_fac_min) = (s(k.safety), s(k.inv_fac_max), s(k.inv_fac_min));
     let h_max = s(k.h_max);
@@ -463,6 +478,9 @@ fn body<V: Lanes, D: LaneDynamics<M>, const M: usize>(
     out.ends = ((t_new.ge(st.t_end) | at_cap) & accepted).bits();
     let rounding = s(64.0 * f64::EPSILON) * (t_new.abs() + st.grid_scale);
     out.near_landing = ((st.landing - t_new).le(rounding) & accepted).bits();
+    // The next limit (`scaled_limit`; the engine computes it again where the landing
+    // point or the scale changes).
+    st.limit = accepted.select(st.landing.min(t_new + st.scale), st.limit);
     // Accepted lanes: the new state, the next step, the dense output.
     st.t = accepted.select(t_new, st.t);
     st.h = accepted.select(lands.select(h_next.max(h), h_next), st.h);

@@ -37,6 +37,17 @@ pub trait EventFunction<T: Real, const N: usize> {
         None
     }
 
+    /// Whether [`time_scale`](EventFunction::time_scale) has the same value at every `t`
+    /// (`None` everywhere included: no explicit time dependence, or a surface moving at a
+    /// constant frequency). The ensemble then bounds each lane's steps with the value at
+    /// its start, computed in the lanes, instead of asking at every step. Default `false`;
+    /// implemented by [`Level`](super::Level), [`Stop`](super::Stop),
+    /// [`FnEvent`] and [`Gap`](super::Gap) (as its motion's
+    /// [`Excitation::constant_time_scale`](crate::excite::Excitation::constant_time_scale)).
+    fn constant_time_scale(&self) -> bool {
+        false
+    }
+
     /// Checks that the function can be evaluated on states of dimension `N` (e.g. that a
     /// component index is in range); the driver calls it before a run starts. Default: `Ok`.
     ///
@@ -83,5 +94,8 @@ impl<T: Real, const N: usize, F: Fn(T, &SVector<T, N>) -> T> EventFunction<T, N>
     #[inline(always)]
     fn value(&self, t: T, y: &SVector<T, N>) -> T {
         (self.0)(t, y)
+    }
+    fn constant_time_scale(&self) -> bool {
+        true
     }
 }

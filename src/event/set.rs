@@ -146,6 +146,12 @@ pub trait EventSet<T: Real, const N: usize> {
     fn max_step(&self, _t: T) -> Option<T> {
         None
     }
+    /// Whether [`max_step`](EventSet::max_step) has the same value at every `t`: every
+    /// event's function has a [constant time scale](EventFunction::constant_time_scale).
+    /// Default `false`.
+    fn constant_max_step(&self) -> bool {
+        false
+    }
     /// Event `i`'s value and rate at `L` points at once, one per lane (its function's
     /// [`EventFunction::lanes`]), or `None` if its function has no lane form.
     #[inline(always)]
@@ -191,6 +197,9 @@ impl<T: Real, const N: usize> EventSet<T, N> for () {
     fn interior_samples(&self, _i: usize) -> usize {
         0
     }
+    fn constant_max_step(&self) -> bool {
+        true
+    }
 }
 
 impl<T: Real, const N: usize, G: EventFunction<T, N>, R: ResetMap<T, N>> EventSet<T, N>
@@ -230,6 +239,9 @@ impl<T: Real, const N: usize, G: EventFunction<T, N>, R: ResetMap<T, N>> EventSe
     #[inline(always)]
     fn max_step(&self, t: T) -> Option<T> {
         min_option(self.function.time_scale(t), self.max_step.map(lit))
+    }
+    fn constant_max_step(&self) -> bool {
+        self.function.constant_time_scale()
     }
     #[inline(always)]
     fn lanes<V: Lanes>(&self, _i: usize, t: V, y: &[V; N], dy: &[V; N]) -> Option<(V, Option<V>)> {
@@ -303,6 +315,9 @@ macro_rules! event_tuple {
                 let m = None;
                 $(let m = min_option(m, self.$idx.max_step(t));)+
                 m
+            }
+            fn constant_max_step(&self) -> bool {
+                true $(&& self.$idx.constant_max_step())+
             }
         }
     };

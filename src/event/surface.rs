@@ -72,6 +72,9 @@ impl<T: Real, const N: usize> EventFunction<T, N> for Level<T> {
     fn lanes<V: Lanes>(&self, _t: V, y: &[V; N], dy: &[V; N]) -> Option<(V, Option<V>)> {
         component_lanes::<T, V, N>(self.index, self.level, y, dy)
     }
+    fn constant_time_scale(&self) -> bool {
+        true
+    }
 }
 
 /// A one-sided stop `y[position] = level` with `y[velocity]` the position's rate: the
@@ -119,6 +122,9 @@ impl<T: Real, const N: usize> EventFunction<T, N> for Stop<T> {
             });
         }
         Ok(())
+    }
+    fn constant_time_scale(&self) -> bool {
+        true
     }
 }
 
@@ -234,6 +240,9 @@ impl<T: Real, const N: usize, const M: usize, S: crate::excite::Excitation<T>> E
     /// harmonic surface: sixteen steps per surface period at least).
     fn time_scale(&self, t: T) -> Option<T> {
         self.motion.time_scale(t)
+    }
+    fn constant_time_scale(&self) -> bool {
+        self.motion.constant_time_scale()
     }
     #[inline(always)]
     fn lanes<V: Lanes>(&self, t: V, y: &[V; M], _dy: &[V; M]) -> Option<(V, Option<V>)> {

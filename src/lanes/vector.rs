@@ -292,17 +292,7 @@ macro_rules! lanes_type {
             }
             #[inline(always)]
             fn select(self, a: Self, b: Self) -> Self {
-                // The mask's sign bit decides (one blend per register instead of three
-                // bit operations); a mask has every bit of a lane set or clear.
-                let mut r = [0.0; $n];
-                for i in 0..$n {
-                    r[i] = if (self.0[i].to_bits() as i64) < 0 {
-                        a.0[i]
-                    } else {
-                        b.0[i]
-                    };
-                }
-                Self(r)
+                (self & a) | (!self & b)
             }
             #[inline(always)]
             fn bits(self) -> u32 {

@@ -358,6 +358,9 @@ where
     fn max_step(&self, t: T) -> Option<T> {
         self.events.max_step(t)
     }
+    fn constant_max_step(&self) -> bool {
+        self.events.constant_max_step()
+    }
 }
 
 /// The tangent-space (QR) estimate of `K` exponents for a system with events and resets:

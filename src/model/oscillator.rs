@@ -211,6 +211,10 @@ where
     fn pack_lane<V: crate::lanes::Lanes>(&self, packed: &mut Self::Packed<V>, lane: usize) {
         <OneDof<f64, L, E> as crate::LaneDynamics<2>>::pack_lane(&self.model, packed, lane)
     }
+    /// No time scale is declared (the driver's default `None`).
+    fn constant_time_scale(&self) -> bool {
+        true
+    }
     fn same_structure(&self, other: &Self) -> bool {
         <OneDof<f64, L, E> as crate::LaneDynamics<2>>::same_structure(&self.model, &other.model)
     }

@@ -59,6 +59,9 @@ impl<const M: usize, G: EventFunction<f64, M>> EventSet<f64, M> for SurfaceEvent
             .filter_map(|g| g.time_scale(t))
             .fold(None, |m: Option<f64>, h| Some(m.map_or(h, |m| m.min(h))))
     }
+    fn constant_max_step(&self) -> bool {
+        self.0.iter().all(|g| g.constant_time_scale())
+    }
 }
 
 /// The impacts of a run: rising crossings of surface `k` (event `k`) from `record_from` on,

@@ -424,6 +424,10 @@ impl<const N: usize, G: Surface<f64, N>> EventFunction<f64, N> for SurfaceEvent<
     fn check(&self) -> Result<(), crate::event::EventError> {
         self.0.as_ref().map_or(Ok(()), |s| s.check())
     }
+    /// No time scale (the default `None`).
+    fn constant_time_scale(&self) -> bool {
+        true
+    }
 }
 
 /// An event function that is either a level or never zero.
@@ -444,6 +448,10 @@ impl<const N: usize> EventFunction<f64, N> for StopEvent {
             Some(s) => Some(dy[s.position]),
             None => Some(0.0),
         }
+    }
+    /// No time scale (the default `None`).
+    fn constant_time_scale(&self) -> bool {
+        true
     }
 }
 

@@ -414,6 +414,10 @@ where
         self.loads.pack_lane(&mut l.loads, lane);
     }
 
+    /// No time scale is declared (the driver's default `None`).
+    fn constant_time_scale(&self) -> bool {
+        true
+    }
     fn same_structure(&self, other: &Self) -> bool {
         self.same_lane_structure(other)
     }

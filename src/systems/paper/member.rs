@@ -118,6 +118,10 @@ impl LaneDynamics<2> for Member {
     fn pack_lane<V: Lanes>(&self, packed: &mut Self::Packed<V>, lane: usize) {
         self.scalar.pack_lane(packed, lane)
     }
+    /// No time scale is declared (the driver's default `None`).
+    fn constant_time_scale(&self) -> bool {
+        true
+    }
     fn same_structure(&self, other: &Self) -> bool {
         self.scalar.same_structure(&other.scalar)
     }
