@@ -1151,3 +1151,45 @@ fn failures_and_caps_counted_in_lanes_match_the_driver() {
         assert_eq!(kinds, want.into_iter().collect(), "cap {cap}");
     }
 }
+
+/// An event function whose time scale is declared only after `t = 2`: 0.01 s.
+#[derive(Debug, Clone, Copy)]
+struct LateScale;
+
+impl nonsmooth::event::EventFunction<f64, 2> for LateScale {
+    fn value(&self, _t: f64, y: &Vector2<f64>) -> f64 {
+        y[0] - 0.5
+    }
+    fn time_scale(&self, t: f64) -> Option<f64> {
+        (t > 2.0).then_some(0.01)
+    }
+}
+
+/// The step bound of a time scale that the events declare only later in the run bounds the
+/// lanes' steps as it bounds the driver's (the ensemble used to look at the start only):
+/// same end, state and statistics, and the bound shows in the step count.
+#[test]
+fn a_time_scale_declared_later_bounds_the_lanes_steps() {
+    use nonsmooth::testing::HarmonicOscillator;
+    let tol = tol(1e-8);
+    let ev = Event::new(LateScale, Direction::Either);
+    let ens = Ensemble::new(tol).unwrap().with_event(ev).unwrap();
+    let jobs: Vec<_> = (0..6)
+        .map(|k| {
+            let m = nonsmooth::LaneByLane(HarmonicOscillator::new(1.0 + 0.2 * k as f64).unwrap());
+            MemberRun::new(m, 0.0, Vector2::new(1.0, 0.0), 6.0).unwrap()
+        })
+        .collect();
+    let mut obs = vec![(); jobs.len()];
+    let out = ens.run::<F64x4, _, _>(&jobs, &mut obs).unwrap();
+    for (j, o) in jobs.iter().zip(&out) {
+        let o = o.as_ref().unwrap();
+        let want = Simulation::new(j.member.0, Dopri5::new(tol))
+            .with_events(ev)
+            .run(j.t0, j.y0, j.t_end, &mut ())
+            .unwrap();
+        assert_eq!((o.t, o.y, o.stats), (want.t, want.y, want.stats));
+        // 4 s at no more than 0.01 s per step.
+        assert!(o.stats.accepted >= 400, "{:?}", o.stats);
+    }
+}
