@@ -76,6 +76,25 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, E: EventSet<T, N>, D: DenseOutp
         sides: &mut Sides,
         observer: &mut O,
     ) -> Result<Option<Termination>> {
+        if let Some(positive) = self.quiet(sides) {
+            // What the scan below does when it finds nothing: the whole step to the
+            // observer, then each event's side to that of the step's end.
+            let dense = self.dense;
+            let (t0, t1) = dense.span();
+            let (y0, y1) = dense.endpoints();
+            let view = StepView {
+                t0,
+                t1,
+                y0: *y0,
+                y1: *y1,
+                dense,
+            };
+            let stop = observer.on_step(&view) == Control::Stop;
+            for (i, &p) in positive.iter().enumerate().take(E::LEN) {
+                sides.quiet_step(i, p);
+            }
+            return Ok(stop.then_some(Termination::ObserverStopped));
+        }
         let mut scan = self.start_scan(sides)?;
         let (t_lo, y_lo) = match self.crossings(&mut scan, sides, observer)? {
             Crossings::Through(t_lo, y_lo) => (t_lo, y_lo),
@@ -99,6 +118,32 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, E: EventSet<T, N>, D: DenseOutp
             }
         }
         Ok(stop.then_some(Termination::ObserverStopped))
+    }
+
+    /// Whether the step is quiet for every event ([`QuietEnds::of`] of its ends and
+    /// [`Sides::is_quiet_with`]): then the scan would find nothing and only move the
+    /// sides; `Some` with each event's side at the end (`g > 0`). Any doubt (a value that
+    /// is not finite, a zero, a grazing pair, an unknown side, interior samples, sticking)
+    /// is `None`, and the full scan decides.
+    fn quiet(&self, sides: &Sides) -> Option<[bool; MAX_EVENTS]> {
+        let dense = self.dense;
+        let (t0, t1) = dense.span();
+        let (y0, y1) = dense.endpoints();
+        let (f0, f1) = dense.end_derivatives();
+        let mut positive = [false; MAX_EVENTS];
+        for (i, p) in positive.iter_mut().enumerate().take(E::LEN) {
+            let g = (self.events.value(i, t0, y0), self.events.value(i, t1, y1));
+            let r = (
+                self.events.rate(i, t0, y0, f0),
+                self.events.rate(i, t1, y1, f1),
+            );
+            let q = QuietEnds::of(g, r)?;
+            if !sides.is_quiet_with(self.events, i, q) {
+                return None;
+            }
+            *p = q.positive;
+        }
+        Some(positive)
     }
 
     /// Every event's values and rates at both ends of the step and its first crossing.
@@ -552,8 +597,8 @@ impl Sides {
     /// step only moves the side to that of the ends ([`quiet_step`](Self::quiet_step));
     /// the ensemble skips it where every event's step is quiet, with `q` from
     /// [`QuietEnds::lanes`] and this rule in lanes ([`LaneSides::quiet`], which the tests
-    /// hold to it).
-    #[cfg(test)]
+    /// hold to it); the driver skips its own scan of such a step ([`Scan::quiet`]).
+    #[inline(always)]
     pub(crate) fn is_quiet_with<T: Real, const N: usize, E: EventSet<T, N>>(
         &self,
         events: &E,
@@ -576,7 +621,7 @@ impl Sides {
     /// What the scan of a quiet step ([`is_quiet_with`](Self::is_quiet_with)) does to
     /// event `i`: its side becomes that of the step's ends (`positive`: `g > 0` there).
     /// The ensemble's form: [`LaneSides::quiet_step`].
-    #[cfg(test)]
+    #[inline(always)]
     pub(crate) fn quiet_step(&mut self, i: usize, positive: bool) {
         self.side[i] = if positive { 1 } else { -1 };
     }
@@ -678,9 +723,9 @@ impl QuietEnds {
     /// The ends' part of [`Sides::is_quiet_with`]: `None` unless `g0`, `g1` are finite,
     /// non-zero and of one sign, and the rates (where both are known) are not a grazing
     /// pair (the start moving towards the surface, the end away from it). The rule as the
-    /// scan states it, for one lane; the ensemble uses its lane form
-    /// [`lanes`](Self::lanes), which the tests hold to it.
-    #[cfg(test)]
+    /// scan states it, for one lane (the driver's quiet steps, [`Scan::quiet`]); the
+    /// ensemble uses its lane form [`lanes`](Self::lanes), which the tests hold to it.
+    #[inline(always)]
     pub(crate) fn of<T: Real>((g0, g1): (T, T), (r0, r1): (Option<T>, Option<T>)) -> Option<Self> {
         if !(g0.is_finite() && g1.is_finite()) || g0 == T::zero() || g1 == T::zero() {
             return None;
