@@ -402,7 +402,6 @@ impl<const M: usize> DenseOutput<f64, M> for LaneDense<M> {
 struct Slot<D> {
     job: Option<usize>,
     member: Option<D>,
-    t_end: f64,
     grid: Option<(f64, f64)>,
     history: EventHistory<f64>,
     stats: Stats,
@@ -413,7 +412,6 @@ impl<D> Slot<D> {
         Self {
             job: None,
             member: None,
-            t_end: 0.0,
             grid: None,
             history: EventHistory::new(),
             stats: Stats::default(),
@@ -608,7 +606,6 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
         *s = Slot::idle();
         s.job = Some(j);
         s.member = Some(m.clone());
-        s.t_end = t_end;
         s.grid = job.grid;
         s.stats = stats;
         Ok(())
@@ -717,7 +714,8 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
                     self.show_quiet_step(i, &step, observers, out);
                 } else {
                     let dense = LaneDense::<M>::from_rows(&step.buf, i);
-                    self.after_step(i, &dense, observers, out);
+                    let near = step.near_landing & (1 << i) != 0;
+                    self.after_step((i, near), &dense, observers, out);
                 }
             }
         }
@@ -796,10 +794,10 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
 
     /// A lane's accepted step: the driver's event handling and observer calls
     /// ([`Scan`]), then the end, a restart where an event reset or cut the step, or the
-    /// next limit.
+    /// next limit (`near_landing`: the kernel found the step's end near the landing point).
     fn after_step<O: Observer<f64, M>>(
         &mut self,
-        i: usize,
+        (i, near_landing): (usize, bool),
         dense: &LaneDense<M>,
         observers: &mut [O],
         out: &mut [Option<Result<Outcome<f64, M>>>],
@@ -845,7 +843,7 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
                     self.st.ends.fresh.set_lane(i, TRUE);
                 }
                 let steps = self.st.counts.accepted.get_lane(i);
-                if t >= self.slots[i].t_end {
+                if t >= self.st.t_end.get_lane(i) {
                     self.finish(i, Ok((t, y, Termination::ReachedEnd)), observers, out);
                 } else if steps >= cfg.max_steps as f64 {
                     let e = IntegrateError::MaxSteps {
@@ -854,18 +852,13 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
                     };
                     self.finish(i, Err(e.into()), observers, out);
                 } else {
-                    let near = restart.is_some() || self.near_landing(i, t);
+                    // Without a restart the lane is at its step's end, where the kernel
+                    // told whether it is near its landing point.
+                    let near = restart.is_some() || near_landing;
                     self.update_limit(i, t, near);
                 }
             }
         }
-    }
-
-    /// Whether lane `i`, now at `t`, is on or near (within the rounding of its
-    /// computation) its landing point: the kernel's `near_landing`, for one lane.
-    fn near_landing(&self, i: usize, t: f64) -> bool {
-        let rounding = 64.0 * f64::EPSILON * (t.abs() + self.st.grid_scale.get_lane(i));
-        self.st.landing.get_lane(i) - t <= rounding
     }
 
     /// The next step limit of lane `i`, now at `t`: the driver's
@@ -882,7 +875,7 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
         let slot = &self.slots[i];
         let mut landing = self.st.landing.get_lane(i);
         if near {
-            landing = landing_limit(t, slot.t_end, slot.grid);
+            landing = landing_limit(t, self.st.t_end.get_lane(i), slot.grid);
             self.st.landing.set_lane(i, landing);
         }
         let bound = slot
