@@ -197,10 +197,10 @@ pub fn pow_masked<V: Lanes>(math: LaneMath, mask: V, x: V, c: V) -> V {
 }
 
 /// `e^{c·ln x}` in the lanes of `bits` (others: 0), by the platform's functions one lane
-/// at a time. Out of line: scalar calls gain nothing from the lane step's instruction set,
-/// and a copy inlined at every power of every kernel (per width, model and instruction
-/// set) would only make the kernels larger and slower to compile.
-#[inline(never)]
+/// at a time. Inlined, like [`map`], so that the calls are direct: out of line, the
+/// functions came in as pointers and every lane's call was an indirect one, which costs
+/// most at narrow widths, where these calls are a larger part of a pass.
+#[inline(always)]
 fn pow_lanes<V: Lanes>(bits: u32, x: V, c: V) -> V {
     let (mut xa, mut ca) = ([0.0f64; 16], [0.0f64; 16]);
     x.store(&mut xa);
@@ -296,7 +296,7 @@ fn patch<V: Lanes>(v: V, mask: V, x: V, f: fn(f64) -> f64) -> V {
     }
 }
 
-/// [`patch`]'s rare path, out of line (see [`pow_lanes`]).
+/// [`patch`]'s rare path, out of line (cold: lanes outside the fast ranges).
 #[cold]
 #[inline(never)]
 fn patch_lanes<V: Lanes>(mut v: V, bits: u32, x: V, f: fn(f64) -> f64) -> V {
@@ -308,8 +308,9 @@ fn patch_lanes<V: Lanes>(mut v: V, bits: u32, x: V, f: fn(f64) -> f64) -> V {
     v
 }
 
-/// `f` in every lane, one lane at a time (out of line, see [`pow_lanes`]).
-#[inline(never)]
+/// `f` in every lane, one lane at a time (inlined: a direct call per lane, see
+/// [`pow_lanes`]).
+#[inline(always)]
 fn map<V: Lanes>(x: V, f: fn(f64) -> f64) -> V {
     let mut a = [0.0f64; 16];
     x.store(&mut a);
