@@ -378,7 +378,8 @@ impl<T: Real> Excitation<T> for Harmonic<T> {
 /// Where `ωt` overflows, the phase is taken as `±MAX` (as for [`Harmonic`]): for finite `t`
 /// the force and its rate are finite.
 /// # References
-/// The paper's eq. (1), right-hand side; `m0·e = 0.01805 kg·m`.
+/// The forcing of the impact oscillator of [`systems::paper`](crate::systems::paper) (its
+/// eq. (1), right-hand side; its parameters are there).
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct UnbalancedRotor<T> {

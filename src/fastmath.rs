@@ -1,8 +1,7 @@
 //! `sin` and `cos` for the right-hand side's hot path.
 //!
 //! A forced oscillator evaluates `sin ωt` at every stage; with the platform's `libm` that
-//! call is about a quarter of a right-hand-side evaluation of the paper's model (measured in
-//! `comparisons/results/profile.md`). The `f64` kernels here are a short, branch-light
+//! call is a large part of a right-hand-side evaluation (`comparisons/results/profile.md`). The `f64` kernels here are a short, branch-light
 //! polynomial evaluation with the accuracy of a good `libm` on the arguments a simulation
 //! produces:
 //!
@@ -19,10 +18,9 @@
 //! `|sin x|, |cos x| > 10⁻³`, and an absolute error below `2.2·10⁻¹⁶` near the zeros. The
 //! kernels are plain arithmetic, so results do not depend on the platform's `libm`.
 //!
-//! Measured on the paper's model (`comparisons/`, `rhs-bench free`): a right-hand-side
-//! evaluation in free flight drops from 21 ns to 13 ns. The same approach for the contact
-//! law's `exp`/`ln` pair (fdlibm-style `ln` with a division, Taylor `exp`) was *slower*
-//! than glibc's table-driven functions (37 ns against 31 ns in contact) and is not used.
+//! The same approach for the contact law's `exp`/`ln` pair (fdlibm-style `ln` with a
+//! division, Taylor `exp`) was slower than glibc's table-driven functions and is not used
+//! (`comparisons/`, `rhs-bench`; the figures are in the README).
 //!
 //! Both functions are generic over [`Real`]: the kernels are taken only when `T` *is* `f64`
 //! (a `TypeId` test the compiler folds away); `f32` and user scalar types (dual numbers,

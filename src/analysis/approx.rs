@@ -139,14 +139,16 @@ fn equilibrium<T: Real, L: ForceLaw<T>, E: Excitation<T>>(
 /// $$A_1 = \frac{F_0\,\Delta}{(\omega c)^2 + \Delta^2},\qquad
 ///   A_2 = -\frac{c\,F_0\,\omega}{(\omega c)^2 + \Delta^2},\qquad
 ///   \Delta = k_\mathrm{eff} - m\omega^2,$$
-/// and amplitude $F_0/\sqrt{(\omega c)^2+\Delta^2}$. For the paper's model
-/// $F_0 = m_0 e\,\omega^2$ and $k_\mathrm{eff} = k + 1.5\,k_I\sqrt{X_0 - x_I}$; here
+/// and amplitude $F_0/\sqrt{(\omega c)^2+\Delta^2}$. For an unbalanced rotor and a Hertz stop
+/// of exponent 3/2 pressed at rest, $F_0 = m_0 e\,\omega^2$ and
+/// $k_\mathrm{eff} = k + 1.5\,k_I\sqrt{X_0 - x_I}$; here
 /// $k_\mathrm{eff}$ comes from the force laws' partials
 /// ([`Oscillator::static_stiffness`]), so any oscillator works.
 ///
-/// `c` is passed explicitly: it is the paper's viscous coefficient. The other
-/// velocity-dependent terms are dropped, as in the paper (its `ε`-terms): the regularized
-/// dry friction has slope `T/ε ≈ 6·10⁵ N·s/m` at `ẋ = 0` and the contact damping
+/// `c` is passed explicitly: it is the viscous coefficient. The other velocity-dependent
+/// terms are dropped, as the method's source does (its `ε`-terms): the regularized dry
+/// friction has the slope `T/ε` at `ẋ = 0` (`5·10⁵ N·s/m` for `T = 0.5 N`,
+/// `ε = 10⁻⁶ m/s`) and the contact damping
 /// `|ẋ|^{n3}` an infinite one, so `∂ΣF/∂ẋ` at rest is no useful damping coefficient for a
 /// finite-amplitude oscillation.
 ///

@@ -26,10 +26,10 @@ pub const SPACING_TOLERANCE: f64 = 1e-6;
 /// Why 1 %: a harmonic at 1 % of the largest amplitude (−40 dB) carries 10⁻⁴ of its energy, so
 /// the harmonics below the threshold change a reconstructed orbit by well under the line width
 /// of a phase portrait; yet the threshold is far above rounding and window-leakage levels of
-/// a simulated periodic orbit (≈10⁻¹²), so it counts what a reader of a spectrum plot (the
-/// paper's Fig. 9b, log scale) calls "dominant". For the paper's orbit at ω = 14 the second
-/// harmonic is ~17 % of the first (eq. 3), the third and higher ones far below 1 %: the
-/// count is 2, as the paper states ("only two dominant frequencies, ω and 2ω").
+/// a simulated periodic orbit (≈10⁻¹²), so it counts what a reader of a spectrum plot (on a
+/// log scale) calls "dominant". For an orbit whose second harmonic is a sixth of the first
+/// and whose third and higher ones are far below 1 % the count is 2: "two dominant
+/// frequencies, ω and 2ω".
 pub const DOMINANCE_THRESHOLD: f64 = 0.01;
 
 /// One harmonic `j` of a [`AmplitudeSpectrum`]:

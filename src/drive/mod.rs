@@ -9,16 +9,17 @@
 //! use nonsmooth::drive::{Simulation, Termination};
 //! use nonsmooth::event::{Direction, Event, Level};
 //! use nonsmooth::integrate::{Dopri5, Tolerances};
-//! use nonsmooth::systems::paper::PAPER;
-//! use nalgebra::Vector2;
+//! use nonsmooth::systems::TwoDofImpact;
+//! use nalgebra::SVector;
 //!
-//! // The paper's oscillator at ω = 20.465 rad/s from rest, impacts = upward crossings of x_I.
-//! let osc = PAPER.oscillator::<f64>(20.465)?;
-//! let impact = Event::new(Level::new(0, PAPER.x_i)?, Direction::Rising);
-//! let tol = Tolerances::per_component(1e-8, [1e-12, 1e-10])?;
-//! let mut sim = Simulation::new(osc, Dopri5::new(tol)).with_events(impact);
-//! let x0 = PAPER.static_equilibrium()?;
-//! let out = sim.run(0.0, Vector2::new(x0, 0.0), 3.0, &mut ())?;
+//! // The 2-DOF impact oscillator at ω = 0.6 from rest, state (q₁, q₂, q̇₁, q̇₂); impacts =
+//! // upward crossings of the stop by the secondary mass, q₂ = d.
+//! let p = TwoDofImpact::default();
+//! let model = p.model::<f64>(0.6)?;
+//! let impact = Event::new(Level::new(1, p.gap)?, Direction::Rising);
+//! let tol = Tolerances::<f64, 4>::new(1e-8, 1e-10)?;
+//! let mut sim = Simulation::new(model, Dopri5::new(tol)).with_events(impact);
+//! let out = sim.run(0.0, SVector::zeros(), 50.0, &mut ())?;
 //! assert_eq!(out.termination, Termination::ReachedEnd);
 //! # Ok::<(), nonsmooth::Error>(())
 //! ```

@@ -122,19 +122,22 @@
 //! use nonsmooth::drive::Simulation;
 //! use nonsmooth::ensemble::{Ensemble, F64x4, MemberRun};
 //! use nonsmooth::integrate::{Dopri5, Tolerances};
-//! use nonsmooth::systems::paper::{Member, PAPER};
+//! use nonsmooth::systems::DuffingUeda;
 //!
-//! let tol = Tolerances::per_component(1e-8, [1e-12, 1e-10])?;
-//! let y0 = Vector2::new(PAPER.static_equilibrium()?, 0.0);
-//! // Eight forcing frequencies, 5 periods each, in lanes of four.
-//! let jobs: Vec<MemberRun<Member>> = (0..8)
-//!     .map(|i| Ok(MemberRun::periods(Member::paper(17.5 + i as f64)?, y0, 5.0)?))
-//!     .collect::<nonsmooth::Result<_>>()?;
+//! let tol = Tolerances::new(1e-8, 1e-10)?;
+//! let y0 = Vector2::new(1.0, 0.0);
+//! // The Duffing–Ueda oscillator at eight forcing amplitudes, 5 periods each, in lanes of four.
+//! let jobs = (0..8)
+//!     .map(|i| {
+//!         let p = DuffingUeda { b: 5.0 + i as f64, ..DuffingUeda::default() };
+//!         Ok(MemberRun::periods_of(p.model::<f64>()?, y0, p.period(), 5.0)?)
+//!     })
+//!     .collect::<nonsmooth::Result<Vec<_>>>()?;
 //! let mut observers = vec![(); jobs.len()];
 //! let out = Ensemble::new(tol)?.run::<F64x4, _, _>(&jobs, &mut observers)?;
 //! // The same as the scalar path, to the bit.
 //! let j = &jobs[3];
-//! let scalar = Simulation::new(*j.member.scalar(), Dopri5::new(tol))
+//! let scalar = Simulation::new(j.member, Dopri5::new(tol))
 //!     .landing_grid(j.grid)?
 //!     .run(0.0, y0, j.t_end, &mut ())?;
 //! assert_eq!(out[3].as_ref().unwrap().y, scalar.y);

@@ -78,7 +78,7 @@ impl<T: Real, const N: usize> EventFunction<T, N> for Level<T> {
 }
 
 /// A one-sided stop `y[position] = level` with `y[velocity]` the position's rate: the
-/// penetration `g = y[position] − level` is negative while the body is free (the paper's
+/// penetration `g = y[position] − level` is negative while the body is free (an upper
 /// stop at `x_I`). Its event rate is `ẏ[position]`.
 ///
 /// The fields are public for struct-literal use; a non-finite level or an index outside

@@ -12,14 +12,14 @@ use crate::{ForceLaw, Real};
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum Side {
     /// The stop limits motion from above: contact when `x ≥ x_I`, the force pushes towards
-    /// smaller `x` (positive on the left-hand side). The paper's configuration.
+    /// smaller `x` (positive on the left-hand side).
     Upper,
     /// The stop limits motion from below: contact when `x ≤ x_I`, the force pushes towards
     /// larger `x`.
     Lower,
 }
 
-/// The generalized Hertz contact law with nonlinear damping of the paper's eq. (1).
+/// The generalized Hertz contact law with nonlinear damping.
 ///
 /// Deserialization (feature `serde`) applies the constructor's and the builders' checks
 /// (the value is rebuilt from its parameters).
@@ -34,7 +34,7 @@ pub enum Side {
 ///
 /// ## The `|δ̇|^{n3}` singularity and its regularization
 /// For `n3 < 1` the damping term is not Lipschitz at `δ̇ = 0`: its slope is infinite there.
-/// A body resting in contact (the paper's initial state) then obeys `m·v̇ ≈ −C·|v|^{n3}`
+/// A body resting in contact (for instance at rest on a preloaded stop) then obeys `m·v̇ ≈ −C·|v|^{n3}`
 /// near `v = 0`, which relaxes in finite time and forces an explicit integrator to crawl.
 /// [`with_rate_regularization`](Self::with_rate_regularization) replaces
 /// `sgn(δ̇)|δ̇|^{n3}` by
@@ -43,8 +43,8 @@ pub enum Side {
 /// With `η = 0` (the default) the law is exact.
 ///
 /// # References
-/// The paper's eq. (1), impact force `F_I`; `n1 = n2 = 3/2`, `n3 = 0.18667`,
-/// `k_I = 2.3983·10⁸ N/m^{3/2}`, `b = 0.8485 m^{−n3}s^{n3}`.
+/// The impact force `F_I` of the impact oscillator of
+/// [`systems::paper`](crate::systems::paper) (its eq. (1); its parameters are there).
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct HertzContact<T> {

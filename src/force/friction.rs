@@ -9,7 +9,7 @@ use crate::{ForceLaw, Real};
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum Regularization {
-    /// `sgn v ≈ v/√(v²+ε²)` — the paper's choice (eq. 1).
+    /// `sgn v ≈ v/√(v²+ε²)`.
     Sqrt,
     /// `sgn v ≈ tanh(v/ε)`.
     Tanh,
@@ -22,12 +22,13 @@ pub enum Regularization {
 /// # Model
 /// $$F(\dot x) = T\,\frac{\dot x}{\sqrt{\dot x^2+\varepsilon^2}} \quad\text{(Sqrt)},\qquad
 ///   F(\dot x) = T\tanh(\dot x/\varepsilon) \quad\text{(Tanh)} .$$
-/// Both tend to `T·sgn ẋ` for `|ẋ| ≫ ε`, and both have the slope `T/ε` at `ẋ = 0`: with the
-/// paper's `T = 0.63133 N` and `ε = 10⁻⁶ m/s` that is `6.3·10⁵ N·s/m`, which makes the
-/// equation of motion stiff near every velocity reversal.
+/// Both tend to `T·sgn ẋ` for `|ẋ| ≫ ε`, and both have the slope `T/ε` at `ẋ = 0`: with
+/// `T = 0.5 N` and `ε = 10⁻⁶ m/s` that is `5·10⁵ N·s/m`, which makes the equation of motion
+/// stiff near every velocity reversal.
 ///
 /// # References
-/// The paper's eq. (1), resistance force `F_R`.
+/// The resistance force `F_R` of the impact oscillator of
+/// [`systems::paper`](crate::systems::paper) (its eq. (1)) is [`DryFriction::sqrt`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct DryFriction<T> {
@@ -42,7 +43,7 @@ crate::serde_check::deserialize_checked! {
 }
 
 impl<T: Real> DryFriction<T> {
-    /// Friction of magnitude `t` (N) regularized with `v/√(v²+ε²)` (the paper's law).
+    /// Friction of magnitude `t` (N) regularized with `v/√(v²+ε²)`.
     ///
     /// # Errors
     /// [`ParameterError`] if `t < 0`, `eps ≤ 0`, or either is not finite.

@@ -3,7 +3,7 @@
 //! where the cusp makes the explicit stepper stiffness-bound ([`CuspSwitch`]).
 //!
 //! # Why
-//! A force term `∝ sgn(ẋ)|ẋ|^q` with `0 < q < 1` (the paper's contact damping, `q = n3`)
+//! A force term `∝ sgn(ẋ)|ẋ|^q` with `0 < q < 1` (a Hertz contact's damping, `q = n3`)
 //! has the slope `q|ẋ|^{q−1}`, unbounded at `ẋ = 0`. Where the body *creeps* in contact —
 //! at rest on a stop, its velocity following the slowly changing balance of the other
 //! forces, `ẍ = A − C·g(ẋ)` with `A ≈ C·g(ẋ)` — the relaxation rate `C·q|ẋ|^{q−1}` is huge
@@ -67,12 +67,12 @@
 //!   cusp's relaxation rate is estimated by a secant in that velocity at the step's end,
 //!   `ρ_i = |a_i(v_i) − a_i(v_i/2)|/|v_i/2|` (one extra evaluation; the secant of
 //!   `|v|^q` over `[v/2, v]` is `2(1 − 2^{−q})/q` times its tangent slope at `v`, 1.3 for
-//!   the paper's `n3`); at `v_i = 0`, `ρ_i = ∞`;
+//!   `q ≈ 0.19`); at `v_i = 0`, `ρ_i = ∞`;
 //! - three explicit steps in a row with `h·ρ > 1/2` hand over to the implicit step. An
 //!   explicit Runge–Kutta method is stable to `h·ρ ≈ 3` on the negative real axis, but in
 //!   the creep its error estimate, dominated by the fast relaxation, holds the step
-//!   lower: on the paper's model DOPRI5 creeps at `h·ρ ≈ 0.7` (secant), with steps of
-//!   `4·10⁻⁹` s at rtol 10⁻¹⁰ (ω = 17 rad/s). Away from the creep `h·ρ ≪ 1/2`; a
+//!   lower: in `examples/exact_law.rs` DOPRI5 creeps at `h·ρ ≈ 0.7` (secant), with steps
+//!   of `4·10⁻⁹` s at rtol 10⁻¹⁰ (ω = 17 rad/s). Away from the creep `h·ρ ≪ 1/2`; a
 //!   transversal reversal gives one or two such steps, not three;
 //! - the implicit step hands back after two steps with `h·ρ < 0.15` (the explicit method
 //!   would be far from that regime at the same step), or as soon as no velocity is in the
@@ -412,18 +412,23 @@ pub struct SwitchCounts {
 ///
 /// ```
 /// use nonsmooth::drive::Simulation;
+/// use nonsmooth::excite::Harmonic;
+/// use nonsmooth::force::{HertzContact, LinearSpring};
 /// use nonsmooth::integrate::{CuspSwitch, Tolerances};
-/// use nonsmooth::systems::paper::PAPER;
+/// use nonsmooth::model::Oscillator;
 /// use nalgebra::Vector2;
 ///
-/// let mut exact = PAPER;
-/// exact.eta = 0.0; // the contact law as written
-/// let osc = exact.oscillator::<f64>(20.465)?;
+/// // A spring pressing the body onto a stop at x = −0.01 (rest position 0), the contact
+/// // damped by b·δ^{3/2}·sgn(ẋ)|ẋ|^{1/4} (exact, no regularization: a cusp at ẋ = 0).
+/// let contact = HertzContact::new(-0.01, 1e6)?.with_damping(1.0, 1.5, 0.25)?;
+/// let osc = Oscillator::new(1.0, (LinearSpring::new(100.0)?, contact), Harmonic::sine(0.5, 8.0)?)?;
+/// let x0 = osc.static_equilibrium(-0.01, 0.0)?; // pressed about 1e-4 into the stop
 /// let rtol = 1e-8;
 /// let tol = Tolerances::per_component(rtol, [rtol * 1e-4, rtol * 1e-2])?;
 /// let mut sim = Simulation::new(osc, CuspSwitch::dopri5(tol, 1e-6)?);
-/// // From rest on the stop: the first creep is stepped implicitly.
-/// let out = sim.run(0.0, Vector2::new(PAPER.static_equilibrium()?, 0.0), 0.3, &mut ())?;
+/// // From rest on the stop: the forcing is too weak to lift the body off, and its creep is
+/// // stepped implicitly.
+/// let out = sim.run(0.0, Vector2::new(x0, 0.0), 0.3, &mut ())?;
 /// assert!(sim.stepper().counts().implicit_steps > 0);
 /// # Ok::<(), nonsmooth::Error>(())
 /// ```
@@ -501,8 +506,8 @@ where
     E::Dense: Clone,
 {
     /// The explicit stepper `explicit`, the implicit step `implicit`, and the band
-    /// `|v| < v_band` in which a velocity's cusp is probed for stiffness (for the paper's
-    /// model 10⁻⁶ m/s: the creep in contact runs at `|ẋ| ≪ 10⁻⁸` m/s).
+    /// `|v| < v_band` in which a velocity's cusp is probed for stiffness (10⁻⁶ m/s in
+    /// `examples/exact_law.rs`, where the creep in contact runs at `|ẋ| ≪ 10⁻⁸` m/s).
     ///
     /// # Errors
     /// [`ParameterError`] unless `v_band` is finite and > 0.

@@ -265,11 +265,10 @@ pub struct StepOptions<T> {
     /// not smooth — the next step is cut by the observed trend instead of being tried at
     /// the PI controller's size and rejected. It can only shorten the PI proposal.
     ///
-    /// Measured on the paper's oscillator (ω = 20.465, DOPRI5, rtol 10⁻⁸): a third fewer
-    /// rejected steps and 6 % fewer evaluations (10 % at 10⁻¹⁰), but at equal *accuracy*
-    /// no gain beyond the run-to-run spread, and a 3–10× larger scatter of Poincaré points
-    /// on periodic orbits (the steps it accepts next to non-smooth points carry errors the
-    /// embedded estimate underrates). Hence off by default.
+    /// It saves rejected steps and evaluations next to non-smooth points, but at equal
+    /// *accuracy* it gains little, and it scatters the Poincaré points of periodic orbits
+    /// more (the steps it accepts next to non-smooth points carry errors the embedded
+    /// estimate underrates; the README gives the figures). Hence off by default.
     pub predictive: bool,
 }
 

@@ -1,11 +1,11 @@
 //! Crossing `ẋ = 0` in a power scale of the velocity: the [`TurningPoints`] stepper.
 //!
 //! # Why
-//! A force term `∝ sgn(ẋ)|ẋ|^q` with `0 < q < 1` (the paper's contact damping, `q = n3 =
-//! 0.18667`) has an infinite slope at `ẋ = 0`. Where the trajectory turns round with an
+//! A force term `∝ sgn(ẋ)|ẋ|^q` with `0 < q < 1` (a Hertz contact's damping, `q = n3`) has
+//! an infinite slope at `ẋ = 0`. Where the trajectory turns round with an
 //! acceleration `a ≠ 0`, `ẋ ≈ a·τ`, so the velocity has a `|τ|^{1+q}` term: a method that
 //! steps in time must shrink its steps to ~10⁻⁸ s there and grow them back (≈ 40 attempts per
-//! turning point at rtol 10⁻⁸ on the paper's model). A regularized friction
+//! turning point at rtol 10⁻⁸ in `examples/turning_points.rs`). A regularized friction
 //! `T·ẋ/√(ẋ² + ε²)` adds a layer of width `ε/|a|` in time at every `ẋ = 0`.
 //!
 //! # How
@@ -21,10 +21,10 @@
 //!
 //! The cusp `|ẋ|^q = |u|^{pq}` (`pq ≥ 1`) enters `dτ/du` multiplied by `u^{p−1}`, so the
 //! segment's right-hand side has `p − 1` more continuous derivatives than the cusp (`p = 6`
-//! for the paper's `n3`: enough for a fifth-order method), and the friction layer is
+//! for `q ≈ 0.19`: enough for a fifth-order method), and the friction layer is
 //! stretched from `ε` to `≈ ε^{1/p}`. An integer `p` keeps the map `u ↦ ẋ` to a few
-//! multiplications: `p = 1/q` itself (5.36 for the paper) took 6 % fewer steps per segment
-//! (14.7 against 15.6 at rtol 10⁻⁸) but a `powf` per evaluation, and more time per period.
+//! multiplications: `p = 1/q` itself took 6 % fewer steps per segment in
+//! `examples/turning_points.rs` (14.7 against 15.6 at rtol 10⁻⁸) but a `powf` per evaluation, and more time per period.
 //!
 //! The state of a *segment* is `(θ, x)`: the time since the segment began in units of its
 //! natural duration, `θ = τ·|a₀|/V*` (`a₀` the acceleration at entry; a segment lasts
@@ -53,8 +53,8 @@
 //! from `w = 0` (the crossing of the stop, located on the time step's dense output) to
 //! `w = δ*^{1/m}` entering, and back from `δ = δ*` to exactly `δ = 0` leaving. It needs
 //! `ẋ ≠ 0` across the band; a contact shallower than `δ*` (the body turns round inside
-//! it) abandons the segment and is stepped in time. Measured on the paper's model
-//! (`examples/turning_points.rs -- --onset 1e-5`), this does not pay: time stepping spends
+//! it) abandons the segment and is stepped in time. Measured with
+//! `examples/turning_points.rs -- --onset 1e-5`, this does not pay: time stepping spends
 //! about 7 attempts per crossing of `[0, 10⁻⁵ m]` at rtol 10⁻⁸, a segment 6.7 plus two
 //! restarts, after which the time stepper regrows its step inside the contact (80 → 88
 //! accepted steps per period there). On the attractor it costs 9 % more evaluations than
@@ -91,8 +91,8 @@
 //! A segment's accuracy is set by the segment stepper's tolerances on `(θ, x)`. The error
 //! in `θ` is a phase error: `δτ = δθ·V*/|a₀|` shifts the state by `(ẋ, ẍ)·δτ` at the exit.
 //! [`TurningPoints::dopri5`] uses `rtol` for both, an absolute tolerance of `100·rtol` on
-//! `θ` and the time stepper's on `x`, chosen by work–precision measurements on the paper's
-//! model (`examples/turning_points.rs`): on a stable period-2 orbit (ω = 19 rad/s, where
+//! `θ` and the time stepper's on `x`, chosen by work–precision measurements
+//! (`examples/turning_points.rs`): on a stable period-2 orbit (ω = 19 rad/s, where
 //! errors do not grow from period to period), time stepping needs 1.0–1.5× (median 1.3×)
 //! the evaluations to reach the segments' error at rtol 10⁻⁶…10⁻¹²; `θ` to `rtol` gains
 //! nothing (0.85–1.13×: the segment then takes as many steps as time stepping spent), and
@@ -122,16 +122,22 @@ const MAX_SEGMENT_STEPS: u32 = 10_000;
 /// ```
 /// use nonsmooth::drive::Simulation;
 /// use nonsmooth::integrate::{Tolerances, TurningPoints};
-/// use nonsmooth::systems::paper::PAPER;
+/// use nonsmooth::excite::Harmonic;
+/// use nonsmooth::force::{HertzContact, LinearSpring, ViscousDamper};
+/// use nonsmooth::model::Oscillator;
 /// use nalgebra::Vector2;
 ///
-/// let osc = PAPER.oscillator::<f64>(20.465)?;
+/// // A forced oscillator hitting a stop at x = 0.01 whose damping term is
+/// // b·δ^{3/2}·sgn(ẋ)|ẋ|^{1/4}: it declares the velocity exponent 1/4.
+/// let contact = HertzContact::new(0.01, 1e6)?.with_damping(1.0, 1.5, 0.25)?;
+/// let laws = (LinearSpring::new(100.0)?, ViscousDamper::new(0.1)?, contact);
+/// let osc = Oscillator::new(1.0, laws, Harmonic::sine(2.0, 8.0)?)?;
 /// let rtol = 1e-8;
 /// let tol = Tolerances::per_component(rtol, [rtol * 1e-4, rtol * 1e-2])?;
-/// // DOPRI5 in time and in the segments, |ẋ| < 3 mm/s.
-/// let stepper = TurningPoints::dopri5(tol, 3e-3)?;
+/// // DOPRI5 in time and in the segments, |ẋ| < 0.01.
+/// let stepper = TurningPoints::dopri5(tol, 1e-2)?;
 /// let mut sim = Simulation::new(osc, stepper);
-/// let out = sim.run(0.0, Vector2::new(PAPER.static_equilibrium()?, 0.0), 3.0, &mut ())?;
+/// let out = sim.run(0.0, Vector2::zeros(), 1.0, &mut ())?;
 /// assert!(sim.stepper().segments() > 0);
 /// # Ok::<(), nonsmooth::Error>(())
 /// ```
@@ -293,8 +299,8 @@ where
     /// A time stepper, a segment stepper and the band `|ẋ| < v_band` in which velocity
     /// segments run.
     ///
-    /// The band should hold the turning point's cusp and friction layer (for the paper's
-    /// model 3·10⁻³ m/s, where the acceleration is 10²–10⁴ m/s²) and be thin enough for the
+    /// The band should hold the turning point's cusp and friction layer (3·10⁻³ m/s in
+    /// `examples/turning_points.rs`, where the acceleration is 10²–10⁴ m/s²) and be thin enough for the
     /// acceleration not to change sign inside it.
     ///
     /// # Errors

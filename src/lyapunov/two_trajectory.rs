@@ -253,14 +253,14 @@ where
     /// ```
     /// use nonsmooth::integrate::{Dopri5, Tolerances};
     /// use nonsmooth::lyapunov::{Norm, TwoTrajectory};
-    /// use nonsmooth::systems::paper::PAPER;
-    /// let tol = Tolerances::per_component(1e-8, [1e-12, 1e-10])?;
+    /// use nonsmooth::systems::DuffingUeda;
+    /// let tol = Tolerances::new(1e-8, 1e-10)?;
     /// let est = TwoTrajectory::<_, 2, 4, _, _>::with_tolerances(
-    ///     PAPER.oscillator::<f64>(14.0)?,
+    ///     DuffingUeda::default().model::<f64>()?,
     ///     Dopri5::new,
     ///     &tol,
     ///     1e-8,
-    ///     Norm::weighted([1e-3, 3e-2])?,
+    ///     Norm::weighted([1.0, 2.0])?,
     /// )?;
     /// # drop(est);
     /// # Ok::<(), nonsmooth::Error>(())

@@ -119,7 +119,7 @@ impl<T: Real, L: ForceLaw<T>, E: Excitation<T>> Oscillator<T, L, E> {
 impl<T: Real, L: ForceLaw<T>, E: Excitation<T>> Dynamics<T, 2> for Oscillator<T, L, E> {
     /// The one-DOF case of [`Mechanical`]'s right-hand side written out,
     /// `ẍ = (f(t) − F(x, ẋ))/m`: the same values to the bit (tested), without the general
-    /// coordinate and matrix bookkeeping on the paper's hot path.
+    /// coordinate and matrix bookkeeping on the hot path.
     #[inline(always)]
     fn rhs(&self, t: T, y: &SVector<T, 2>, dy: &mut SVector<T, 2>) {
         let force = self.excitation().force(t) - self.laws().force(y[0], y[1]);

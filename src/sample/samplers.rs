@@ -165,16 +165,16 @@ impl<R> Store<R> {
 /// ```
 /// use nonsmooth::drive::Simulation;
 /// use nonsmooth::integrate::{Dopri5, Tolerances};
-/// use nonsmooth::systems::paper::PAPER;
+/// use nonsmooth::systems::DuffingUeda;
 /// use nonsmooth::sample::Stroboscopic;
 /// use nalgebra::Vector2;
 ///
-/// let omega = 19.0;
-/// let period = std::f64::consts::TAU / omega;
+/// let p = DuffingUeda::default(); // ẍ + 0.05ẋ + x³ = 7.5 cos t
+/// let period = p.period();
 /// let mut strobe = Stroboscopic::periodic(0.0, period, 10.0 * period, 1000)?;
-/// let osc = PAPER.oscillator::<f64>(omega)?;
-/// let tol = Tolerances::per_component(1e-8, [1e-12, 1e-10])?;
-/// Simulation::new(osc, Dopri5::new(tol)).run(0.0, Vector2::new(PAPER.static_equilibrium()?, 0.0), 20.0 * period, &mut strobe)?;
+/// let model = p.model::<f64>()?;
+/// let tol = Tolerances::new(1e-8, 1e-10)?;
+/// Simulation::new(model, Dopri5::new(tol)).run(0.0, Vector2::new(1.0, 0.0), 20.0 * period, &mut strobe)?;
 /// assert_eq!(strobe.points().len(), 11); // sections 10..=20
 /// # Ok::<(), nonsmooth::Error>(())
 /// ```

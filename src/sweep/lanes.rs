@@ -139,24 +139,27 @@ pub struct LaneStart<D, const M: usize> {
 ///
 /// # Examples
 /// ```
-/// use nalgebra::Vector2;
+/// use nalgebra::SVector;
 /// use nonsmooth::ensemble::{Ensemble, F64x4};
 /// use nonsmooth::event::Stop;
 /// use nonsmooth::integrate::Tolerances;
-/// use nonsmooth::sweep::{IndependentSweep, sweep_independent};
-/// use nonsmooth::systems::paper::{Member, PAPER};
+/// use nonsmooth::sweep::{IndependentSweep, LaneStart, sweep_independent};
+/// use nonsmooth::systems::TwoDofImpact;
 ///
-/// let tol = Tolerances::per_component(1e-8, [1e-12, 1e-10])?;
-/// let y0 = Vector2::new(PAPER.static_equilibrium()?, 0.0);
-/// let starts = [19.0, 19.1, 19.2]
-///     .map(|w| Member::paper(w).map(|m| m.start(y0)))
+/// let p = TwoDofImpact::default();
+/// let tol = Tolerances::new(1e-6, 1e-8)?;
+/// let starts = [0.6, 0.7, 0.8]
+///     .map(|w| -> nonsmooth::Result<_> {
+///         Ok(LaneStart { param: w, system: p.model(w)?, period: TwoDofImpact::period(w), y0: SVector::zeros() })
+///     })
 ///     .into_iter()
-///     .collect::<Result<Vec<_>, _>>()?;
-/// let stop = Stop { position: 0, velocity: 1, level: PAPER.x_i };
-/// let settings = IndependentSweep::new(40, 10)?;
-/// let points = sweep_independent::<F64x4, _, _, 2>(&Ensemble::new(tol)?, &settings, &starts, Some(stop))?;
+///     .collect::<nonsmooth::Result<Vec<_>>>()?;
+/// // State (q₁, q₂, q̇₁, q̇₂): impacts of the secondary mass on the stop q₂ = d.
+/// let stop = Stop { position: 1, velocity: 3, level: p.gap };
+/// let settings = IndependentSweep::new(20, 5)?;
+/// let points = sweep_independent::<F64x4, _, _, 4>(&Ensemble::new(tol)?, &settings, &starts, Some(stop))?;
 /// assert_eq!(points.len(), 3);
-/// assert_eq!(points[1].param, 19.1);
+/// assert_eq!(points[1].param, 0.7);
 /// # Ok::<(), nonsmooth::Error>(())
 /// ```
 ///

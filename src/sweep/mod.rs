@@ -3,7 +3,7 @@
 //! frequency ramp.
 //!
 //! A sweep runs a system at each value `p` of a parameter grid (built by a closure
-//! `make(p)`): `transient` forcing periods are discarded (the paper: 100 at the first value,
+//! `make(p)`): `transient` forcing periods are discarded (by default 100 at the first value,
 //! 50 after each step) and `record` periods are recorded — the stroboscopic points
 //! `y(t_i)`, the impacts and their intervals `T_j`, the per-period grazing margin. With
 //! continuation each value starts from the end state of the previous one (at forcing phase
@@ -213,14 +213,14 @@ pub struct SweepConfig {
 
 impl SweepConfig {
     /// A sweep over the given strictly increasing values; defaults: both directions,
-    /// continuation, the paper's transients (100 first, 50 per step), 50 recorded periods,
+    /// continuation, transients of 100 periods first and 50 per step, 50 recorded periods,
     /// period detection to `10⁻⁴` of the points' scale up to period 16, `10⁷` steps per
     /// value.
     ///
     /// The period tolerance must sit above the scatter of the stroboscopic points on a
     /// periodic orbit, which is the integration error amplified at the impacts: on the
-    /// paper's model at `rtol = 10⁻⁸` that scatter is ~`5·10⁻⁶` of the scale (e.g. the
-    /// period-2 orbit at ω = 19 rad/s), at `rtol = 10⁻¹⁰` ~`10⁻⁶`.
+    /// impact oscillator of `examples/paper.rs` at `rtol = 10⁻⁸` that scatter is ~`5·10⁻⁶`
+    /// of the scale (e.g. the period-2 orbit at ω = 19 rad/s), at `rtol = 10⁻¹⁰` ~`10⁻⁶`.
     ///
     /// # Errors
     /// [`SweepError`] for an empty, non-finite or non-increasing grid.
@@ -612,22 +612,23 @@ fn impacts_per_period(
 ///
 /// # Examples
 /// ```
-/// use nalgebra::Vector2;
+/// use nalgebra::SVector;
 /// use nonsmooth::integrate::{Dopri5, Tolerances};
-/// use nonsmooth::systems::paper::PAPER;
+/// use nonsmooth::systems::TwoDofImpact;
 /// use nonsmooth::sweep::{SweepConfig, SweepSystem, Stop, SweepDirection, sweep};
 ///
-/// let config = SweepConfig::grid(19.0, 19.2, 0.1)?.direction(SweepDirection::Up).transients(40, 20).record(10)?;
+/// let p = TwoDofImpact::default();
+/// let config = SweepConfig::grid(0.6, 0.8, 0.1)?.direction(SweepDirection::Up).transients(20, 10).record(5)?;
 /// let make = |w: f64| -> nonsmooth::Result<SweepSystem<_>> {
 ///     Ok(SweepSystem {
-///         system: PAPER.oscillator::<f64>(w)?,
-///         period: std::f64::consts::TAU / w,
-///         stop: Some(Stop { position: 0, velocity: 1, level: PAPER.x_i }),
+///         system: p.model::<f64>(w)?,
+///         period: TwoDofImpact::period(w),
+///         // State (q₁, q₂, q̇₁, q̇₂): impacts of the secondary mass on the stop q₂ = d.
+///         stop: Some(Stop { position: 1, velocity: 3, level: p.gap }),
 ///     })
 /// };
-/// let tol = Tolerances::per_component(1e-8, [1e-12, 1e-10])?;
-/// let x0 = PAPER.static_equilibrium()?;
-/// let res = sweep(&config, make, || nonsmooth::integrate::Dopri5::new(tol), Vector2::new(x0, 0.0))?;
+/// let tol = Tolerances::<f64, 4>::new(1e-6, 1e-8)?;
+/// let res = sweep(&config, make, || nonsmooth::integrate::Dopri5::new(tol), SVector::zeros())?;
 /// assert_eq!(res.branches[0].points.len(), 3);
 /// # Ok::<(), nonsmooth::Error>(())
 /// ```

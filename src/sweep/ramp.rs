@@ -38,7 +38,7 @@ pub struct RampImpact {
 
 /// The records of a ramped run.
 ///
-/// Memory: `24 + 8N` bytes per section (48 B for the paper's `N = 2`) and 40 B per impact;
+/// Memory: `24 + 8N` bytes per section (48 B for `N = 2`) and 40 B per impact;
 /// the run keeps them while it lasts, so the peak is about twice that. Bound it with
 /// [`ramp_with_capacity`].
 #[derive(Debug, Clone, PartialEq)]
