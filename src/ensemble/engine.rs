@@ -7,7 +7,9 @@ use crate::LaneDynamics;
 use crate::drive::{Control, Observer, Outcome, RunError, StepView, Termination};
 use crate::drive::{LaneSides, Scan, check_work, landing_limit, scaled_limit, time_scale};
 use crate::event::{Event, EventFunction, EventHistory, EventSet, MAX_EVENTS, ZenoGuard};
-use crate::integrate::{DenseOutput, IntegrateError, Stats, StepOptions, Tolerances};
+use crate::integrate::{
+    DenseOutput, Dopri5Dense, HermiteDense, IntegrateError, Stats, StepOptions, Tolerances,
+};
 use crate::lanes::{LaneMath, Lanes, Simd, TRUE};
 use crate::validate::ParameterError;
 
@@ -338,63 +340,24 @@ impl<E: EventSet<f64, M>, const M: usize> Ensemble<E, M> {
     }
 }
 
-/// The dense output of one lane's accepted step (Hairer's continuous extension of
-/// DOPRI5, the same formula as [`Dopri5Dense`](crate::integrate::Dopri5Dense)).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct LaneDense<const M: usize = 2> {
-    t0: f64,
-    t1: f64,
-    h: f64,
-    y0: SVector<f64, M>,
-    y1: SVector<f64, M>,
-    f0: SVector<f64, M>,
-    f1: SVector<f64, M>,
-    r2: SVector<f64, M>,
-    r3: SVector<f64, M>,
-    r4: SVector<f64, M>,
-    r5: SVector<f64, M>,
-}
+/// The dense output of one lane's accepted step: the scalar stepper's own
+/// [`Dopri5Dense`] (Hairer's continuous extension of DOPRI5), built from the lane's rows.
+pub type LaneDense<const M: usize = 2> = Dopri5Dense<f64, M>;
 
-impl<const M: usize> LaneDense<M> {
-    /// Lane `i`'s step from the rows of a pass's output.
-    #[inline(always)]
-    fn from_rows(buf: &[[f64; 16]], i: usize) -> Self {
-        let v = |q: usize| SVector::<f64, M>::from_fn(|c, _| buf[row::vector(q, M) + c][i]);
-        Self {
-            t0: buf[row::T0][i],
-            t1: buf[row::T1][i],
-            h: buf[row::H][i],
-            y0: v(row::X0),
-            y1: v(row::X1),
-            f0: v(row::F0),
-            f1: v(row::F1),
-            r2: v(row::R2),
-            r3: v(row::R3),
-            r4: v(row::R4),
-            r5: v(row::R5),
-        }
-    }
-}
-
-impl<const M: usize> DenseOutput<f64, M> for LaneDense<M> {
-    fn span(&self) -> (f64, f64) {
-        (self.t0, self.t1)
-    }
-    fn endpoints(&self) -> (&SVector<f64, M>, &SVector<f64, M>) {
-        (&self.y0, &self.y1)
-    }
-    fn end_derivatives(&self) -> (&SVector<f64, M>, &SVector<f64, M>) {
-        (&self.f0, &self.f1)
-    }
-    #[inline(always)]
-    fn interpolate_unchecked(&self, t: f64, out: &mut SVector<f64, M>) {
-        let th = (t - self.t0) / self.h;
-        let th1 = 1.0 - th;
-        for i in 0..M {
-            out[i] = self.y0[i]
-                + th * (self.r2[i] + th1 * (self.r3[i] + th * (self.r4[i] + th1 * self.r5[i])));
-        }
-    }
+/// Lane `i`'s step from the rows of a pass's output.
+#[inline(always)]
+fn dense_of<const M: usize>(buf: &[[f64; 16]], i: usize) -> Dopri5Dense<f64, M> {
+    let v = |q: usize| SVector::<f64, M>::from_fn(|c, _| buf[row::vector(q, M) + c][i]);
+    let ends = HermiteDense::new(
+        buf[row::T0][i],
+        buf[row::T1][i],
+        v(row::X0),
+        v(row::X1),
+        v(row::F0),
+        v(row::F1),
+    );
+    let r = [v(row::R2), v(row::R3), v(row::R4), v(row::R5)];
+    Dopri5Dense::from_parts(ends, buf[row::H][i], r)
 }
 
 /// Per-lane bookkeeping (scalar). The step counts are lanes of the vector state
@@ -713,7 +676,7 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
                 if quiet & (1 << i) != 0 {
                     self.show_quiet_step(i, &step, observers, out);
                 } else {
-                    let dense = LaneDense::<M>::from_rows(&step.buf, i);
+                    let dense = dense_of::<M>(&step.buf, i);
                     let near = step.near_landing & (1 << i) != 0;
                     self.after_step((i, near), &dense, observers, out);
                 }
@@ -820,7 +783,7 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
         }
         .scan_step(&mut sides, &mut observers[j]);
         self.sides.set(i, &sides);
-        let (t, y) = restart.unwrap_or((dense.t1, dense.y1));
+        let (t, y) = restart.unwrap_or((dense.span().1, *dense.endpoints().1));
         match res {
             Err(e) => self.finish(i, Err(e), observers, out),
             Ok(Some(termination)) => self.finish(i, Ok((t, y, termination)), observers, out),
@@ -935,16 +898,17 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
         out: &mut [Option<Result<Outcome<f64, M>>>],
     ) {
         let Some(j) = self.slots[i].job else { return };
-        let dense = LaneDense::<M>::from_rows(&step.buf, i);
+        let dense = dense_of::<M>(&step.buf, i);
+        let ((t0, t1), (y0, y1)) = (dense.span(), dense.endpoints());
         let view = StepView {
-            t0: dense.t0,
-            t1: dense.t1,
-            y0: dense.y0,
-            y1: dense.y1,
+            t0,
+            t1,
+            y0: *y0,
+            y1: *y1,
             dense: &dense,
         };
         if observers[j].on_step(&view) == Control::Stop {
-            let end = Ok((dense.t1, dense.y1, Termination::ObserverStopped));
+            let end = Ok((t1, *y1, Termination::ObserverStopped));
             self.finish(i, end, observers, out);
         }
     }

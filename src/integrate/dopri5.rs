@@ -71,6 +71,22 @@ pub type Dopri5<T, const N: usize> = Adaptive<T, N, Dopri5Method>;
 /// Dense output of a [`Dopri5`] step.
 pub type Dopri5Dense<T, const N: usize> = MethodDense<T, N, Dopri5Interpolant<T, N>>;
 
+impl<T: Real, const N: usize> Dopri5Dense<T, N> {
+    /// A step's dense output from its parts: the ends, the step `h` and Hairer's
+    /// coefficients `[r2, r3, r4, r5]` (the ensemble builds each lane's step from its rows:
+    /// the same interpolation as the scalar stepper's, to the bit).
+    pub(crate) fn from_parts(
+        ends: HermiteDense<T, N>,
+        h: T,
+        [r2, r3, r4, r5]: [SVector<T, N>; 4],
+    ) -> Self {
+        MethodDense {
+            ends,
+            poly: Dopri5Interpolant { h, r2, r3, r4, r5 },
+        }
+    }
+}
+
 /// The Dormand–Prince 5(4) method (see [`Dopri5`]).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct Dopri5Method;
