@@ -71,7 +71,6 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, E: EventSet<T, N>, D: DenseOutp
     /// The events and observer calls of the step just taken: its crossings in time order
     /// ([`crossings`](Self::crossings)), the sticking check, then the observer's view of
     /// the rest of the step. Returns how the run ends, if it ends here.
-    #[inline]
     pub(crate) fn scan_step<O: Observer<T, N>>(
         &mut self,
         sides: &mut Sides,
