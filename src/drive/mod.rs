@@ -72,7 +72,21 @@ pub struct StepView<'a, T: Real, const N: usize, D> {
     pub dense: &'a D,
 }
 
-impl<T: Real, const N: usize, D: DenseOutput<T, N>> StepView<'_, T, N, D> {
+impl<'a, T: Real, const N: usize, D: DenseOutput<T, N>> StepView<'a, T, N, D> {
+    /// The view of the whole step of `dense` (its span and end states): what a quiet step
+    /// shows, in the driver and in the ensemble's lanes.
+    #[inline(always)]
+    pub(crate) fn whole(dense: &'a D) -> Self {
+        let ((t0, t1), (y0, y1)) = (dense.span(), dense.endpoints());
+        Self {
+            t0,
+            t1,
+            y0: *y0,
+            y1: *y1,
+            dense,
+        }
+    }
+
     /// The interpolated state at `t ∈ [t0, t1]` (ends are returned exactly).
     #[inline(always)]
     pub fn state_at(&self, t: T, out: &mut SVector<T, N>) {

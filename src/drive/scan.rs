@@ -79,17 +79,7 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, E: EventSet<T, N>, D: DenseOutp
         if let Some(positive) = self.quiet(sides) {
             // What the scan below does when it finds nothing: the whole step to the
             // observer, then each event's side to that of the step's end.
-            let dense = self.dense;
-            let (t0, t1) = dense.span();
-            let (y0, y1) = dense.endpoints();
-            let view = StepView {
-                t0,
-                t1,
-                y0: *y0,
-                y1: *y1,
-                dense,
-            };
-            let stop = observer.on_step(&view) == Control::Stop;
+            let stop = observer.on_step(&StepView::whole(self.dense)) == Control::Stop;
             for (i, &p) in positive.iter().enumerate().take(E::LEN) {
                 sides.quiet_step(i, p);
             }

@@ -899,16 +899,9 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
     ) {
         let Some(j) = self.slots[i].job else { return };
         let dense = dense_of::<M>(&step.buf, i);
-        let ((t0, t1), (y0, y1)) = (dense.span(), dense.endpoints());
-        let view = StepView {
-            t0,
-            t1,
-            y0: *y0,
-            y1: *y1,
-            dense: &dense,
-        };
+        let view = StepView::whole(&dense);
         if observers[j].on_step(&view) == Control::Stop {
-            let end = Ok((t1, *y1, Termination::ObserverStopped));
+            let end = Ok((view.t1, view.y1, Termination::ObserverStopped));
             self.finish(i, end, observers, out);
         }
     }
