@@ -21,9 +21,11 @@
 //! non-zero otherwise, for lanes of 4, 8 and 16. It then times the scalar path and the
 //! ensemble in six configurations (lanes of 4, 8 and 16; exact math and the vector math,
 //! `LaneMath::Vector`: `exp` and `ln` — the Hertz law's power, the step-size controller's —
-//! as lane polynomials within 1 ulp instead of the platform's per lane), the best of five turns each in this run, one thread, the instruction
-//! set chosen at run time, and prints `throughput ratio <name> ensemble/scalar: R` for the
-//! fastest configuration.
+//! as lane polynomials within 1 ulp instead of the platform's per lane), the best of five
+//! turns each in this run (a turn repeats a model's runs until the scalar path's turn takes
+//! about a quarter of a second: the bouncing ball's run takes milliseconds), one thread,
+//! the instruction set chosen at run time, and prints
+//! `throughput ratio <name> ensemble/scalar: R` for the fastest configuration.
 
 use std::hint::black_box;
 use std::process::ExitCode;
@@ -142,7 +144,14 @@ where
     ];
     let fresh = || vec![Events::<M>::default(); jobs.len()];
     let mut obs_s = fresh();
+    let t_check = Instant::now();
     let s = scalar(jobs, tol, &events, &mut obs_s);
+    // Each timed turn repeats a short model's runs until the scalar path's turn takes
+    // about a quarter of a second: a turn of a few milliseconds is at the mercy of the
+    // host's scheduler.
+    let reps = (0.25 / t_check.elapsed().as_secs_f64())
+        .ceil()
+        .clamp(1.0, 100.0) as usize;
     let impacts: usize = obs_s.iter().map(|e| e.0.len()).sum();
     let failed = s.iter().filter(|r| r.is_err()).count();
     let mut same = true;
@@ -164,29 +173,35 @@ where
         }
     }
     // Timings: the best of five of each path, in turns (interference on a shared machine
-    // only adds time, and taking turns exposes every path to the same interference).
+    // only adds time, and taking turns exposes every path to the same interference); a
+    // turn is `reps` runs, and a run's time is the turn's over `reps`.
     let mut ts = f64::INFINITY;
     let mut tl = vec![f64::INFINITY; configs.len()];
     for _ in 0..5 {
         let t = Instant::now();
-        black_box(scalar(jobs, tol, &events, &mut fresh()));
-        ts = ts.min(t.elapsed().as_secs_f64());
+        for _ in 0..reps {
+            black_box(scalar(jobs, tol, &events, &mut fresh()));
+        }
+        ts = ts.min(t.elapsed().as_secs_f64() / reps as f64);
         for (c, (_, _, run)) in configs.iter().enumerate() {
-            let mut obs = fresh();
             let t = Instant::now();
-            black_box(run(&mut obs)?);
-            tl[c] = tl[c].min(t.elapsed().as_secs_f64());
+            for _ in 0..reps {
+                let mut obs = fresh();
+                black_box(run(&mut obs)?);
+            }
+            tl[c] = tl[c].min(t.elapsed().as_secs_f64() / reps as f64);
         }
     }
     println!(
-        "{name}: {} trajectories ({failed} ended in an error), {impacts} events; scalar {ts:.3} s",
-        jobs.len()
+        "{name}: {} trajectories ({failed} ended in an error), {impacts} events; scalar {ts:.4} s (best of 5 turns of {reps} run{})",
+        jobs.len(),
+        if reps == 1 { "" } else { "s" }
     );
     let mut best = (0.0f64, "");
     for (c, (cname, bits, _)) in configs.iter().enumerate() {
         let r = ts / tl[c];
         println!(
-            "  lanes {cname:<9} {:.3} s  ratio {r:.2}  {}/{} trajectories equal to the scalar path to the bit{}",
+            "  lanes {cname:<9} {:.4} s  ratio {r:.2}  {}/{} trajectories equal to the scalar path to the bit{}",
             tl[c],
             agree[c],
             jobs.len(),

@@ -761,7 +761,9 @@ impl QuietEnds {
     pub(crate) fn lanes<V: Lanes>((g0, g1): (V, V), (r0, r1): (Option<V>, Option<V>)) -> [V; 3] {
         let z = V::splat(0.0);
         let p = g0 * g1;
-        let mut quiet = p.gt(z) & p.lt(V::splat(f64::INFINITY));
+        // `p ≤ MAX` rather than `p < ∞` (the same lanes): the compiler turned the pair
+        // `0 < p < ∞` into a class test of the bits, evaluated lane by lane in scalar code.
+        let mut quiet = p.gt(z) & p.le(V::splat(f64::MAX));
         let positive = g0.gt(z);
         let Some(r1) = r1 else {
             return [quiet, positive, z];
