@@ -628,6 +628,8 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
         out: &mut [Option<Result<Outcome<f64, M>>>],
     ) {
         let mut step = Box::new(StepOut::new(M));
+        // The events' ends tell which lanes' steps are quiet (quiet_lanes).
+        let want_events = E::LEN > 0;
         while self.st.active.bits() != 0 {
             if self.next >= self.queue.len()
                 && <V::Half as Lanes>::LANES < V::LANES
@@ -636,7 +638,17 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
                 self.compact().drive(observers, out);
                 return;
             }
-            super::kernel::step(&mut self.st, (&self.consts, &self.cfg.events), &mut step);
+            super::kernel::step(&mut self.st, &self.consts, &mut step);
+            step.events = false;
+            if want_events && step.accepted != 0 {
+                let st = &mut *self.st;
+                super::kernel::event_ends::<V, E, M>(
+                    &self.cfg.events,
+                    self.consts.simd(),
+                    (&mut st.ends, st.accepted),
+                    &mut step,
+                );
+            }
             if step.too_small != 0 {
                 for i in lanes_of(step.too_small) {
                     let e = IntegrateError::StepSizeTooSmall {

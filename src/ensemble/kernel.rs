@@ -144,6 +144,11 @@ impl<const M: usize> StepConsts<M> {
             simd: simd.resolve(),
         }
     }
+
+    /// The instruction set of the run (already resolved for this CPU).
+    pub(crate) fn simd(&self) -> Simd {
+        self.simd
+    }
 }
 
 /// The rows of [`StepOut::buf`]: lane `i` of each vector is `buf[row][i]`; a vector
@@ -216,50 +221,45 @@ impl StepOut {
     }
 }
 
-/// One pass of the lane loop in the instruction set `k.simd`: the trial step of every
-/// lane and, where steps were accepted, the events' values and rates at their ends
-/// ([`event_ends`]), in one function compiled for that instruction set.
+/// One pass of the lane loop in the instruction set `k.simd`.
 #[inline(never)]
-pub(crate) fn step<V: Lanes, D: LaneDynamics<M>, E: EventSet<f64, M>, const M: usize>(
+pub(crate) fn step<V: Lanes, D: LaneDynamics<M>, const M: usize>(
     st: &mut LaneState<V, D, M>,
-    (k, events): (&StepConsts<M>, &E),
+    k: &StepConsts<M>,
     out: &mut StepOut,
 ) {
     #[cfg(target_arch = "x86_64")]
     match k.simd {
         Simd::Avx512 => {
             if let Some(v4) = pulp::x86::V4::try_new() {
-                return pulp::Simd::vectorize(v4, Pass { st, k, events, out });
+                return pulp::Simd::vectorize(v4, Pass { st, k, out });
             }
         }
         Simd::Avx2 => {
             if let Some(v3) = pulp::x86::V3::try_new() {
-                return pulp::Simd::vectorize(v3, Pass { st, k, events, out });
+                return pulp::Simd::vectorize(v3, Pass { st, k, out });
             }
         }
         _ => {}
     }
-    body(st, (k, events), out)
+    body(st, k, out)
 }
 
 /// One pass, handed to `pulp` to be compiled with the instruction set's target features.
 #[cfg(target_arch = "x86_64")]
-struct Pass<'a, V: Lanes, D: LaneDynamics<M>, E, const M: usize> {
+struct Pass<'a, V: Lanes, D: LaneDynamics<M>, const M: usize> {
     st: &'a mut LaneState<V, D, M>,
     k: &'a StepConsts<M>,
-    events: &'a E,
     out: &'a mut StepOut,
 }
 
 #[cfg(target_arch = "x86_64")]
-impl<V: Lanes, D: LaneDynamics<M>, E: EventSet<f64, M>, const M: usize> pulp::WithSimd
-    for Pass<'_, V, D, E, M>
-{
+impl<V: Lanes, D: LaneDynamics<M>, const M: usize> pulp::WithSimd for Pass<'_, V, D, M> {
     type Output = ();
 
     #[inline(always)]
     fn with_simd<S: pulp::Simd>(self, _simd: S) {
-        body(self.st, (self.k, self.events), self.out)
+        body(self.st, self.k, self.out)
     }
 }
 
@@ -397,9 +397,9 @@ fn combo<V: Lanes, const M: usize>(k: &[[V; M]; 7], terms: &[(usize, V)], c: usi
 /// [`Dopri5`](crate::integrate::Dopri5) and its controller), the masked update of the
 /// accepted and rejected lanes, and the accepted lanes' step data in `out.buf`.
 #[inline(always)]
-fn body<V: Lanes, D: LaneDynamics<M>, E: EventSet<f64, M>, const M: usize>(
+fn body<V: Lanes, D: LaneDynamics<M>, const M: usize>(
     st: &mut LaneState<V, D, M>,
-    (k, events): (&StepConsts<M>, &E),
+    k: &StepConsts<M>,
     out: &mut StepOut,
 ) {
     let s = V::splat;
@@ -420,7 +420,6 @@ fn body<V: Lanes, D: LaneDynamics<M>, E: EventSet<f64, M>, const M: usize>(
     out.failing = 0;
     out.ends = 0;
     out.near_landing = 0;
-    out.events = false;
     let (t, y, h) = (st.t, st.y, st.h);
     // The trial step, cut to land on the lane's limit (clamp_to_limit).
     let rest = st.limit - t;
@@ -503,26 +502,89 @@ fn body<V: Lanes, D: LaneDynamics<M>, E: EventSet<f64, M>, const M: usize>(
             w.store(&mut out.buf[row::vector(q, M) + c]);
         }
     }
-    if E::LEN > 0 {
-        let ends = [(t, y, k1), (t_new, yn, k7)];
-        event_ends::<V, E, M>(events, (&mut st.ends, accepted), ends, out);
+}
+
+/// Every event's value and rate at both ends of the accepted steps of a pass (from the
+/// rows `T0, T1, X0, X1, F0, F1` of `out`; at the start from `cache` where the lane is not
+/// fresh), from its lane form, and what they say about a quiet step
+/// ([`QuietEnds::lanes`], into `out.quiet`); `out.events` tells whether every event has a
+/// lane form. The accepted lanes' ends become their cached starts. Compiled, like
+/// [`step`], for the instruction set `simd` (and apart from it, so that the step is not
+/// compiled again for each event set).
+#[inline(never)]
+pub(crate) fn event_ends<V: Lanes, E: EventSet<f64, M>, const M: usize>(
+    events: &E,
+    simd: Simd,
+    (cache, accepted): (&mut EndsCache<V>, V),
+    out: &mut StepOut,
+) {
+    #[cfg(target_arch = "x86_64")]
+    match simd {
+        Simd::Avx512 => {
+            if let Some(v4) = pulp::x86::V4::try_new() {
+                let ends = Ends::<V, E, M>::new(events, (cache, accepted), out);
+                return pulp::Simd::vectorize(v4, ends);
+            }
+        }
+        Simd::Avx2 => {
+            if let Some(v3) = pulp::x86::V3::try_new() {
+                let ends = Ends::<V, E, M>::new(events, (cache, accepted), out);
+                return pulp::Simd::vectorize(v3, ends);
+            }
+        }
+        _ => {}
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = simd;
+    ends_body::<V, E, M>(events, (cache, accepted), out)
+}
+
+/// The events' ends, handed to `pulp` like [`Pass`].
+#[cfg(target_arch = "x86_64")]
+struct Ends<'a, V, E, const M: usize> {
+    events: &'a E,
+    cache: &'a mut EndsCache<V>,
+    accepted: V,
+    out: &'a mut StepOut,
+}
+
+#[cfg(target_arch = "x86_64")]
+impl<'a, V, E, const M: usize> Ends<'a, V, E, M> {
+    fn new(
+        events: &'a E,
+        (cache, accepted): (&'a mut EndsCache<V>, V),
+        out: &'a mut StepOut,
+    ) -> Self {
+        Self {
+            events,
+            cache,
+            accepted,
+            out,
+        }
     }
 }
 
-/// Every event's value and rate at both ends `(t, y, ẏ)` of the accepted steps of a pass
-/// (at the start from `cache` where the lane is not fresh), from its lane form, and what
-/// they say about a quiet step ([`QuietEnds::lanes`], into `out.quiet`); `out.events`
-/// tells whether every event has a lane form. The accepted lanes' ends become their
-/// cached starts. Part of the pass ([`step`]): the ends are the step's own values, still
-/// in registers, and one call compiled for the instruction set does both.
+#[cfg(target_arch = "x86_64")]
+impl<V: Lanes, E: EventSet<f64, M>, const M: usize> pulp::WithSimd for Ends<'_, V, E, M> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _simd: S) {
+        ends_body::<V, E, M>(self.events, (self.cache, self.accepted), self.out)
+    }
+}
+
 #[inline(always)]
-fn event_ends<V: Lanes, E: EventSet<f64, M>, const M: usize>(
+fn ends_body<V: Lanes, E: EventSet<f64, M>, const M: usize>(
     events: &E,
     (cache, accepted): (&mut EndsCache<V>, V),
-    [(t0, y0, f0), (t1, y1, f1)]: [(V, [V; M], [V; M]); 2],
     out: &mut StepOut,
 ) {
     out.events = false;
+    let buf = &out.buf;
+    let load = |r: usize| V::load(&buf[r]);
+    let vector = |q: usize| -> [V; M] { core::array::from_fn(|c| load(row::vector(q, M) + c)) };
+    let (t1, y1, f1) = (load(row::T1), vector(row::X1), vector(row::F1));
     let fresh = cache.fresh & accepted;
     let any_fresh = fresh.bits() != 0;
     for e in 0..E::LEN {
@@ -534,6 +596,7 @@ fn event_ends<V: Lanes, E: EventSet<f64, M>, const M: usize>(
         // came and went between points (then only the fresh lanes are evaluated here).
         let mut trust = V::splat(TRUE);
         let (g0, r0) = if any_fresh {
+            let (t0, y0, f0) = (load(row::T0), vector(row::X0), vector(row::F0));
             let Some((g, r)) = events.lanes(e, t0, &y0, &f0) else {
                 return;
             };
