@@ -2,9 +2,10 @@
 //! user's own) run through `ensemble::Ensemble`, each checked against the scalar
 //! `Simulation` + `Dopri5` and timed against it on one thread.
 //!
-//! `cargo run --release --features timing --example ensemble_any [-- --quick] [--only NAME]`
-//! (`--only duffing_ueda`, `two_dof_impact`, `bouncing_ball` or `user_law_fallback`: that
-//! model alone, e.g. under a profiler)
+//! `cargo run --release --features timing --example ensemble_any [-- --quick] [--only NAME]
+//! [--simd avx2]` (`--only duffing_ueda`, `two_dof_impact`, `bouncing_ball` or
+//! `user_law_fallback`: that model alone, e.g. under a profiler; `--simd baseline|avx2|avx512`
+//! caps the run-time dispatch, so an AVX-512 host measures the AVX2 code too)
 //!
 //! * (a) the Duffing–Ueda oscillator (`systems::DuffingUeda`), 64 forcing amplitudes;
 //! * (b) the 2-DOF impact system of the catalogue (`systems::TwoDofImpact`, state of
@@ -33,7 +34,7 @@ use std::time::Instant;
 
 use nalgebra::SVector;
 use nonsmooth::drive::{Control, EventRecord, Observer, Outcome, RunError, Simulation};
-use nonsmooth::ensemble::{Ensemble, F64x4, F64x8, F64x16, LaneMath, MemberRun};
+use nonsmooth::ensemble::{Ensemble, F64x4, F64x8, F64x16, LaneMath, MemberRun, Simd};
 use nonsmooth::event::{Direction, Event, EventSet};
 use nonsmooth::excite::Harmonic;
 use nonsmooth::force::ViscousDamper;
@@ -100,12 +101,15 @@ fn compare<D, E, const M: usize>(
     jobs: &[MemberRun<D, M>],
     tol: Tolerances<f64, M>,
     events: E,
+    simd: Simd,
 ) -> nonsmooth::Result<bool>
 where
     D: LaneDynamics<M>,
     E: EventSet<f64, M> + Clone,
 {
-    let exact = Ensemble::new(tol)?.with_events(events.clone())?;
+    let exact = Ensemble::new(tol)?
+        .with_simd(simd)
+        .with_events(events.clone())?;
     let vector = exact.clone().with_math(LaneMath::Vector);
     type Run<'a, const M: usize> = Box<
         dyn Fn(&mut [Events<M>]) -> Result<Vec<Result<Outcome<f64, M>, RunError>>, RunError> + 'a,
@@ -263,6 +267,21 @@ fn run() -> nonsmooth::Result<bool> {
         eprintln!("ensemble_any: --only takes one of {names:?}, not {o:?}");
         return Ok(false);
     }
+    let simd = match args
+        .iter()
+        .position(|a| a == "--simd")
+        .map(|k| args.get(k + 1).map_or("", String::as_str))
+    {
+        None => Simd::Auto,
+        Some("baseline") => Simd::Baseline,
+        Some("avx2") => Simd::Avx2,
+        Some("avx512") => Simd::Avx512,
+        Some(o) => {
+            eprintln!("ensemble_any: --simd takes baseline, avx2 or avx512, not {o:?}");
+            return Ok(false);
+        }
+    };
+    println!("instruction set: {:?}", simd.resolve());
     let runs = |name: &str| only.is_none_or(|o| o == name);
     let n = 64;
     let periods = if quick { 10.0 } else { 200.0 };
@@ -285,7 +304,7 @@ fn run() -> nonsmooth::Result<bool> {
                 )?)
             })
             .collect::<nonsmooth::Result<Vec<_>>>()?;
-        ok &= compare(names[0], &jobs, tol, ())?;
+        ok &= compare(names[0], &jobs, tol, (), simd)?;
     }
 
     // (b) The 2-DOF impact system, ω from 0.3 to 1.3, its stop as a detection event.
@@ -304,7 +323,7 @@ fn run() -> nonsmooth::Result<bool> {
             })
             .collect::<nonsmooth::Result<Vec<_>>>()?;
         let stop = Event::new(p.stop::<f64>()?, Direction::Rising);
-        ok &= compare(names[1], &jobs, tol, stop)?;
+        ok &= compare(names[1], &jobs, tol, stop, simd)?;
     }
 
     // (c) The bouncing ball, Γ from 2.5 to 4 at e = 0.8: restitution on the moving table.
@@ -332,7 +351,7 @@ fn run() -> nonsmooth::Result<bool> {
             .collect::<nonsmooth::Result<Vec<_>>>()?;
         let impact =
             Event::new(base.table::<f64>()?, Direction::Rising).with_reset(base.impact::<f64>()?);
-        ok &= compare(names[2], &jobs, tol, impact)?;
+        ok &= compare(names[2], &jobs, tol, impact, simd)?;
     }
 
     // (d) A law of one's own: the fallback evaluates the right-hand side lane by lane.
@@ -354,7 +373,7 @@ fn run() -> nonsmooth::Result<bool> {
                 )?)
             })
             .collect::<nonsmooth::Result<Vec<_>>>()?;
-        ok &= compare(names[3], &jobs, tol, ())?;
+        ok &= compare(names[3], &jobs, tol, (), simd)?;
     }
     Ok(ok)
 }
