@@ -42,6 +42,9 @@ pub enum Side {
 /// equal to the exact term for `|δ̇| ≫ η` and linear with slope `η^{n3−1}` inside `|δ̇| ≲ η`.
 /// With `η = 0` (the default) the law is exact.
 ///
+/// With `n3 = 1` (damping linear in the rate, as in Hunt and Crossley's model) the term is
+/// `δ̇` itself, evaluated without a power.
+///
 /// # References
 /// The impact force `F_I` of the impact oscillator of
 /// [`systems::paper`](crate::systems::paper) (its eq. (1); its parameters are there).
@@ -206,10 +209,15 @@ impl<T: Real> HertzContact<T> {
                 T::zero(),
                 if self.n3 < T::one() {
                     T::max_value().unwrap_or(T::zero())
+                } else if self.n3 == T::one() {
+                    T::one()
                 } else {
                     T::zero()
                 },
             )
+        } else if self.n3 == T::one() {
+            // Linear in the rate (Hunt–Crossley): `g = w` exactly, without `exp(ln|w|)`.
+            (w, T::one())
         } else {
             let a = w.abs();
             let m = (self.n3 * a.ln()).exp();
@@ -378,6 +386,7 @@ pub struct HertzLanes<V> {
     n2: ExponentLanes<V>,
     n2_is_n1: V,
     n3: V,
+    n3_one: V,
     half_n3m1: V,
     eta2: V,
     eta_pos: V,
@@ -397,6 +406,7 @@ impl super::LaneLaw for HertzContact<f64> {
             n2: ExponentLanes::zero(),
             n2_is_n1: z,
             n3: z,
+            n3_one: z,
             half_n3m1: z,
             eta2: z,
             eta_pos: z,
@@ -416,6 +426,7 @@ impl super::LaneLaw for HertzContact<f64> {
         p.n2.set(i, self.n2);
         p.n2_is_n1 = p.n2_is_n1.with_lane(i, mask(self.n1 == self.n2));
         p.n3 = p.n3.with_lane(i, self.n3);
+        p.n3_one = p.n3_one.with_lane(i, mask(self.n3 == 1.0));
         p.half_n3m1 = p.half_n3m1.with_lane(i, self.half_n3_minus_1);
         p.eta2 = p.eta2.with_lane(i, self.eta * self.eta);
         p.eta_pos = p.eta_pos.with_lane(i, mask(self.eta > 0.0));
@@ -447,8 +458,15 @@ impl super::LaneLaw for HertzContact<f64> {
         let g = if exact.bits() == 0 {
             g_reg
         } else {
-            let m = pow_masked(math, exact, w.abs(), p.n3);
-            let g_ex = w.gt(z).select(m, -m);
+            // `n3 = 1`: `g = w` (the scalar law's fast path); the power only where some
+            // lane has another exponent.
+            let general = exact & !p.n3_one;
+            let g_ex = if general.bits() == 0 {
+                w
+            } else {
+                let m = pow_masked(math, general, w.abs(), p.n3);
+                p.n3_one.select(w, w.gt(z).select(m, -m))
+            };
             exact.select(g_ex, p.eta_pos.select(g_reg, z))
         };
         let f = p.b_zero.select(p1, p1 + p.b * p2 * g);
@@ -513,6 +531,25 @@ mod tests {
         let (_, dv) = reg.partials(x, 0.0);
         let expect = 2.3983e8 * 0.8485 * 4e-6_f64.powf(1.5) * 1e-7_f64.powf(0.18667 - 1.0);
         assert!((dv - expect).abs() < 1e-9 * expect);
+    }
+
+    #[test]
+    fn linear_rate_term_is_the_rate_itself() {
+        // n3 = 1 (Hunt–Crossley): F = k·(δ^{3/2} + b·δ^{3/2}·δ̇), the rate taken as it is.
+        let c = HertzContact::new(0.0, 2.0)
+            .unwrap()
+            .with_damping(0.5, 1.5, 1.0)
+            .unwrap();
+        let (d, v) = (0.01_f64, -0.3_f64);
+        let p = d * d.sqrt();
+        assert_eq!(c.force(d, v), 2.0 * (p + 0.5 * p * v));
+        // ∂F/∂v = k·b·δ^{3/2}, also at v = 0 (the slope of a linear term).
+        for v in [0.0, 0.2] {
+            assert_eq!(c.partials(d, v).1, 2.0 * (0.5 * p * 1.0));
+        }
+        // Below the stop the same law pulls the other way.
+        let lower = c.with_side(Side::Lower);
+        assert_eq!(lower.force(-d, -v), -2.0 * (p + 0.5 * p * v));
     }
 
     #[test]
