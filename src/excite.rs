@@ -102,6 +102,19 @@ pub trait Excitation<T: Real> {
         false
     }
 
+    /// Bounds on `[t0, t1]`, if known: `(d, a)` with `|f(t) − ℓ(t)| ≤ d`, where `ℓ` is the
+    /// chord between `f(t0)` and `f(t1)`, and `a` the scale of the rounding of `f`'s
+    /// computed values (`|f(t)| ≤ a`, and for `A·sin(ωt + φ)` also `|A|·|ωt + φ|`: the
+    /// rounding of the phase; the rounding allowance is relative to it). The event search uses them
+    /// for a surface that moves as this excitation ([`Gap`](crate::event::Gap)) to rule
+    /// out a crossing inside a step without searching it (a bound that holds only
+    /// approximately would let a crossing be missed). For `|f̈| ≤ K` on the interval,
+    /// `d = K·(t1 − t0)²/8`. Default `None`; implemented by `()`, [`Constant`],
+    /// [`Harmonic`] and [`UnbalancedRotor`].
+    fn chord_bounds(&self, _t0: T, _t1: T) -> Option<(T, T)> {
+        None
+    }
+
     /// The force and its rate `(f(t), ḟ(t))` at `L` times at once, one per lane, if the
     /// excitation has a lane form (`None`, the default, if not). Each lane must be
     /// [`force`](Excitation::force) and [`force_rate`](Excitation::force_rate) at that
@@ -165,6 +178,9 @@ impl<T: Real, E: Excitation<T> + ?Sized> Excitation<T> for &E {
     fn constant_time_scale(&self) -> bool {
         (**self).constant_time_scale()
     }
+    fn chord_bounds(&self, t0: T, t1: T) -> Option<(T, T)> {
+        (**self).chord_bounds(t0, t1)
+    }
 }
 
 /// No forcing.
@@ -186,6 +202,9 @@ impl<T: Real> Excitation<T> for () {
     }
     fn force_acceleration(&self, _t: T) -> T {
         T::zero()
+    }
+    fn chord_bounds(&self, _t0: T, _t1: T) -> Option<(T, T)> {
+        Some((T::zero(), T::zero()))
     }
 }
 
@@ -238,6 +257,9 @@ impl<T: Real> Excitation<T> for Constant<T> {
     }
     fn force_acceleration(&self, _t: T) -> T {
         T::zero()
+    }
+    fn chord_bounds(&self, _t0: T, _t1: T) -> Option<(T, T)> {
+        Some((T::zero(), self.value.abs()))
     }
 }
 
@@ -366,6 +388,15 @@ impl<T: Real> Excitation<T> for Harmonic<T> {
     fn constant_time_scale(&self) -> bool {
         true
     }
+    /// `|F0|·ω²·(t1 − t0)²/8` (`|f̈| ≤ |F0|·ω²`) and `|F0|·(1 + |ω|·max|t| + |φ0|)`.
+    fn chord_bounds(&self, t0: T, t1: T) -> Option<(T, T)> {
+        let (a, h) = (self.amplitude.abs(), t1 - t0);
+        let phase = self.omega.abs() * t0.abs().max(t1.abs()) + self.phase0.abs();
+        Some((
+            a * self.omega * self.omega * h * h / lit(8.0),
+            a * (T::one() + phase),
+        ))
+    }
 }
 
 /// An unbalanced rotor at constant speed: `m0·e·ω²·sin(ωt)` (the paper's forcing).
@@ -467,6 +498,15 @@ impl<T: Real> Excitation<T> for UnbalancedRotor<T> {
     }
     fn constant_time_scale(&self) -> bool {
         true
+    }
+    /// `|m0·e·ω²|·ω²·(t1 − t0)²/8` and `|m0·e·ω²|·(1 + |ω|·max|t|)`.
+    fn chord_bounds(&self, t0: T, t1: T) -> Option<(T, T)> {
+        let (a, h) = (self.amp.abs(), t1 - t0);
+        let phase = self.omega.abs() * t0.abs().max(t1.abs());
+        Some((
+            a * self.omega * self.omega * h * h / lit(8.0),
+            a * (T::one() + phase),
+        ))
     }
 }
 

@@ -267,3 +267,76 @@ fn impacts_on_a_moving_surface_of_a_two_dof_system() {
     assert!((surface.gap(1.0, &y) - (0.7 - 0.5 - 0.1 * 3.0f64.sin())).abs() < 1e-15);
     assert!((surface.gap_rate(1.0, &y) - (0.2 - 0.3 * 3.0f64.cos())).abs() < 1e-15);
 }
+
+/// A moving table without its chord bounds: the same function, every grazing pair searched.
+struct Unbounded<G>(G);
+impl<G: nonsmooth::event::EventFunction<f64, 2>> nonsmooth::event::EventFunction<f64, 2>
+    for Unbounded<G>
+{
+    fn value(&self, t: f64, y: &SVector<f64, 2>) -> f64 {
+        self.0.value(t, y)
+    }
+    fn rate(&self, t: f64, y: &SVector<f64, 2>, dy: &SVector<f64, 2>) -> Option<f64> {
+        self.0.rate(t, y, dy)
+    }
+    fn time_scale(&self, t: f64) -> Option<f64> {
+        self.0.time_scale(t)
+    }
+}
+
+#[test]
+fn chord_bounds_change_no_result() {
+    // The bouncing ball on a vibrating table (period-one, period-two and chaotic bouncing,
+    // chattering included): with the table's chord bounds the grazing pairs farther from
+    // the table than the bounds are not searched; every impact and the end state must be
+    // those of the search without them, to the bit.
+    use nonsmooth::systems::BouncingBallTable;
+    let (mut impacts, mut finished) = (0, 0);
+    for gamma in [1.5, 2.5, 3.2, 3.9] {
+        let ball = BouncingBallTable::with_gamma(gamma, 0.8).unwrap();
+        let y0 = Vector2::new(0.0, ball.table_motion(0.0).1 + 2.0);
+        let t_end = 60.0 * ball.period();
+        let impact = ball.impact::<f64>().unwrap();
+        let run = |with: &mut Events, bounded: bool| {
+            let tol = Tolerances::new(1e-10, 1e-12).unwrap();
+            let table = ball.table::<f64>().unwrap();
+            let out = if bounded {
+                Simulation::new(ball.model::<f64>().unwrap(), Dopri5::new(tol))
+                    .with_events(Event::new(table, Direction::Rising).with_reset(impact))
+                    .run(0.0, y0, t_end, with)
+            } else {
+                Simulation::new(ball.model::<f64>().unwrap(), Dopri5::new(tol))
+                    .with_events(Event::new(Unbounded(table), Direction::Rising).with_reset(impact))
+                    .run(0.0, y0, t_end, with)
+            };
+            out.map(|o| (o.t.to_bits(), o.y.map(f64::to_bits), o.stats.rhs_evals))
+                .map_err(|e| e.to_string())
+        };
+        let (mut a, mut b) = (Events::default(), Events::default());
+        let ra = run(&mut a, true);
+        let rb = run(&mut b, false);
+        assert_eq!(ra, rb, "Γ = {gamma}");
+        finished += usize::from(ra.is_ok());
+        assert_eq!(a.0.len(), b.0.len(), "Γ = {gamma}");
+        for (x, y) in a.0.iter().zip(&b.0) {
+            assert_eq!(
+                (
+                    x.t.to_bits(),
+                    x.y.map(f64::to_bits),
+                    x.y_after.map(|v| v.map(f64::to_bits))
+                ),
+                (
+                    y.t.to_bits(),
+                    y.y.map(f64::to_bits),
+                    y.y_after.map(|v| v.map(f64::to_bits))
+                ),
+                "Γ = {gamma}"
+            );
+        }
+        impacts += a.0.len();
+    }
+    assert!(
+        impacts > 100 && finished >= 2,
+        "{impacts} impacts, {finished} runs finished"
+    );
+}

@@ -494,7 +494,23 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, E: EventSet<T, N>, D: DenseOutp
                 ev.rate(i, t_lo, &y, &f)
             })
         };
-        crossing_between(g_at, rate_lo, tol, t_lo, g_lo, t1, g1, r1)
+        // A grazing pair that cannot reach the surface: both ends farther from it than
+        // the function can stray from its chord on the step (from the start of the step
+        // only: a chord from a point inside it is not the one bounded).
+        let out_of_reach = || {
+            let (t0, t_end) = dense.span();
+            if t_lo != t0 || t1 != t_end {
+                return false;
+            }
+            let Some((dev, mag)) = dense.chord_bounds() else {
+                return false;
+            };
+            let Some((d, a)) = ev.chord_bounds(i, t0, t1, &dev, &mag) else {
+                return false;
+            };
+            clear_of_chord(g_lo, g1, d, a)
+        };
+        crossing_between(g_at, rate_lo, out_of_reach, tol, t_lo, g_lo, t1, g1, r1)
     }
 }
 
@@ -504,12 +520,14 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, E: EventSet<T, N>, D: DenseOutp
 /// `g1 = 0`), a grazing pair when the rates show an interior extremum that reaches the
 /// other side (`rate_lo`, the rate at `t_lo`, is evaluated only then): the extremum by
 /// golden-section search, the crossing before it, and the extremum as where the scan
-/// resumes.
+/// resumes; the search is skipped where `out_of_reach` shows that no point of the step
+/// reaches the surface (the search would find none: the same result).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn crossing_between<T: Real>(
     g_at: impl Fn(T) -> T + Copy,
     rate_lo: impl FnOnce() -> Option<T>,
+    out_of_reach: impl FnOnce() -> bool,
     tol: T,
     t_lo: T,
     g_lo: T,
@@ -539,7 +557,7 @@ fn crossing_between<T: Real>(
     } else {
         r1 < T::zero()
     };
-    if !(towards && (away || g1 == T::zero())) {
+    if !(towards && (away || g1 == T::zero())) || out_of_reach() {
         return None;
     }
     let sg = if s > 0 { T::one() } else { -T::one() };
@@ -554,6 +572,21 @@ fn crossing_between<T: Real>(
         rising: ge > T::zero(),
         resume: Some((te, ge)),
     })
+}
+
+/// Whether `g` keeps the side of `g0` on the whole step, given the chord bounds `(d, a)`
+/// of its values `g0`, `g1` at the ends ([`EventFunction::chord_bounds`]): both ends on
+/// one side, farther from 0 than `d` and a rounding allowance (`10⁻¹²·a` plus `10⁻⁹·d`,
+/// thousands of times the rounding of the values computed on the dense output), so that
+/// every value computed inside keeps the sign.
+///
+/// [`EventFunction::chord_bounds`]: crate::event::EventFunction::chord_bounds
+#[inline(always)]
+fn clear_of_chord<T: Real>(g0: T, g1: T, d: T, a: T) -> bool {
+    let need = d + lit::<T>(1e-9) * d + lit::<T>(1e-12) * a;
+    let s = if g0 > T::zero() { T::one() } else { -T::one() };
+    // False for NaN bounds (every comparison with NaN is).
+    need.is_finite() && s * g0 > need && s * g1 > need
 }
 
 fn non_finite<T: Real>(index: usize, t: T, g: T) -> RunError {
@@ -846,9 +879,73 @@ pub(crate) fn sign_of<T: Real>(x: T) -> i8 {
 
 #[cfg(test)]
 mod tests {
-    use super::{LaneSides, QuietEnds, Sides};
-    use crate::event::{Direction, Event, EventSet, Level, MAX_EVENTS, Restitution};
+    use super::{LaneSides, QuietEnds, Sides, clear_of_chord};
+    use crate::event::{
+        Direction, Event, EventFunction, EventSet, Gap, Level, MAX_EVENTS, Restitution,
+    };
+    use crate::excite::Harmonic;
+    use crate::integrate::{DenseOutput, Dopri5, Stepper, Tolerances};
     use crate::lanes::{F64x4, Lanes};
+    use crate::model::Coordinate;
+    use crate::testing::HarmonicOscillator;
+    use nalgebra::SVector;
+
+    /// Where the chord bounds rule a step out, every value of the event function on the
+    /// step's dense output keeps the ends' side (2 001 points a step), and the function
+    /// stays within `d` of its chord: an oscillator of period 2π against a surface that
+    /// moves with amplitude 0.3 at ω = 3, over 400 steps of `Dopri5` at a loose tolerance
+    /// (long steps, large deviations) and a tight one. Grazing pairs must be among the
+    /// steps ruled out, and crossings among those not.
+    #[test]
+    fn chord_bounds_rule_out_only_steps_that_stay_clear() {
+        let sys = HarmonicOscillator::new(1.0).unwrap();
+        let surface = Harmonic::new(0.3, 3.0, 0.5).unwrap();
+        let gap = Gap::above(Coordinate::<f64, 1>::dof(0).unwrap(), surface);
+        for rtol in [1e-3, 1e-9] {
+            let tol = Tolerances::new(rtol, rtol * 1e-2).unwrap();
+            let mut st = Dopri5::new(tol);
+            st.reset_state(0.0, SVector::from([1.0, 0.0]));
+            let (mut ruled_out, mut grazing, mut kept_crossings) = (0, 0, 0);
+            for _ in 0..400 {
+                st.step(&sys, f64::INFINITY).unwrap();
+                let d = st.dense();
+                let (t0, t1) = d.span();
+                let (y0, y1) = d.endpoints();
+                let (f0, f1) = d.end_derivatives();
+                let g0 = EventFunction::<f64, 2>::value(&gap, t0, y0);
+                let g1 = EventFunction::<f64, 2>::value(&gap, t1, y1);
+                let (dev, mag) = d.chord_bounds().unwrap();
+                let (dg, a) = gap.chord_bounds(t0, t1, &dev, &mag).unwrap();
+                let values: Vec<(f64, f64)> = (0..=2000)
+                    .map(|k| {
+                        let t = t0 + (t1 - t0) * k as f64 / 2000.0;
+                        let mut y = SVector::zeros();
+                        d.interpolate_unchecked(t, &mut y);
+                        (t, EventFunction::<f64, 2>::value(&gap, t, &y))
+                    })
+                    .collect();
+                let crosses = values.iter().any(|&(_, g)| g * g0 <= 0.0);
+                if clear_of_chord(g0, g1, dg, a) {
+                    ruled_out += 1;
+                    assert!(!crosses, "a step ruled out holds a crossing: [{t0}, {t1}]");
+                    let r0 = gap.rate(t0, y0, f0).unwrap();
+                    let r1 = gap.rate(t1, y1, f1).unwrap();
+                    if r0 * g0 < 0.0 && r1 * g0 > 0.0 {
+                        grazing += 1;
+                    }
+                } else if crosses {
+                    kept_crossings += 1;
+                }
+                for &(t, g) in &values {
+                    let chord = g0 + (g1 - g0) * (t - t0) / (t1 - t0);
+                    assert!((g - chord).abs() <= dg * (1.0 + 1e-9) + 1e-12 * a);
+                }
+            }
+            assert!(ruled_out > 100, "rtol {rtol}: {ruled_out} steps ruled out");
+            assert!(grazing > 0, "rtol {rtol}: no grazing pair ruled out");
+            assert!(kept_crossings > 0, "rtol {rtol}: no crossing in 400 steps");
+        }
+    }
 
     /// `LaneSides::quiet` and `quiet_step` are `Sides::is_quiet_with` and `quiet_step` lane
     /// for lane: every side (unknown, −, +), arming, ends' answer and event (with and

@@ -48,6 +48,34 @@ pub trait EventFunction<T: Real, const N: usize> {
         false
     }
 
+    /// Bounds on `g` along a step's dense output `y(t)` on `[t0, t1]`, if the function can
+    /// give them: `(d, a)` with `|g(t, y(t)) − ℓ(t)| ≤ d`, where `ℓ` is the chord between
+    /// `g` at the step's ends, and `a` a bound on the magnitudes of the terms `g` is
+    /// computed from (the rounding allowance is relative to it). `dev[k]` bounds
+    /// `|y_k(t) − ℓ_k(t)|` (the chord of component `k`) and `mag[k]` the magnitudes of the
+    /// terms of `y_k(t)` on the step
+    /// ([`DenseOutput::chord_bounds`](crate::integrate::DenseOutput::chord_bounds)).
+    ///
+    /// The driver uses them where the rates at a step's ends show a grazing pair (both
+    /// ends on one side, moving towards the surface and then away from it): when both
+    /// ends are farther from the surface than `d` plus the allowance, no point of the step
+    /// reaches it, and the search for the extremum is skipped; the result is the one the
+    /// search would have given. A bound that holds only approximately would let a
+    /// crossing be missed. For `g` affine in `y`, `g = w·y + c + s(t)`, it is
+    /// `d = Σ|w_k|·dev_k + d_s` with `d_s` the surface's own chord deviation. Default
+    /// `None` (the search always runs); implemented by [`Level`](super::Level),
+    /// [`Stop`](super::Stop) and [`Gap`](super::Gap) (as its motion's
+    /// [`Excitation::chord_bounds`](crate::excite::Excitation::chord_bounds)).
+    fn chord_bounds(
+        &self,
+        _t0: T,
+        _t1: T,
+        _dev: &SVector<T, N>,
+        _mag: &SVector<T, N>,
+    ) -> Option<(T, T)> {
+        None
+    }
+
     /// Checks that the function can be evaluated on states of dimension `N` (e.g. that a
     /// component index is in range); the driver calls it before a run starts. Default: `Ok`.
     ///

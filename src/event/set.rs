@@ -152,6 +152,17 @@ pub trait EventSet<T: Real, const N: usize> {
     fn constant_max_step(&self) -> bool {
         false
     }
+    /// Event `i`'s [`EventFunction::chord_bounds`].
+    fn chord_bounds(
+        &self,
+        _i: usize,
+        _t0: T,
+        _t1: T,
+        _dev: &SVector<T, N>,
+        _mag: &SVector<T, N>,
+    ) -> Option<(T, T)> {
+        None
+    }
     /// Event `i`'s value and rate at `L` points at once, one per lane (its function's
     /// [`EventFunction::lanes`]), or `None` if its function has no lane form.
     #[inline(always)]
@@ -243,6 +254,16 @@ impl<T: Real, const N: usize, G: EventFunction<T, N>, R: ResetMap<T, N>> EventSe
     fn constant_max_step(&self) -> bool {
         self.function.constant_time_scale()
     }
+    fn chord_bounds(
+        &self,
+        _i: usize,
+        t0: T,
+        t1: T,
+        dev: &SVector<T, N>,
+        mag: &SVector<T, N>,
+    ) -> Option<(T, T)> {
+        self.function.chord_bounds(t0, t1, dev, mag)
+    }
     #[inline(always)]
     fn lanes<V: Lanes>(&self, _i: usize, t: V, y: &[V; N], dy: &[V; N]) -> Option<(V, Option<V>)> {
         self.function.lanes(t, y, dy)
@@ -299,6 +320,16 @@ macro_rules! event_tuple {
             fn check(&self) -> Result<(), EventError> {
                 $(self.$idx.check()?;)+
                 Ok(())
+            }
+            fn chord_bounds(
+                &self,
+                i: usize,
+                t0: T,
+                t1: T,
+                dev: &SVector<T, N>,
+                mag: &SVector<T, N>,
+            ) -> Option<(T, T)> {
+                dispatch!(self, i, None, |m, j| m.chord_bounds(j, t0, t1, dev, mag); $($name $idx),+)
             }
             #[inline(always)]
             fn lanes<V: Lanes>(

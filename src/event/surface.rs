@@ -68,6 +68,15 @@ impl<T: Real, const N: usize> EventFunction<T, N> for Level<T> {
     fn check(&self) -> Result<(), EventError> {
         check_index(self.index, N)
     }
+    fn chord_bounds(
+        &self,
+        _t0: T,
+        _t1: T,
+        dev: &SVector<T, N>,
+        mag: &SVector<T, N>,
+    ) -> Option<(T, T)> {
+        component_bounds(self.index, self.level, dev, mag)
+    }
     #[inline(always)]
     fn lanes<V: Lanes>(&self, _t: V, y: &[V; N], dy: &[V; N]) -> Option<(V, Option<V>)> {
         component_lanes::<T, V, N>(self.index, self.level, y, dy)
@@ -111,6 +120,15 @@ impl<T: Real, const N: usize> EventFunction<T, N> for Stop<T> {
     fn lanes<V: Lanes>(&self, _t: V, y: &[V; N], dy: &[V; N]) -> Option<(V, Option<V>)> {
         component_lanes::<T, V, N>(self.position, self.level, y, dy)
     }
+    fn chord_bounds(
+        &self,
+        _t0: T,
+        _t1: T,
+        dev: &SVector<T, N>,
+        mag: &SVector<T, N>,
+    ) -> Option<(T, T)> {
+        component_bounds(self.position, self.level, dev, mag)
+    }
     fn check(&self) -> Result<(), EventError> {
         check_index(self.position, N)?;
         check_index(self.velocity, N)?;
@@ -144,6 +162,17 @@ fn component_lanes<T: Real, V: Lanes, const N: usize>(
         *y.get(index)? - V::splat(to_f64(level)),
         Some(*dy.get(index)?),
     ))
+}
+
+/// [`EventFunction::chord_bounds`] of `g = y[index] − level`: component `index`'s bounds
+/// (`None` for an index outside the state).
+fn component_bounds<T: Real, const N: usize>(
+    index: usize,
+    level: T,
+    dev: &SVector<T, N>,
+    mag: &SVector<T, N>,
+) -> Option<(T, T)> {
+    Some((*dev.get(index)?, *mag.get(index)? + level.abs()))
 }
 
 /// A contact surface of an `N`-DOF mechanical system with state `y = (q, q̇)` (dimension
@@ -243,6 +272,25 @@ impl<T: Real, const N: usize, const M: usize, S: crate::excite::Excitation<T>> E
     }
     fn constant_time_scale(&self) -> bool {
         self.motion.constant_time_scale()
+    }
+    /// `Σ|w_k|·dev_k` over the positions plus the motion's
+    /// [`chord_bounds`](crate::excite::Excitation::chord_bounds) (`None` without them).
+    fn chord_bounds(
+        &self,
+        t0: T,
+        t1: T,
+        dev: &SVector<T, M>,
+        mag: &SVector<T, M>,
+    ) -> Option<(T, T)> {
+        if M != 2 * N {
+            return None;
+        }
+        let (ds, s) = self.motion.chord_bounds(t0, t1)?;
+        let c = &self.coordinate;
+        Some((
+            c.weighted_bound(&dev.as_slice()[..N]) + ds,
+            c.weighted_bound(&mag.as_slice()[..N]) + c.offset().abs() + s,
+        ))
     }
     #[inline(always)]
     fn lanes<V: Lanes>(&self, t: V, y: &[V; M], _dy: &[V; M]) -> Option<(V, Option<V>)> {

@@ -68,6 +68,12 @@ pub trait Interpolant<T: Real, const N: usize>:
     /// Writes `y(t)` into `out` from the step's ends `ends`.
     #[doc(hidden)]
     fn eval(&self, ends: &HermiteDense<T, N>, t: T, out: &mut SVector<T, N>);
+
+    /// [`DenseOutput::chord_bounds`] of the interpolant (default `None`).
+    #[doc(hidden)]
+    fn chord_bounds(&self, _ends: &HermiteDense<T, N>) -> Option<(SVector<T, N>, SVector<T, N>)> {
+        None
+    }
 }
 
 /// The dense output of one step of an [`Adaptive`] method: the step's ends (states and
@@ -107,6 +113,10 @@ impl<T: Real, const N: usize, P: Interpolant<T, N>> DenseOutput<T, N> for Method
     #[inline(always)]
     fn interpolate_unchecked(&self, t: T, out: &mut SVector<T, N>) {
         self.poly.eval(&self.ends, t, out)
+    }
+
+    fn chord_bounds(&self) -> Option<(SVector<T, N>, SVector<T, N>)> {
+        self.poly.chord_bounds(&self.ends)
     }
 }
 

@@ -127,6 +127,21 @@ impl<T: Real, const N: usize> Interpolant<T, N> for Dopri5Interpolant<T, N> {
                 + th * (self.r2[i] + th1 * (self.r3[i] + th * (self.r4[i] + th1 * self.r5[i])));
         }
     }
+
+    /// With `u = θ`, `v = 1 − θ` the interpolant less its chord `y0 + θ·r2` is
+    /// `uv·r3 + u²v·r4 + u²v²·r5`, and on `[0, 1]` `uv ≤ 1/4`, `u²v ≤ 4/27 < 0.15`,
+    /// `u²v² ≤ 1/16`: `dev = |r3|/4 + 0.15·|r4| + |r5|/16`; `mag = |y0| + Σ|r_j|`.
+    fn chord_bounds(&self, ends: &HermiteDense<T, N>) -> Option<(SVector<T, N>, SVector<T, N>)> {
+        let (q, e, s) = (lit::<T>(0.25), lit::<T>(0.15), lit::<T>(0.0625));
+        let mut dev = SVector::zeros();
+        let mut mag = SVector::zeros();
+        for i in 0..N {
+            let (a3, a4, a5) = (self.r3[i].abs(), self.r4[i].abs(), self.r5[i].abs());
+            dev[i] = q * a3 + e * a4 + s * a5;
+            mag[i] = ends.y0[i].abs() + self.r2[i].abs() + a3 + a4 + a5;
+        }
+        Some((dev, mag))
+    }
 }
 
 impl<T: Real, const N: usize> Method<T, N> for Dopri5Method {

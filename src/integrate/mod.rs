@@ -416,6 +416,18 @@ pub trait DenseOutput<T: Real, const N: usize> {
     /// `t ∈ [t0, t1]`; outside it the polynomial is extrapolated).
     fn interpolate_unchecked(&self, t: T, out: &mut SVector<T, N>);
 
+    /// Bounds on the interpolant, if known: `(dev, mag)` with
+    /// `|y_k(t) − ℓ_k(t)| ≤ dev_k` on the step, where `ℓ_k` is the chord between the ends'
+    /// `y_k` (the interpolant's own values there), and `mag_k` a bound on the magnitudes of
+    /// the terms `y_k(t)` is summed from (for a rounding allowance). The event search
+    /// turns them into bounds on an event function
+    /// ([`EventFunction::chord_bounds`](crate::event::EventFunction::chord_bounds)) to
+    /// rule out a crossing without searching the step. Default `None`; given by
+    /// [`Dopri5`](super::Dopri5)'s interpolant.
+    fn chord_bounds(&self) -> Option<(SVector<T, N>, SVector<T, N>)> {
+        None
+    }
+
     /// Writes `y(t)` into `out`.
     ///
     /// # Errors

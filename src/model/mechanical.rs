@@ -229,6 +229,14 @@ impl<T: Real, const N: usize> Coordinate<T, N> {
         self.offset
     }
 
+    /// `Σ |w_k|·x_k` (with bounds `x_k ≥ 0` on the components: a bound on `|w·x|`).
+    pub(crate) fn weighted_bound(&self, x: &[T]) -> T {
+        self.weights
+            .iter()
+            .zip(x)
+            .fold(T::zero(), |acc, (w, v)| acc + w.abs() * *v)
+    }
+
     /// `g(q)`: `o + Σ w_k q_k` summed in index order.
     #[inline(always)]
     pub fn value(&self, q: &[T]) -> T {
