@@ -90,6 +90,29 @@ proptest! {
         check_law(&laws, &xs, &vs, LaneMath::Exact);
     }
 
+    /// Every lane a damped Hertz stop above with `n1 = n2 = 3/2` and no regularization
+    /// (the lane form's own path for that shape), `n3 = 1` or not per lane, in both math
+    /// modes (exact: to the bit; vector: the same where `n3 = 1` in every lane).
+    #[test]
+    fn hertz_contact_uniform(
+        (xs, vs) in states(),
+        params in prop::collection::vec(
+            (-2e-3..2e-3f64, 1e6..1e9f64, 1e-3..2.0f64, prop_oneof![Just(1.0), 0.1..1.5f64]),
+            L),
+        all_linear in any::<bool>(),
+    ) {
+        let laws: Vec<_> = params
+            .iter()
+            .map(|&(x_i, k_i, b, n3)| {
+                hertz((x_i, k_i, b, 1.5, 1.5, if all_linear { 1.0 } else { n3 }, 0.0, false))
+            })
+            .collect();
+        check_law(&laws, &xs, &vs, LaneMath::Exact);
+        if all_linear {
+            check_law(&laws, &xs, &vs, LaneMath::Vector);
+        }
+    }
+
     #[test]
     fn dry_friction(
         (xs, vs) in states(),

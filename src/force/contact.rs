@@ -390,6 +390,9 @@ pub struct HertzLanes<V> {
     half_n3m1: V,
     eta2: V,
     eta_pos: V,
+    /// Every lane a damped Hertz stop above (`n1 = n2 = 3/2`, `b > 0`, `η = 0`, upper
+    /// side): the shape most models use, evaluated without the other shapes' selects.
+    hertz: bool,
 }
 
 impl super::LaneLaw for HertzContact<f64> {
@@ -410,6 +413,7 @@ impl super::LaneLaw for HertzContact<f64> {
             half_n3m1: z,
             eta2: z,
             eta_pos: z,
+            hertz: false,
         };
         for i in 0..V::LANES {
             self.pack_lane(&mut p, i);
@@ -430,12 +434,20 @@ impl super::LaneLaw for HertzContact<f64> {
         p.half_n3m1 = p.half_n3m1.with_lane(i, self.half_n3_minus_1);
         p.eta2 = p.eta2.with_lane(i, self.eta * self.eta);
         p.eta_pos = p.eta_pos.with_lane(i, mask(self.eta > 0.0));
+        let all = V::splat(crate::lanes::TRUE).bits();
+        p.hertz = p.lower.bits() == 0
+            && p.n1.three_halves.bits() == all
+            && p.n2_is_n1.bits() == all
+            && (p.b_zero | p.eta_pos).bits() == 0;
     }
     /// The scalar law's terms in its order; lanes out of contact cost a compare (and
     /// nothing more when no lane is in contact).
     #[inline(always)]
     fn force_lanes<V: Lanes>(p: &HertzLanes<V>, math: LaneMath, x: V, v: V) -> V {
         let z = V::splat(0.0);
+        if p.hertz {
+            return hertz_force_lanes(p, math, x, v);
+        }
         // The penetration and its rate: (x − x_I, v) above, (x_I − x, −v) below.
         let d = p.lower.select(p.x_i - x, x - p.x_i);
         let inside = !d.le(z);
@@ -473,6 +485,36 @@ impl super::LaneLaw for HertzContact<f64> {
         let kf = p.k_i * f;
         (inside & !f.le(z)).select(p.lower.select(-p.k_i * f, kf), z)
     }
+}
+
+/// [`LaneLaw::force_lanes`](super::LaneLaw::force_lanes) where every lane is a damped
+/// Hertz stop above ([`HertzLanes::hertz`]): the general lane form's operations with the
+/// selects of the other shapes left out (each lane's value the same, to the bit).
+#[inline(always)]
+fn hertz_force_lanes<V: Lanes>(p: &HertzLanes<V>, math: LaneMath, x: V, v: V) -> V {
+    let z = V::splat(0.0);
+    let d = x - p.x_i;
+    let inside = !d.le(z);
+    if inside.bits() == 0 {
+        return z;
+    }
+    let p1 = inside.select(d * inside.select(d, V::splat(1.0)).sqrt(), z);
+    let exact = inside & !v.eq(z);
+    let g = if exact.bits() == 0 {
+        // The general form's regularized term where no lane has one: `w·0`.
+        v * z
+    } else {
+        let general = exact & !p.n3_one;
+        let g_ex = if general.bits() == 0 {
+            v
+        } else {
+            let m = pow_masked(math, general, v.abs(), p.n3);
+            p.n3_one.select(v, v.gt(z).select(m, -m))
+        };
+        exact.select(g_ex, z)
+    };
+    let f = p1 + p.b * p1 * g;
+    (inside & !f.le(z)).select(p.k_i * f, z)
 }
 
 #[cfg(test)]
