@@ -53,6 +53,18 @@ impl<const M: usize, G: EventFunction<f64, M>> EventSet<f64, M> for SurfaceEvent
     fn check(&self) -> Result<(), EventError> {
         self.0.iter().try_for_each(|g| g.check())
     }
+    fn chord_bounds(
+        &self,
+        i: usize,
+        t0: f64,
+        t1: f64,
+        dev: &SVector<f64, M>,
+        mag: &SVector<f64, M>,
+    ) -> Option<(f64, f64)> {
+        self.0
+            .get(i)
+            .map_or(Some((0.0, 1.0)), |g| g.chord_bounds(t0, t1, dev, mag))
+    }
     fn max_step(&self, t: f64) -> Option<f64> {
         self.0
             .iter()

@@ -449,6 +449,19 @@ impl<const N: usize> EventFunction<f64, N> for StopEvent {
             None => Some(0.0),
         }
     }
+    /// The stop's (a constant has no deviation from its chord).
+    fn chord_bounds(
+        &self,
+        t0: f64,
+        t1: f64,
+        dev: &SVector<f64, N>,
+        mag: &SVector<f64, N>,
+    ) -> Option<(f64, f64)> {
+        match &self.0 {
+            Some(s) => s.chord_bounds(t0, t1, dev, mag),
+            None => Some((0.0, 1.0)),
+        }
+    }
     /// No time scale (the default `None`).
     fn constant_time_scale(&self) -> bool {
         true
