@@ -470,20 +470,26 @@ impl super::LaneLaw for HertzContact<f64> {
         let g = if exact.bits() == 0 {
             g_reg
         } else {
-            // `n3 = 1`: `g = w` (the scalar law's fast path); the power only where some
-            // lane has another exponent.
-            let general = exact & !p.n3_one;
-            let g_ex = if general.bits() == 0 {
-                w
-            } else {
-                let m = pow_masked(math, general, w.abs(), p.n3);
-                p.n3_one.select(w, w.gt(z).select(m, -m))
-            };
-            exact.select(g_ex, p.eta_pos.select(g_reg, z))
+            exact.select(p.rate_power(math, exact, w), p.eta_pos.select(g_reg, z))
         };
         let f = p.b_zero.select(p1, p1 + p.b * p2 * g);
         let kf = p.k_i * f;
         (inside & !f.le(z)).select(p.lower.select(-p.k_i * f, kf), z)
+    }
+}
+
+impl<V: Lanes> HertzLanes<V> {
+    /// `sgn(w)|w|^{n3}` in the lanes of `exact` (`w ≠ 0`, no regularization): `w` itself
+    /// where `n3 = 1` (the scalar law's fast path), the power only where some lane has
+    /// another exponent.
+    #[inline(always)]
+    fn rate_power(&self, math: LaneMath, exact: V, w: V) -> V {
+        let general = exact & !self.n3_one;
+        if general.bits() == 0 {
+            return w;
+        }
+        let m = pow_masked(math, general, w.abs(), self.n3);
+        self.n3_one.select(w, w.gt(V::splat(0.0)).select(m, -m))
     }
 }
 
@@ -504,14 +510,7 @@ fn hertz_force_lanes<V: Lanes>(p: &HertzLanes<V>, math: LaneMath, x: V, v: V) ->
         // The general form's regularized term where no lane has one: `w·0`.
         v * z
     } else {
-        let general = exact & !p.n3_one;
-        let g_ex = if general.bits() == 0 {
-            v
-        } else {
-            let m = pow_masked(math, general, v.abs(), p.n3);
-            p.n3_one.select(v, v.gt(z).select(m, -m))
-        };
-        exact.select(g_ex, z)
+        exact.select(p.rate_power(math, exact, v), z)
     };
     let f = p1 + p.b * p1 * g;
     (inside & !f.le(z)).select(p.k_i * f, z)
