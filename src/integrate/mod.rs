@@ -423,7 +423,7 @@ pub trait DenseOutput<T: Real, const N: usize> {
     /// turns them into bounds on an event function
     /// ([`EventFunction::chord_bounds`](crate::event::EventFunction::chord_bounds)) to
     /// rule out a crossing without searching the step. Default `None`; given by
-    /// [`Dopri5`](super::Dopri5)'s interpolant.
+    /// [`Dopri5`]'s interpolant.
     fn chord_bounds(&self) -> Option<(SVector<T, N>, SVector<T, N>)> {
         None
     }
