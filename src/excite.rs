@@ -355,6 +355,14 @@ impl<T: Real> Harmonic<T> {
     }
 }
 
+/// [`Excitation::chord_bounds`] of `A·sin(ωt + φ)` on `[t0, t1]`: `|A|·ω²·(t1 − t0)²/8`
+/// (`|f̈| ≤ |A|·ω²`) and the rounding scale `|A|·(1 + |ω|·max|t| + |φ|)`.
+fn sine_chord_bounds<T: Real>(amplitude: T, omega: T, phase0: T, t0: T, t1: T) -> (T, T) {
+    let (a, h) = (amplitude.abs(), t1 - t0);
+    let phase = omega.abs() * t0.abs().max(t1.abs()) + phase0.abs();
+    (a * omega * omega * h * h / lit(8.0), a * (T::one() + phase))
+}
+
 impl<T: Real> Excitation<T> for Harmonic<T> {
     #[inline(always)]
     fn force(&self, t: T) -> T {
@@ -390,11 +398,12 @@ impl<T: Real> Excitation<T> for Harmonic<T> {
     }
     /// `|F0|·ω²·(t1 − t0)²/8` (`|f̈| ≤ |F0|·ω²`) and `|F0|·(1 + |ω|·max|t| + |φ0|)`.
     fn chord_bounds(&self, t0: T, t1: T) -> Option<(T, T)> {
-        let (a, h) = (self.amplitude.abs(), t1 - t0);
-        let phase = self.omega.abs() * t0.abs().max(t1.abs()) + self.phase0.abs();
-        Some((
-            a * self.omega * self.omega * h * h / lit(8.0),
-            a * (T::one() + phase),
+        Some(sine_chord_bounds(
+            self.amplitude,
+            self.omega,
+            self.phase0,
+            t0,
+            t1,
         ))
     }
 }
@@ -501,12 +510,7 @@ impl<T: Real> Excitation<T> for UnbalancedRotor<T> {
     }
     /// `|m0·e·ω²|·ω²·(t1 − t0)²/8` and `|m0·e·ω²|·(1 + |ω|·max|t|)`.
     fn chord_bounds(&self, t0: T, t1: T) -> Option<(T, T)> {
-        let (a, h) = (self.amp.abs(), t1 - t0);
-        let phase = self.omega.abs() * t0.abs().max(t1.abs());
-        Some((
-            a * self.omega * self.omega * h * h / lit(8.0),
-            a * (T::one() + phase),
-        ))
+        Some(sine_chord_bounds(self.amp, self.omega, T::zero(), t0, t1))
     }
 }
 
