@@ -58,6 +58,24 @@ pub(crate) fn positive<T: crate::Real>(
     }
 }
 
+/// Validates that `value` is finite, strictly positive and has a finite inverse (a mass or
+/// an inertia that is divided by: a subnormal value would make `1/value` infinite).
+pub(crate) fn invertible<T: crate::Real>(
+    name: &'static str,
+    value: T,
+) -> std::result::Result<T, ParameterError> {
+    let v = crate::scalar::to_f64(value);
+    if value.is_finite() && value > T::zero() && (T::one() / value).is_finite() {
+        Ok(value)
+    } else {
+        Err(ParameterError::new(
+            name,
+            v,
+            "finite and > 0 with a finite inverse (>= 5.6e-309 for f64)",
+        ))
+    }
+}
+
 /// Validates that `value` is finite and non-negative.
 pub(crate) fn non_negative<T: crate::Real>(
     name: &'static str,

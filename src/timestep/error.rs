@@ -22,8 +22,11 @@ pub enum TimeStepError {
         /// What the system requires (a length, or the bound an index must stay below).
         expected: usize,
     },
-    /// The mass matrix is not symmetric positive definite (Cholesky fails).
-    #[error("the mass matrix is not positive definite at t = {t} (pivot {pivot} = {value:e})")]
+    /// The mass matrix is not positive definite (a Cholesky pivot, or a diagonal entry of
+    /// a diagonal mass matrix, is not positive, or its inverse is not finite).
+    #[error(
+        "the mass matrix is not positive definite at t = {t} (pivot {pivot} = {value:e}, or its inverse is not finite)"
+    )]
     MassMatrix {
         /// Time of the evaluation.
         t: f64,
@@ -31,6 +34,53 @@ pub enum TimeStepError {
         pivot: usize,
         /// Its value.
         value: f64,
+    },
+    /// The mass matrix is not symmetric: `M[row][col]` and `M[col][row]` differ by more
+    /// than rounding (`64 ε max(|M_ii|, |M_jj|)`).
+    #[error(
+        "the mass matrix is not symmetric at t = {t}: M[{row}][{col}] = {value:e} but M[{col}][{row}] = {transposed:e}"
+    )]
+    MassAsymmetric {
+        /// Time of the evaluation.
+        t: f64,
+        /// The row of the entry.
+        row: usize,
+        /// Its column.
+        col: usize,
+        /// `M[row][col]`.
+        value: f64,
+        /// `M[col][row]`.
+        transposed: f64,
+    },
+    /// The iteration matrix `W = M + hθC + h²θ²K` of the implicit forces is singular (its
+    /// LU factorization meets a zero or non-finite pivot): the step is too large for the
+    /// forces' negative stiffness or damping, or `M` itself is singular.
+    #[error(
+        "the iteration matrix W = M + hθC + h²θ²K is singular at t = {t} (pivot {pivot} = {value:e}): shorten the step h = {h:e} or check the force Jacobians"
+    )]
+    IterationMatrix {
+        /// Time of the evaluation.
+        t: f64,
+        /// The step.
+        h: f64,
+        /// The failing pivot column.
+        pivot: usize,
+        /// The largest pivot candidate.
+        value: f64,
+    },
+    /// The clock cannot resolve the step: near `t` neighbouring floating-point times are
+    /// farther apart than `h/1024`, so the steps `t_{k+1} − t_k` would be rounded to
+    /// lengths other than `h` (or to 0).
+    #[error(
+        "the clock cannot resolve the step h = {h:e} at t = {t:e}: neighbouring times there are up to {spacing:e} apart (more than h/1024); start the clock nearer 0"
+    )]
+    Clock {
+        /// The largest time of the run.
+        t: f64,
+        /// The step.
+        h: f64,
+        /// The spacing of floating-point times near `t` (`ε·|t|`).
+        spacing: f64,
     },
     /// A contact was given to a complementarity solver that cannot treat it (friction to
     /// Lemke or projected Gauss–Seidel).

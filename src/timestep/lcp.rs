@@ -14,14 +14,18 @@
 //!    |p_t| \le \mu p_n,\quad p_t = -\mu p_n \operatorname{sgn}(u_t) \text{ if } u_t \ne 0 .$$
 //!
 //! # Residual
-//! Every solver reports the **complementarity residual** of its answer, the natural map
-//! scaled by the data,
-//! $$ r = \frac{\max_i |\,z_i - \max(0, z_i - w_i)\,|}{\max(1, \lVert q\rVert_\infty)}
-//!      = \frac{\max_i |\min(z_i, w_i)|}{\max(1, \lVert q\rVert_\infty)} ,$$
+//! Every solver reports the **complementarity residual** of its answer: the natural map
+//! with `z` measured in the units of `w` by `s_M = max_ij |M_ij|`, relative to the data,
+//! $$ r = \frac{\max_i |\min(s_M z_i,\, w_i)|}{\lVert q\rVert_\infty} ,$$
 //! and for friction the same with the tangential term
-//! `|p_t − clamp(p_t − u_t, −μp_n, μp_n)|`. A solver that cannot bring `r` to its tolerance
-//! returns an [`LcpError`] naming the residual reached; it never returns an unconverged
-//! answer.
+//! `|s_M p_t − clamp(s_M p_t − u_t, −μ s_M p_n, μ s_M p_n)|`. `r` does not change when `q`
+//! or `M` is multiplied by a positive factor (the answer `z` scales with `q` and inversely
+//! with `M`), so one tolerance means the same at every scale: a residual of `10⁻¹⁰` leaves
+//! every `w_i` of a positive `z_i` within `10⁻¹⁰ ‖q‖∞` of zero, whether the data are of
+//! order 1, `10⁻³⁰⁰` or `10³⁰⁰`. Where `q ≥ 0` (no contact pressed), `z = 0` solves the
+//! problem and every solver returns it at once (residual 0). A solver that cannot bring
+//! `r` to its tolerance returns an [`LcpError`] naming the residual reached; it never
+//! returns an unconverged answer.
 //!
 //! # Which solver
 //! - [`Lemke`] is exact (to rounding: the final basis is re-solved by an LU factorization)
@@ -115,6 +119,17 @@ pub enum LcpError {
         /// The tolerance asked for.
         tolerance: f64,
     },
+    /// The answer's scale, `‖q‖∞ / max_ij |M_ij|`, lies outside the range of the scalar
+    /// type: `z` would overflow or underflow.
+    #[error(
+        "complementarity problem: the answer's scale ‖q‖∞ / max|M_ij| = {q_norm:e} / {m_norm:e} is outside the range of the scalar type (z would overflow or underflow): rescale the problem"
+    )]
+    Scale {
+        /// `‖q‖∞`.
+        q_norm: f64,
+        /// `max_ij |M_ij|`.
+        m_norm: f64,
+    },
     /// Lemke's method terminated but its answer (after re-solving the final basis) misses
     /// the tolerance: the problem is too ill-conditioned for the scalar type.
     #[error(
@@ -137,18 +152,41 @@ pub struct LcpReport {
     pub residual: f64,
 }
 
-/// The default residual tolerance: `10⁻¹⁰`, or `1000 ε` if larger (`1.2·10⁻⁴` for `f32`).
+/// The default residual tolerance (relative, see the [module docs](self)): `10⁻¹⁰`, or
+/// `1000 ε` if larger (`1.2·10⁻⁴` for `f32`).
 fn default_tolerance<T: Real>() -> T {
     lit::<T>(1e-10).max(lit::<T>(1000.0) * T::default_epsilon())
 }
 
-/// `max(1, ‖q‖∞)`, the residual's scale.
-fn scale<T: Real>(q: &[T]) -> T {
-    q.iter().fold(T::one(), |a, &x| a.max(x.abs()))
+/// `max_i |x_i|`.
+fn norm_inf<T: Real>(x: &[T]) -> T {
+    x.iter().fold(T::zero(), |a, &v| a.max(v.abs()))
 }
 
-/// The scaled complementarity residual `max_i |min(z_i, w_i)| / max(1, ‖q‖∞)` of `z` for
-/// LCP(M, q), `w = Mz + q` (see the [module docs](self)). NaN entries give NaN.
+/// The exponent `e` with `2^e ≤ |x| < 2^{e+1}` (of the `f64` value; 0 for 0 or non-finite).
+fn exponent<T: Real>(x: T) -> i32 {
+    let v = to_f64(x).abs();
+    if v > 0.0 && v.is_finite() {
+        v.log2().floor() as i32
+    } else {
+        0
+    }
+}
+
+/// `x · 2^e`, exact unless the result over- or underflows (in steps of at most `2^±960`,
+/// all of one sign, so that no intermediate result loses what the final one keeps).
+fn ldexp<T: Real>(mut x: T, mut e: i32) -> T {
+    while e != 0 {
+        let k = e.clamp(-960, 960);
+        x *= lit::<T>(2.0_f64.powi(k));
+        e -= k;
+    }
+    x
+}
+
+/// The scaled complementarity residual `max_i |min(s_M z_i, w_i)| / ‖q‖∞` of `z` for
+/// LCP(M, q), `w = Mz + q`, `s_M = max_ij |M_ij|` (see the [module docs](self)); 0 where
+/// `q = 0` and `z = 0`. NaN entries give NaN.
 ///
 /// # Errors
 /// [`LcpError::Dimension`] if `m` is not `n × n` or `z` not of length `n = q.len()`.
@@ -161,17 +199,23 @@ pub fn residual<T: Real>(m: &[T], q: &[T], z: &[T]) -> Result<T, LcpError> {
 
 fn residual_unchecked<T: Real>(m: &[T], q: &[T], z: &[T]) -> T {
     let n = q.len();
+    let sm = norm_inf(m);
     let mut r = T::zero();
     for i in 0..n {
         let row = &m[i * n..(i + 1) * n];
         let w = row.iter().zip(z).fold(q[i], |a, (&mij, &zj)| a + mij * zj);
-        let e = z[i].min(w).abs();
+        let e = (sm * z[i]).min(w).abs();
         if !(e >= T::zero()) {
             return e;
         }
         r = r.max(e);
     }
-    r / scale(q)
+    relative(r, norm_inf(q))
+}
+
+/// `r / scale`, 0 for `r = 0` (a zero problem solved by zero), infinite for `r > 0 = scale`.
+fn relative<T: Real>(r: T, scale: T) -> T {
+    if r == T::zero() { r } else { r / scale }
 }
 
 fn check_len(what: &'static str, got: usize, expected: usize) -> Result<(), LcpError> {
@@ -280,6 +324,11 @@ impl<T: Real> Lemke<T> {
         Ok(self)
     }
 
+    /// The residual tolerance (relative, see the [module docs](self)).
+    pub fn tolerance(&self) -> T {
+        self.tolerance
+    }
+
     /// Sizes the workspace for problems up to `n` unknowns.
     pub fn reserve(&mut self, n: usize) {
         let grow = |v: &mut Vec<T>, len: usize| {
@@ -320,6 +369,22 @@ impl<T: Real> Lemke<T> {
             });
         }
         self.reserve(n);
+        // The method runs on the problem scaled by powers of two, exactly, to entries of
+        // order 1: `M/2^a`, `q/2^b` (its tests and floors are then relative to the data),
+        // and `z = z̃·2^(b−a)`.
+        let (m_norm, q_norm) = (norm_inf(m), norm_inf(q));
+        let (ea, eb) = (exponent(m_norm), exponent(q_norm));
+        let scale_error = || LcpError::Scale {
+            q_norm: to_f64(q_norm),
+            m_norm: to_f64(m_norm),
+        };
+        if !(m_norm > T::zero()) {
+            // M = 0 with some q_i < 0: w_i = q_i < 0 whatever z.
+            return Err(LcpError::RayTermination {
+                pivots: 0,
+                entering: 2 * n,
+            });
+        }
         let limit = self.pivot_limit.unwrap_or(1000 + 50 * n);
         let cols = 2 * n + 2;
         let (z0, rhs) = (2 * n, 2 * n + 1);
@@ -330,10 +395,10 @@ impl<T: Real> Lemke<T> {
             row.iter_mut().for_each(|x| *x = T::zero());
             row[i] = T::one();
             for j in 0..n {
-                row[n + j] = -m[i * n + j];
+                row[n + j] = -ldexp(m[i * n + j], -ea);
             }
             row[z0] = -T::one();
-            row[rhs] = q[i];
+            row[rhs] = ldexp(q[i], -eb);
             self.basis[i] = i;
         }
         // z₀ enters; the row of the most negative q leaves (ties broken lexicographically).
@@ -343,7 +408,7 @@ impl<T: Real> Lemke<T> {
                 r = i;
             }
         }
-        let tie = lit::<T>(1e-12) * scale(q);
+        let tie = lit::<T>(1e-12) * q_norm;
         let mut ties = 0;
         for i in 0..n {
             if q[i] - q[r] <= tie {
@@ -381,11 +446,20 @@ impl<T: Real> Lemke<T> {
             }
             entering = complement(leaving, n);
         }
+        let mut largest = T::zero();
         for i in 0..n {
             let b = self.basis[i];
             if (n..2 * n).contains(&b) {
-                z[b - n] = tab[i * cols + rhs].max(T::zero());
+                let zi = tab[i * cols + rhs].max(T::zero());
+                largest = largest.max(zi);
+                z[b - n] = ldexp(zi, eb - ea);
             }
+        }
+        // The largest entry must survive the scaling both ways (no overflow, no loss of
+        // digits to underflow); smaller ones may underflow, below its rounding.
+        let back = ldexp(largest, eb - ea);
+        if !back.is_finite() || ldexp(back, ea - eb) != largest {
+            return Err(scale_error());
         }
         let mut res = residual_unchecked(m, q, z);
         if let Some(polished) = self.polish(m, q, z) {
@@ -625,6 +699,11 @@ impl<T: Real> Pgs<T> {
         Ok(self)
     }
 
+    /// The residual tolerance (relative, see the [module docs](self)).
+    pub fn tolerance(&self) -> T {
+        self.tolerance
+    }
+
     /// Sets the relaxation factor `ω ∈ (0, 2)`.
     ///
     /// # Errors
@@ -672,6 +751,13 @@ impl<T: Real> Pgs<T> {
                     value: to_f64(d),
                 });
             }
+        }
+        if q.iter().all(|&x| x >= T::zero()) {
+            z.iter_mut().for_each(|x| *x = T::zero());
+            return Ok(LcpReport {
+                iterations: 0,
+                residual: 0.0,
+            });
         }
         for x in z.iter_mut() {
             if !(x.is_finite() && *x > T::zero()) {
@@ -760,6 +846,11 @@ impl<T: Real> Nsgs<T> {
         Ok(self)
     }
 
+    /// The residual tolerance (relative, see the [module docs](self)).
+    pub fn tolerance(&self) -> T {
+        self.tolerance
+    }
+
     /// Solves the planar frictional contact problem with Delassus matrix `w` (`2k × 2k`,
     /// rows in the order `n₁, t₁, n₂, t₂, …`), free velocities `q` (`2k`) and friction
     /// coefficients `mu` (`k`, each ≥ 0), starting from the impulses `p`.
@@ -787,6 +878,14 @@ impl<T: Real> Nsgs<T> {
                     value: to_f64(d),
                 });
             }
+        }
+        if q.iter().step_by(2).all(|&x| x >= T::zero()) {
+            // Every contact takes off: p = 0 (u = q, u_n ≥ 0).
+            p.iter_mut().for_each(|x| *x = T::zero());
+            return Ok(LcpReport {
+                iterations: 0,
+                residual: 0.0,
+            });
         }
         for x in p.iter_mut() {
             if !x.is_finite() {
@@ -837,6 +936,18 @@ impl<T: Real> Nsgs<T> {
 /// a_tt]]`; `pt_old` is used only by the projected fallback (never reached for a positive
 /// definite `A` and `μ` within its range).
 fn local_contact<T: Real>(a: [T; 4], rn: T, rt: T, mu: T, pt_old: T) -> (T, T) {
+    // Where `a_nn` is far from 1, on `A/2^e` (entries of order 1, exactly: the
+    // determinant neither over- nor underflows), and `p = p̃/2^e`.
+    if a[0] >= lit(1e-150) && a[0] <= lit(1e150) {
+        return local_contact_unit(a, rn, rt, mu, pt_old);
+    }
+    let e = exponent(a[0]);
+    let (pn, pt) = local_contact_unit(a.map(|x| ldexp(x, -e)), rn, rt, mu, ldexp(pt_old, e));
+    (ldexp(pn, -e), ldexp(pt, -e))
+}
+
+/// [`local_contact`] for a block `A` with entries of order 1.
+fn local_contact_unit<T: Real>(a: [T; 4], rn: T, rt: T, mu: T, pt_old: T) -> (T, T) {
     let [ann, ant, atn, att] = a;
     let zero = T::zero();
     if rn >= zero {
@@ -875,6 +986,7 @@ fn local_contact<T: Real>(a: [T; 4], rn: T, rt: T, mu: T, pt_old: T) -> (T, T) {
 /// The residual of the planar frictional contact problem (see the [module docs](self)).
 fn frictional_residual<T: Real>(w: &[T], q: &[T], mu: &[T], p: &[T]) -> T {
     let n = q.len();
+    let sw = norm_inf(w);
     let mut r = T::zero();
     for (c, &mu_c) in mu.iter().enumerate() {
         let (i, j) = (2 * c, 2 * c + 1);
@@ -884,16 +996,17 @@ fn frictional_residual<T: Real>(w: &[T], q: &[T], mu: &[T], p: &[T]) -> T {
             un += w[i * n + k] * p[k];
             ut += w[j * n + k] * p[k];
         }
-        let en = p[i].min(un).abs();
-        let bound = mu_c * p[i].max(T::zero());
-        let et = (p[j] - (p[j] - ut).max(-bound).min(bound)).abs();
+        let (pn, pt) = (sw * p[i], sw * p[j]);
+        let en = pn.min(un).abs();
+        let bound = mu_c * pn.max(T::zero());
+        let et = (pt - (pt - ut).max(-bound).min(bound)).abs();
         let e = en.max(et);
         if !(e >= T::zero()) {
             return e;
         }
         r = r.max(e);
     }
-    r / scale(q)
+    relative(r, norm_inf(q))
 }
 
 /// The residual of the planar frictional contact problem for impulses `p` (see the

@@ -20,7 +20,9 @@
 //! 2. active set: contact `i` enters the step's problem if its predicted gap
 //!    $g_i(q_k, t_k) + \gamma h \dot g_i^-\le \delta$, $\dot g_i^- = \nabla g_i\cdot v_k +
 //!    \partial_t g_i$, with a threshold δ of a few ulps of the positions (rounding must not
-//!    open a resting contact);
+//!    open a resting contact), or if it is resting (it carried an impulse in the last step
+//!    and left it at rest to the solver's tolerance) or the last step's position
+//!    projection treated it;
 //! 3. one complementarity problem for the impulses $p$ of the active contacts:
 //!    $$ u = W p + q_{\rm free},\quad W = H M^{-1} H^{\mathsf T},\quad
 //!    q_{{\rm free},n,i} = \nabla g_i\cdot v_{\rm free} + \partial_t g_i(t_{k+1}) +

@@ -16,7 +16,7 @@
 
 use crate::Real;
 use crate::scalar::to_f64;
-use crate::validate::{ParameterError, finite, non_negative, positive};
+use crate::validate::{ParameterError, finite, invertible, non_negative, positive};
 
 use super::error::TimeStepError;
 use super::system::{Contact, Geometry, Jacobian, Lagrangian};
@@ -32,11 +32,12 @@ impl<T: Real> RigidBody<T> {
     /// A body of mass `mass` and moment of inertia `inertia` about its centre of mass.
     ///
     /// # Errors
-    /// [`ParameterError`] unless both are finite and > 0.
+    /// [`ParameterError`] naming the value unless both are finite and > 0 with finite
+    /// inverses (the scheme divides by them).
     pub fn new(mass: T, inertia: T) -> Result<Self, ParameterError> {
         Ok(Self {
-            mass: positive("mass", mass)?,
-            inertia: positive("inertia", inertia)?,
+            mass: invertible("mass", mass)?,
+            inertia: invertible("inertia", inertia)?,
         })
     }
 

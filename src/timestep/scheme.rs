@@ -26,6 +26,15 @@ pub enum Solver<T> {
 }
 
 impl<T: Real> Solver<T> {
+    /// The solver's residual tolerance (relative, see [`lcp`](super::lcp)).
+    fn tolerance(&self) -> T {
+        match self {
+            Solver::Lemke(s) => s.tolerance(),
+            Solver::Pgs(s) => s.tolerance(),
+            Solver::Nsgs(s) => s.tolerance(),
+        }
+    }
+
     fn name(&self) -> &'static str {
         match self {
             Solver::Lemke(_) => "Lemke",
@@ -98,6 +107,8 @@ struct Workspace<T> {
     rows: Vec<(usize, T)>,
     offsets: Vec<usize>,
     active: Vec<usize>,
+    /// Contacts the last projection treated: active in the next step whatever their gap.
+    held: Vec<bool>,
     gaps: Vec<T>,
     pre: Vec<[T; 2]>,
     w: Vec<T>,
@@ -137,6 +148,7 @@ impl<T: Real> Workspace<T> {
             rows: Vec::with_capacity(12 * m),
             offsets: Vec::with_capacity(2 * m + 1),
             active: Vec::with_capacity(m),
+            held: vec![false; m],
             gaps: Vec::with_capacity(m),
             pre: Vec::with_capacity(m),
             w: Vec::new(),
@@ -224,6 +236,29 @@ fn lu_in_place<T: Real>(a: &mut [T], piv: &mut [usize], n: usize) -> Result<(), 
             for c in j + 1..n {
                 let u = a[j * n + c];
                 a[i * n + c] -= l * u;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Checks that the row-major `n × n` mass matrix `m` is symmetric to rounding:
+/// `|M_ij − M_ji| ≤ 64 ε max(|M_ii|, |M_jj|)` (the Cholesky factorization reads one
+/// triangle only, so an asymmetric matrix would be integrated as another one).
+fn symmetric<T: Real>(m: &[T], n: usize, t: T) -> Result<(), TimeStepError> {
+    let tol = lit::<T>(64.0) * T::default_epsilon();
+    for i in 0..n {
+        for j in 0..i {
+            let (a, b) = (m[i * n + j], m[j * n + i]);
+            let scale = m[i * n + i].abs().max(m[j * n + j].abs());
+            if !((a - b).abs() <= tol * scale) {
+                return Err(TimeStepError::MassAsymmetric {
+                    t: to_f64(t),
+                    row: i,
+                    col: j,
+                    value: to_f64(a),
+                    transposed: to_f64(b),
+                });
             }
         }
     }
@@ -348,6 +383,16 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
     /// ulps above zero or its velocity a few ulps separating (a stack of balls would
     /// otherwise lose a contact and let the balls above it fall for a step).
     ///
+    /// A **resting** contact — one that carried a normal impulse in the last step and left
+    /// it with a normal velocity `ġ⁺ ≤ r ‖q‖∞` (`r` the solver's relative tolerance, `q`
+    /// the step's free velocities: at rest to the solver's accuracy) — stays in the next
+    /// step's problem whatever its gap. An iterative solver leaves the velocities of a
+    /// resting stack within `r ‖q‖∞` of zero, always on the same side, so the gaps move by
+    /// up to `h r ‖q‖∞` per step in one direction and would pass any threshold after
+    /// enough steps (a 50-ball column with projected Gauss–Seidel at `r = 10⁻¹⁰` opened
+    /// within 0.1 s before this rule). A contact that separates faster (a bounce) leaves
+    /// the problem by the predicted-gap test.
+    ///
     /// # Errors
     /// [`ParameterError`] unless `δ` is finite and ≥ 0.
     pub fn with_activation_threshold(mut self, delta: T) -> Result<Self, ParameterError> {
@@ -369,6 +414,14 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
     /// metric that closes the linearized gaps) and repeats with the gaps re-evaluated until
     /// every gap is `≥ −tolerance` (at most 20 times; each pass is a Newton step on the
     /// active gaps, so a curvature error `O(h²)` is removed in one or two).
+    ///
+    /// Every contact the projection treats (`g_i ≤ tolerance` in one of its passes) is
+    /// active in the next step's problem whatever its gap, as resting contacts are (see
+    /// [`with_activation_threshold`](Self::with_activation_threshold)): the projection
+    /// leaves closed contacts at `g ≈ 0` instead of slightly inside, where the `O(Δq²)`
+    /// error of its linearized passes and of the position update (measured up to `10⁻⁹` m
+    /// on a rocking block) can open them above the activation threshold. A contact that
+    /// separates leaves the problem at the next step, with a zero impulse.
     ///
     /// # Errors
     /// [`ParameterError`] unless `tolerance` is finite and > 0.
@@ -463,7 +516,11 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
     /// # Errors
     /// [`TimeStepError::Dimension`] if `q` or `v` does not have `dofs()` entries;
     /// [`TimeStepError::Parameter`] unless `t0 ≤ t_end` are finite;
-    /// [`TimeStepError::MassMatrix`]; [`TimeStepError::NonFinite`] for a non-finite force,
+    /// [`TimeStepError::Clock`] if the clock cannot resolve the step (`ε·max(|t0|, |t_end|)
+    /// > h/1024`: every step then has length `h` to within 0.1 %, never 0);
+    /// [`TimeStepError::MassMatrix`] / [`TimeStepError::MassAsymmetric`] for a mass matrix
+    /// that is not symmetric positive definite, [`TimeStepError::IterationMatrix`] for a
+    /// singular iteration matrix of the implicit forces; [`TimeStepError::NonFinite`] for a non-finite force,
     /// gap, Jacobian entry or state; [`TimeStepError::Contact`] if a step's contact problem
     /// is not solved (with the step, its time and the residual reached). The state is that
     /// of the last completed step after an error.
@@ -511,8 +568,20 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
         if !(steps < 1e15) {
             return Err(ParameterError::new("h", to_f64(self.h), "giving < 1e15 steps").into());
         }
+        // The grid t₀ + k·h must be resolved by the clock: otherwise the steps t_{k+1} − t_k
+        // are rounded to other lengths than h, or to 0.
+        let t_max = t0.abs().max(t_end.abs());
+        let spacing = T::default_epsilon() * t_max;
+        if spacing > self.h / lit(1024.0) {
+            return Err(TimeStepError::Clock {
+                t: to_f64(t_max),
+                h: to_f64(self.h),
+                spacing: to_f64(spacing),
+            });
+        }
         let steps = steps as usize;
         self.ws.factored = false;
+        self.ws.held.iter_mut().for_each(|x| *x = false);
         observer.on_start(t0, q, v);
         let mut summary = Summary {
             steps: 0,
@@ -601,6 +670,9 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
         let n = ws.n;
         self.system.mass(q, &mut ws.mass);
         Self::nonfinite(k, t, "mass", &ws.mass)?;
+        if !ws.diagonal {
+            symmetric(&ws.mass, n, t)?;
+        }
         if ws.implicit {
             if !self
                 .system
@@ -620,8 +692,9 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
                 ws.chol[i] = ws.mass[i] + ht * ws.tan_c[i] + ht * ht * ws.tan_k[i];
             }
             lu_in_place(&mut ws.chol, &mut ws.piv, n).map_err(|(pivot, value)| {
-                TimeStepError::MassMatrix {
+                TimeStepError::IterationMatrix {
                     t: to_f64(t),
+                    h: to_f64(h),
                     pivot,
                     value: to_f64(value),
                 }
@@ -629,14 +702,15 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
         } else if ws.diagonal {
             for i in 0..n {
                 let d = ws.mass[i * n + i];
-                if !(d > T::zero()) {
+                let inv = T::one() / d;
+                if !(d > T::zero() && inv.is_finite()) {
                     return Err(TimeStepError::MassMatrix {
                         t: to_f64(t),
                         pivot: i,
                         value: to_f64(d),
                     });
                 }
-                ws.inv_diag[i] = T::one() / d;
+                ws.inv_diag[i] = inv;
             }
         } else {
             let l = &mut ws.chol;
@@ -646,7 +720,7 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
                 for k2 in 0..j {
                     d -= l[j * n + k2] * l[j * n + k2];
                 }
-                if !(d > T::zero()) {
+                if !(d > T::zero() && (T::one() / d).is_finite()) {
                     return Err(TimeStepError::MassMatrix {
                         t: to_f64(t),
                         pivot: j,
@@ -719,7 +793,9 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
         self.ws.vnew.copy_from_slice(&self.ws.vfree);
         self.apply_impulses(frictional);
         Self::nonfinite(k, ta, "velocity", &self.ws.vnew)?;
-        self.record(tb, q, frictional);
+        let resting =
+            self.solver.tolerance() * self.ws.q.iter().fold(T::zero(), |a, &x| a.max(x.abs()));
+        self.record(tb, q, frictional, resting);
         // q⁺ = q + h ((1−θ) v + θ v⁺).
         let theta = self.theta;
         for i in 0..self.ws.n {
@@ -819,6 +895,7 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
                 if worst.is_none_or(|(_, g)| gap < g) {
                     worst = Some((i, gap));
                 }
+                ws.held[i] = true;
                 ws.active.push(i);
                 ws.gaps.push(gap);
                 ws.rows.extend_from_slice(&ws.scratch_n);
@@ -873,7 +950,8 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
         Ok(())
     }
 
-    /// The active contacts, by the predicted gap `g + γ h ġ ≤ δ`: their indices, gaps,
+    /// The active contacts, by the predicted gap `g + γ h ġ ≤ δ` or held by the last
+    /// position projection (see [`with_projection`](Self::with_projection)): their indices, gaps,
     /// pre-step rates and Jacobian rows (normal, tangent) into the workspace; an inactive
     /// contact's warm start is cleared.
     fn activate(&mut self, k: usize, ta: T, h: T, q: &[T], v: &[T]) -> Result<(), TimeStepError> {
@@ -913,7 +991,8 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
                     value: to_f64(geo.gap + un + ut),
                 });
             }
-            if geo.gap + self.gamma * h * un <= threshold {
+            let held = core::mem::replace(&mut ws.held[i], false);
+            if held || geo.gap + self.gamma * h * un <= threshold {
                 ws.active.push(i);
                 ws.gaps.push(geo.gap);
                 ws.pre.push([un, ut]);
@@ -1065,7 +1144,7 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
 
     /// The records of the active contacts, the work of the impulses, and the warm start
     /// of the next step.
-    fn record(&mut self, tb: T, q: &[T], frictional: bool) {
+    fn record(&mut self, tb: T, q: &[T], frictional: bool, resting: T) {
         let ws = &mut self.ws;
         ws.work = T::zero();
         for c in 0..ws.active.len() {
@@ -1086,6 +1165,11 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
             for &(j, x) in row(&ws.rows, &ws.offsets, 2 * c + 1) {
                 slip += x * ws.vnew[j];
                 free_slip += x * ws.vfree[j];
+            }
+            // A resting contact (pressed, left at rest to the solver's tolerance) stays in
+            // the next step's problem.
+            if pn > T::zero() && post <= resting {
+                ws.held[i] = true;
             }
             // ΔT = ½ pᵀ H (v⁺ + v_free): the drift terms cancel in the sums below.
             ws.work += lit::<T>(0.5)
