@@ -7,8 +7,8 @@ use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 use nonsmooth::drive::{Coulomb, SlipMode, StepView, StickSlip, run_modes};
 use nonsmooth::excite::{Constant, Harmonic};
 use nonsmooth::filippov::{
-    Filippov, FilippovError, FilippovSimulation, Mode, ModeTransition, Region, SlidingObserver,
-    Switched, TransitionKind,
+    Filippov, FilippovError, FilippovSimulation, Mode, ModeTransition, Region, Settings,
+    SlidingObserver, Switched, TransitionKind,
 };
 use nonsmooth::force::LinearSpring;
 use nonsmooth::integrate::{DenseOutput, Dopri5, Tolerances};
@@ -1774,4 +1774,60 @@ fn filippov_two_trajectory_in_f32_and_its_error_paths() {
         ),
         "expected a repelling-surface error"
     );
+}
+
+// ---------------------------------------------------------------------------------------
+// Decisions at the surface and the inputs they meet (issue 49).
+
+#[test]
+fn settings_outside_their_meaningful_range_are_named() {
+    let sim = FilippovSimulation::new(Corner, Dopri5::new(tol2()));
+    let base = *sim.settings();
+    // A relative tolerance ≥ 1 is no tolerance: |∇H·F| ≤ ‖∇H‖·‖F‖, so tangency = 1e300
+    // made every crossing a tangency (accepted before).
+    for (name, set) in [
+        (
+            "tangency",
+            (|s, v| s.tangency = v) as fn(&mut Settings<f64>, f64),
+        ),
+        ("coincidence", |s, v| s.coincidence = v),
+        ("drift", |s, v| s.drift = v),
+    ] {
+        for v in [1.0, 1e300, f64::INFINITY, f64::NAN, 0.0, -1e-9] {
+            let mut s = base;
+            set(&mut s, v);
+            let err = FilippovSimulation::new(Corner, Dopri5::new(tol2()))
+                .with_settings(s)
+                .err()
+                .unwrap_or_else(|| panic!("{name} = {v} accepted"));
+            assert_eq!(
+                (err.name, err.value.to_bits()),
+                (name, v.to_bits()),
+                "{err}"
+            );
+        }
+        let mut s = base;
+        set(&mut s, 0.5);
+        assert!(s.validate().is_ok(), "{name} = 0.5");
+    }
+    // Counts that overflow their loops: drift_samples = usize::MAX made the drift check
+    // report "t = NaN" (drift_samples + 1 wrapped to 0).
+    for (name, set) in [
+        (
+            "drift_samples",
+            (|s, v| s.drift_samples = v) as fn(&mut Settings<f64>, usize),
+        ),
+        ("exit_samples", |s, v| s.exit_samples = v),
+    ] {
+        for v in [usize::MAX, 1_000_001] {
+            let mut s = base;
+            set(&mut s, v);
+            let err = s.validate().unwrap_err();
+            assert_eq!(err.name, name, "{err}");
+            assert_eq!(err.value, v as f64, "{err}");
+        }
+        let mut s = base;
+        set(&mut s, 1_000_000);
+        assert!(s.validate().is_ok(), "{name} = 10⁶");
+    }
 }

@@ -152,7 +152,7 @@ pub use friction::CoulombFriction;
 pub use load::RelayLoad;
 pub use relay::LinearRelay;
 pub use run::{
-    FilippovRun, FilippovSimulation, ModeTransition, Plain, Settings, SlidingObserver,
+    FilippovRun, FilippovSimulation, MAX_SAMPLES, ModeTransition, Plain, Settings, SlidingObserver,
     TransitionKind,
 };
 pub use system::{Filippov, Mode, Region, Switched};

@@ -187,21 +187,23 @@ pub struct Settings<T> {
     /// Absolute event-time tolerance (default 10⁻¹², plus 4·ε·|t|).
     pub event_tol: T,
     /// A normal rate `|∇H·F + ∂H/∂t|` below this times `‖∇H‖·‖F‖` is a tangency, decided
-    /// by the second-order test (default 10⁻⁹, at least `1000·ε`).
+    /// by the second-order test (default 10⁻⁹, at least `1000·ε`; in `(0, 1)`).
     pub tangency: T,
     /// Another surface within this (relative) of zero at an event is met at once: a
-    /// codimension-2 point (default 10⁻⁹, at least `1000·ε`).
+    /// codimension-2 point (default 10⁻⁹, at least `1000·ε`; in `(0, 1)`).
     pub coincidence: T,
     /// The largest relative `|H|` allowed while sliding, checked at step ends and at
     /// [`drift_samples`](Self::drift_samples) interior points of each step (default 10⁻⁹,
-    /// at least `1000·ε`;
+    /// at least `1000·ε`; in `(0, 1)`;
     /// a linear surface is held to rounding, a curved one to the local error between the
     /// projections at step ends).
     pub drift: T,
-    /// Interior points per sliding step at which the drift is checked (default 3).
+    /// Interior points per sliding step at which the drift is checked (default 3, at most
+    /// [`MAX_SAMPLES`]).
     pub drift_samples: usize,
     /// Interior samples per sliding step of the exit event `min(α, 1−α)` (default 3), so
-    /// that an excursion of `α` out of `[0, 1]` and back inside one step is found.
+    /// that an excursion of `α` out of `[0, 1]` and back inside one step is found (at most
+    /// [`MAX_SAMPLES`]).
     pub exit_samples: usize,
     /// The step cap per run (default 10⁸).
     pub max_steps: usize,
@@ -227,17 +229,53 @@ impl<T: Real> Default for Settings<T> {
     }
 }
 
+/// The largest [`Settings::drift_samples`] and [`Settings::exit_samples`]: a million
+/// samples per step is far beyond any use, and the bound keeps the sample loops' counts
+/// (`samples + 1` intervals) from overflowing.
+pub const MAX_SAMPLES: usize = 1_000_000;
+
 impl<T: Real> Settings<T> {
     /// Checks every setting.
     ///
+    /// - `event_tol` is finite and `> 0`.
+    /// - The relative tolerances `tangency`, `coincidence` and `drift` are in `(0, 1)`. At 1
+    ///   and above they no longer tell anything apart: by Cauchy–Schwarz
+    ///   `|∇H·F| ≤ ‖∇H‖·‖F‖`, so `tangency ≥ 1` makes every crossing of a fixed surface a
+    ///   tangency (decided by the second-order test alone); `coincidence ≥ 1` or
+    ///   `drift ≥ 1` accept `|H|` as large as the surface's scale
+    ///   `max(1, ‖∇H‖∞·‖x‖∞)` (the size of `H` over the state itself) as "on the surface".
+    /// - `drift_samples` and `exit_samples` are at most [`MAX_SAMPLES`]; `max_steps` and
+    ///   `max_stalls` are `> 0`.
+    ///
     /// # Errors
-    /// [`ParameterError`] naming the first setting that is not finite and positive (or,
-    /// for the counts, zero).
+    /// [`ParameterError`] naming the first setting that breaks its rule, with its value.
     pub fn validate(&self) -> std::result::Result<(), ParameterError> {
         positive("event_tol", self.event_tol)?;
-        positive("tangency", self.tangency)?;
-        positive("coincidence", self.coincidence)?;
-        positive("drift", self.drift)?;
+        for (name, value) in [
+            ("tangency", self.tangency),
+            ("coincidence", self.coincidence),
+            ("drift", self.drift),
+        ] {
+            if !(value > T::zero() && value < T::one()) {
+                return Err(ParameterError::new(
+                    name,
+                    to_f64(value),
+                    "in (0, 1) (a relative tolerance)",
+                ));
+            }
+        }
+        for (name, count) in [
+            ("drift_samples", self.drift_samples),
+            ("exit_samples", self.exit_samples),
+        ] {
+            if count > MAX_SAMPLES {
+                return Err(ParameterError::new(
+                    name,
+                    count as f64,
+                    "at most MAX_SAMPLES = 10⁶",
+                ));
+            }
+        }
         if self.max_steps == 0 {
             return Err(ParameterError::new("max_steps", 0.0, "> 0"));
         }
