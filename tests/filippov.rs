@@ -1779,6 +1779,76 @@ fn filippov_two_trajectory_in_f32_and_its_error_paths() {
 // ---------------------------------------------------------------------------------------
 // Decisions at the surface and the inputs they meet (issue 49).
 
+/// `H = x₀` with a moving part: `∂H/∂t = rate` (a closure may make it NaN).
+struct TimeRate(f64);
+
+impl Filippov<f64, 1, 1> for TimeRate {
+    fn surface(&self, _i: usize, _t: f64, x: &SVector<f64, 1>) -> f64 {
+        x[0]
+    }
+    fn gradient(&self, _i: usize, _t: f64, _x: &SVector<f64, 1>) -> SVector<f64, 1> {
+        SVector::from([1.0])
+    }
+    fn surface_time_rate(&self, _i: usize, _t: f64, _x: &SVector<f64, 1>) -> f64 {
+        self.0
+    }
+    fn field(&self, sides: &[Region; 1], _t: f64, _x: &SVector<f64, 1>, dx: &mut SVector<f64, 1>) {
+        dx[0] = match sides[0] {
+            Region::Minus => 1.0,
+            Region::Plus => 2.0,
+        };
+    }
+}
+
+#[test]
+fn a_non_finite_gradient_or_time_rate_at_a_decision_is_an_error() {
+    // H = x₀, F₋ = 1, F₊ = 2 from x = −1: a plain crossing at t = 1, x(2) = 2. A NaN
+    // gradient made every rate NaN; the decision took NaN for a tangency with an
+    // inconclusive second-order test, stayed below, and returned x(2) = 1.
+    let nan_gradient = Switched::new(
+        |x: &SVector<f64, 1>| x[0],
+        |_x: &SVector<f64, 1>| SVector::from([f64::NAN]),
+        |_t, _x: &SVector<f64, 1>| SVector::from([1.0]),
+        |_t, _x: &SVector<f64, 1>| SVector::from([2.0]),
+    );
+    let tol = Tolerances::new(1e-10, 1e-12).unwrap();
+    let r = FilippovSimulation::new(nan_gradient, Dopri5::new(tol)).run(
+        0.0,
+        SVector::from([-1.0]),
+        2.0,
+        &mut (),
+    );
+    match &r {
+        Err(e @ FilippovError::NonFinite { surface: 0, .. }) => {
+            let msg = e.to_string();
+            assert!(msg.contains("gradient") && msg.contains("NaN"), "{msg}");
+        }
+        other => panic!("expected NonFinite, got {other:?}"),
+    }
+    // The same with a finite gradient and a time rate ∂H/∂t = 0 crosses: x(2) = 2.
+    let mut sim = FilippovSimulation::new(TimeRate(0.0), Dopri5::new(tol));
+    let run = sim.run(0.0, SVector::from([-1.0]), 2.0, &mut ()).unwrap();
+    assert!((run.x[0] - 2.0).abs() < 1e-9, "{:?}", run.x);
+    // A time rate that is NaN or infinite is named at the decision, and at a start on the
+    // surface.
+    for rate in [f64::NAN, f64::INFINITY] {
+        for x0 in [-1.0, 0.0] {
+            let r = FilippovSimulation::new(TimeRate(rate), Dopri5::new(tol)).run(
+                0.0,
+                SVector::from([x0]),
+                2.0,
+                &mut (),
+            );
+            match &r {
+                Err(e @ FilippovError::NonFinite { surface: 0, .. }) => {
+                    assert!(e.to_string().contains("∂H/∂t"), "{e}");
+                }
+                other => panic!("rate {rate}, x0 {x0}: expected NonFinite, got {other:?}"),
+            }
+        }
+    }
+}
+
 #[test]
 fn settings_outside_their_meaningful_range_are_named() {
     let sim = FilippovSimulation::new(Corner, Dopri5::new(tol2()));

@@ -33,6 +33,9 @@
 //! far side that turns back into the surface (`h₊ = 0`, `L²_{F₊}H < 0`) makes the state
 //! slide, and an exit where `α` only touches a bound (`L²H` pointing back) goes on sliding.
 //!
+//! Every quantity a decision reads (`H`, `∇H`, `∂_t H`, `h±`, `L²H`) must be finite; one
+//! that is not stops the run with [`FilippovError::NonFinite`] naming it.
+//!
 //! **Drift**: `∇H·F_s = −∂_t H` holds at every stage of a step, so for a linear surface a
 //! Runge–Kutta step keeps `H` constant to rounding; for a curved one the state is projected
 //! back onto `H = 0` (Newton steps along `∇H`) at every step end. `|H|` is checked on the

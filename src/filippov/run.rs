@@ -5,7 +5,7 @@
 use nalgebra::SVector;
 
 use super::error::{FilippovError, Result};
-use super::field::{ModeField, band, departure, project, rates, scale, with_side};
+use super::field::{ModeField, band, departure, project, rates, rates_checked, scale, with_side};
 use super::system::{Filippov, Mode, Region};
 use crate::Real;
 use crate::drive::{Control, EventRecord, Observer, Scan, StepView, Termination};
@@ -363,10 +363,10 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
     where
         Sys: Filippov<T, N, S>,
     {
-        let r = rates(&self.system, i, sides, t, x);
+        let r = rates_checked(&self.system, i, sides, t, x)?;
         let tang = self.settings.tangency;
-        let sm = departure(&self.system, i, sides, Region::Minus, (t, x), &r, tang);
-        let sp = departure(&self.system, i, sides, Region::Plus, (t, x), &r, tang);
+        let sm = departure(&self.system, i, sides, Region::Minus, (t, x), &r, tang)?;
+        let sp = departure(&self.system, i, sides, Region::Plus, (t, x), &r, tang)?;
         let repelling = || FilippovError::Repelling {
             t: to_f64(t),
             surface: i,
@@ -407,7 +407,8 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
     /// the side both move the state to (the second-order test at a tangency).
     ///
     /// # Errors
-    /// [`FilippovError::NonFinite`] for a non-finite `H_i`; [`FilippovError::Codimension2`]
+    /// [`FilippovError::NonFinite`] for a non-finite `H_i` or `∇H_i`, or, on a surface, a
+    /// non-finite rate the decision reads; [`FilippovError::Codimension2`]
     /// on two surfaces at once; [`FilippovError::Repelling`] on a surface both fields leave;
     /// [`FilippovError::Degenerate`] where both are tangent to second order.
     pub fn mode_at<const N: usize, const S: usize>(
@@ -421,8 +422,7 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
         let mut sides = [Region::Plus; S];
         let mut on: Option<usize> = None;
         for (i, side) in sides.iter_mut().enumerate() {
-            let h = self.surface_checked(i, t, x)?;
-            let grad = self.system.gradient(i, t, x);
+            let (h, grad) = self.surface_checked(i, t, x)?;
             let tol = band::<T>() * scale(&grad, x);
             if h.abs() <= tol {
                 if let Some(first) = on {
@@ -449,24 +449,34 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
         })
     }
 
+    /// `H_i` and `∇H_i` at `(t, x)`.
+    ///
+    /// # Errors
+    /// [`FilippovError::NonFinite`] unless both are finite.
     fn surface_checked<const N: usize, const S: usize>(
         &self,
         i: usize,
         t: T,
         x: &SVector<T, N>,
-    ) -> Result<T>
+    ) -> Result<(T, SVector<T, N>)>
     where
         Sys: Filippov<T, N, S>,
     {
         let h = self.system.surface(i, t, x);
+        let grad = self.system.gradient(i, t, x);
+        let bad = |quantity, value: T| FilippovError::NonFinite {
+            t: to_f64(t),
+            surface: i,
+            quantity,
+            value: to_f64(value),
+        };
         if !h.is_finite() {
-            return Err(FilippovError::NonFinite {
-                t: to_f64(t),
-                surface: i,
-                value: to_f64(h),
-            });
+            return Err(bad("the value H", h));
         }
-        Ok(h)
+        if let Some(g) = grad.iter().find(|g| !g.is_finite()) {
+            return Err(bad("the gradient ∇H", *g));
+        }
+        Ok((h, grad))
     }
 
     /// The next mode after the terminal event `k` of `mode` at `(t, x)`, with the
@@ -495,8 +505,7 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
             }
             // α left [0, 1]: exit to the side of the bound reached, if that field moves
             // the state off the surface (second-order test at the tangency).
-            let r = rates(&self.system, i, &mode.sides, t, x);
-            let a = r.alpha();
+            let a = rates_checked(&self.system, i, &mode.sides, t, x)?.alpha();
             let slack = lit::<T>(1e3) * self.settings.tangency;
             let clearly_out = a < -slack || a > T::one() + slack;
             let target = if a < lit(0.5) {
@@ -505,7 +514,7 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
                 Region::Plus
             };
             project(&self.system, i, t, x);
-            let r2 = rates(&self.system, i, &mode.sides, t, x);
+            let r2 = rates_checked(&self.system, i, &mode.sides, t, x)?;
             let s = departure(
                 &self.system,
                 i,
@@ -514,7 +523,7 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
                 (t, x),
                 &r2,
                 self.settings.tangency,
-            );
+            )?;
             if !clearly_out && (s == 0 || (s > 0) != (target == Region::Plus)) {
                 return Ok((mode, i, TransitionKind::Graze));
             }
@@ -526,8 +535,8 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
         }
         // A surface reached from the mode's side: first, no other surface there.
         for j in (0..S).filter(|&j| j != k) {
-            let h = self.surface_checked(j, t, x)?;
-            let tol = self.settings.coincidence * scale(&self.system.gradient(j, t, x), x);
+            let (h, grad) = self.surface_checked(j, t, x)?;
+            let tol = self.settings.coincidence * scale(&grad, x);
             if h.abs() <= tol {
                 return Err(FilippovError::Codimension2 {
                     t: to_f64(t),
@@ -590,7 +599,9 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
     /// [`FilippovError::Codimension2`] where two surfaces are met at once;
     /// [`FilippovError::Repelling`] / [`FilippovError::Degenerate`] where no side can be
     /// chosen; [`FilippovError::Drift`] if sliding leaves its surface by more than the drift
-    /// tolerance; [`FilippovError::NoProgress`] if transitions repeat at one instant.
+    /// tolerance; [`FilippovError::NoProgress`] if transitions repeat at one instant;
+    /// [`FilippovError::NonFinite`] where a surface's value, gradient or time rate, or a
+    /// rate a decision reads, is not finite.
     pub fn run<const N: usize, const S: usize, O: SlidingObserver<T, N, S>>(
         &mut self,
         t0: T,
@@ -838,7 +849,8 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
     /// and [`Settings::drift_samples`] interior points).
     ///
     /// # Errors
-    /// [`FilippovError::Drift`] if it exceeds [`Settings::drift`].
+    /// [`FilippovError::Drift`] if it exceeds [`Settings::drift`];
+    /// [`FilippovError::NonFinite`] if `H_i` or `∇H_i` is not finite at a sample.
     fn drift_on_step<const N: usize, const S: usize>(&self, i: usize, ta: T, tb: T) -> Result<T>
     where
         Sys: Filippov<T, N, S>,
@@ -854,6 +866,8 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
             let h = self.system.surface(i, t, &y);
             let rel = h.abs() / scale(&self.system.gradient(i, t, &y), &y);
             if !(rel <= self.settings.drift) {
+                // Not finite is not a drift: check H and ∇H here, off the common path.
+                self.surface_checked(i, t, &y)?;
                 return Err(FilippovError::Drift {
                     t: to_f64(t),
                     surface: i,
