@@ -1779,6 +1779,43 @@ fn filippov_two_trajectory_in_f32_and_its_error_paths() {
 // ---------------------------------------------------------------------------------------
 // Decisions at the surface and the inputs they meet (issue 49).
 
+#[test]
+fn a_slow_crossing_below_the_tangency_tolerance_crosses() {
+    // H = x₀. Below, F₋ = (1e-10, 1); above, F₊ = (1, 0). From (−1e-10, 0) the state
+    // reaches x₀ = 0 at t = 1 (x₁ = 1) with the normal rate h₋ = 1e-10, below the tangency
+    // tolerance (1e-9·‖∇H‖·‖F₋‖ ≈ 1e-9). F₋ is constant, so the second-order rate is 0:
+    // no test of order two can decide, and the state, which arrived at the rate h₋ > 0,
+    // goes on through the surface, where F₊ (h₊ = 1) carries it on: a crossing. Then
+    // x = (t − 1, 1), so x(2) = (1, 1). Before, the arrival was taken for a graze and the
+    // run went on with F₋ inside H > 0 to x(2) = (1e-10, 2).
+    //
+    // How close: the event is located where H leaves the rounding band of the surface
+    // (|H| ≤ 16ε, within which a state counts as on its mode's side), reached at the rate
+    // 1e-10: 16ε/1e-10 ≈ 3.6e-5 after t = 1. The crossing's place is exact to 16ε, its
+    // time (and so x(2), moved by F₊ − F₋ over that time) to 3.6e-5.
+    let slow = Switched::new(
+        |x: &SVector<f64, 2>| x[0],
+        |_x: &SVector<f64, 2>| SVector::from([1.0, 0.0]),
+        |_t, _x: &SVector<f64, 2>| SVector::from([1e-10, 1.0]),
+        |_t, _x: &SVector<f64, 2>| SVector::from([1.0, 0.0]),
+    );
+    let mut sim = FilippovSimulation::new(slow, Dopri5::new(tol2()));
+    let run = sim
+        .run(0.0, SVector::from([-1e-10, 0.0]), 2.0, &mut ())
+        .unwrap();
+    assert_eq!(run.transitions.len(), 1, "{:?}", run.transitions);
+    let tr = run.transitions[0];
+    assert_eq!(tr.kind, TransitionKind::Crossing, "{tr:?}");
+    assert_eq!(run.mode.sides, [Region::Plus]);
+    let late = 16.0 * f64::EPSILON / 1e-10;
+    assert!(tr.t >= 1.0 - 1e-12 && tr.t - 1.0 <= 1.01 * late, "{}", tr.t);
+    assert!(
+        (run.x[0] - 1.0).abs() <= 1.01 * late && (run.x[1] - 1.0).abs() <= 1.01 * late,
+        "{:?}",
+        run.x
+    );
+}
+
 /// `H = x₀` with a moving part: `∂H/∂t = rate` (a closure may make it NaN).
 struct TimeRate(f64);
 

@@ -164,10 +164,28 @@ where
     Ok(r)
 }
 
-/// The sign with which the field of `side` moves the state off surface `i` from `(t, x)`:
-/// the sign of `h = ∇H·F + ∂H/∂t` where `|h|` exceeds `tangency` times `‖∇H‖·‖F‖`, else
-/// (a tangency) the sign of the second derivative `L²_F H = d/dt (∇H·F + ∂H/∂t)` along `F`
-/// (central differences), 0 if that vanishes too.
+/// The sign with which the field `F` of `side` moves the state off surface `i` from
+/// `(t, x)`, with `h = ∇H·F + ∂H/∂t` its normal rate (`rates`, finite):
+/// 1. **transversal**: `sgn h` where `|h| > tangency·‖∇H‖·‖F‖`;
+/// 2. **tangency** (`|h|` within that band): the sign of the second-order rate
+///    `L²_F H = d/dt (∇H·F + ∂H/∂t)` along `F` (a central difference over `t₊ − t₋`), where
+///    `|L²_F H| > ρ`, its rounding (below);
+/// 3. **inconclusive** second order (zero, or within its rounding): `sgn h` — a state that
+///    reached the surface at the rate `h ≠ 0` goes on that way, as the flow of `F` does
+///    when nothing of second order turns it back (a slow crossing, not a graze); 0 only if
+///    `h = 0` as well.
+///
+/// The rounding of the central difference is that of the two rates it is the difference
+/// of, over its span:
+/// $$ \rho = \frac{64\,\varepsilon\,(\lVert\nabla H\rVert\lVert F\rVert
+///    + |\partial_t H|)}{t_+ - t_-}. $$
+///
+/// A second-order rate above its rounding that opposes `h` decides (rule 2): inside the
+/// tangency band the flow of `F` goes past the surface by at most `h²/(2|L²_F H|)` before
+/// it turns back, and the tangency setting is the size of rate below which that touch is
+/// taken for a graze. One within its rounding says nothing about the turn, and with it the
+/// state would be held on the wrong side of the surface for as long as `F` takes to bring
+/// it back (forever for a constant field), so it does not decide (rule 3).
 ///
 /// # Errors
 /// [`FilippovError::NonFinite`] if the second-order rate is not finite (a field or
@@ -216,7 +234,13 @@ where
             value: to_f64(second),
         });
     }
-    Ok(sign(second))
+    let (up, down) = crate::excite::difference_points(t, scale);
+    let rounding = lit::<T>(64.0) * T::default_epsilon() * (size + rates.h_t.abs()) / (up - down);
+    Ok(if second.abs() > rounding {
+        sign(second)
+    } else {
+        sign(h)
+    })
 }
 
 /// Moves `x` onto `H_i = 0` along `∇H` (Newton steps `x ← x − H ∇H/‖∇H‖²`) until `|H|` is

@@ -32,6 +32,10 @@
 //! so a grazing arrival (`h₋ = 0`, `L²H < 0`) stays in its region, a field tangent on the
 //! far side that turns back into the surface (`h₊ = 0`, `L²_{F₊}H < 0`) makes the state
 //! slide, and an exit where `α` only touches a bound (`L²H` pointing back) goes on sliding.
+//! Where the second-order test is inconclusive (`L²H` zero, or within the rounding of the
+//! central difference it is computed by) the first-order sign decides: a state that reached
+//! the surface at a rate below the tolerance but not zero, with nothing of second order to
+//! turn it back (a constant field), crosses, as the flow does.
 //!
 //! Every quantity a decision reads (`H`, `∇H`, `∂_t H`, `h±`, `L²H`) must be finite; one
 //! that is not stops the run with [`FilippovError::NonFinite`] naming it.

@@ -187,7 +187,8 @@ pub struct Settings<T> {
     /// Absolute event-time tolerance (default 10⁻¹², plus 4·ε·|t|).
     pub event_tol: T,
     /// A normal rate `|∇H·F + ∂H/∂t|` below this times `‖∇H‖·‖F‖` is a tangency, decided
-    /// by the second-order test (default 10⁻⁹, at least `1000·ε`; in `(0, 1)`).
+    /// by the second-order test where that is conclusive, else by the rate's sign (see the
+    /// [module docs](super); default 10⁻⁹, at least `1000·ε`; in `(0, 1)`).
     pub tangency: T,
     /// Another surface within this (relative) of zero at an event is met at once: a
     /// codimension-2 point (default 10⁻⁹, at least `1000·ε`; in `(0, 1)`).
