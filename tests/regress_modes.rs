@@ -12,7 +12,7 @@ use nonsmooth::drive::{
     Control, Coulomb, EventRecord, ModeError, Observer, SlipMode, StepView, StickSlip, run_modes,
     run_with_sticking,
 };
-use nonsmooth::event::{Direction, Event, Gap, NewtonImpact};
+use nonsmooth::event::{Direction, Event, EventError, Gap, NewtonImpact};
 use nonsmooth::excite::{Constant, Excitation, Harmonic};
 use nonsmooth::force::{LinearSpring, ViscousDamper};
 use nonsmooth::integrate::{DenseOutput, Dopri5, IntegrateError, Tolerances};
@@ -735,4 +735,57 @@ fn a_run_that_needs_more_steps_than_the_cap_fails_up_front() {
         matches!(r, Err(RunError::Integrate(IntegrateError::WorkExceedsCap { needed, .. })) if needed > 1e8),
         "{r:?}"
     );
+}
+
+// ---------------------------------------------------------------------------------------
+// Issue 49: simultaneous contacts at the start.
+
+#[test]
+fn touching_balls_at_the_start_name_the_time_stepper() {
+    // Newton's cradle of three unit balls on a line, touching (the positions are measured
+    // from each ball's place in the chain, so every gap is 0), the first moving at 1 m/s
+    // into the others, e = 1. Ball i hits ball i + 1 when g_i = x_i − x_{i+1} rises
+    // through 0. Both contacts are closed at the start and the first is being struck: a
+    // simultaneous impact, whose outcome depends on how the impulses are shared (Moreau's
+    // LCP gives (−1/3, 2/3, 2/3), a sequence (0, 0, 1)). Before, the run stopped after its
+    // first step with an error calling it sticking.
+    let model = Mechanical::with_masses([1.0; 3]).unwrap();
+    let contact = |i: usize| {
+        let gap = Gap::below(Coordinate::relative(i, i + 1).unwrap(), ());
+        let impact = NewtonImpact::new(gap, 1.0, model.mass_matrix()).unwrap();
+        Event::new(gap, Direction::Rising).with_reset(impact)
+    };
+    let tol = Tolerances::<f64, 6>::new(1e-10, 1e-12).unwrap();
+    let mut sim = Simulation::new(model, Dopri5::new(tol)).with_events((contact(0), contact(1)));
+    let y0 = SVector::from([0.0, 0.0, 0.0, 1.0, 0.0, 0.0]);
+    let r = sim.run(0.0, y0, 1.0, &mut ());
+    match &r {
+        Err(
+            e @ RunError::Event(EventError::SimultaneousContacts {
+                t,
+                moving,
+                other,
+                rate,
+            }),
+        ) => {
+            assert_eq!((*t, *moving, *other, *rate), (0.0, 0, 1, 1.0));
+            let msg = e.to_string();
+            assert!(
+                msg.contains("nonsmooth::timestep::MoreauJean") && !msg.contains("sticking"),
+                "{msg}"
+            );
+        }
+        other => panic!("expected SimultaneousContacts, got {other:?}"),
+    }
+    // Spaced by 1 cm the impacts come one at a time: the textbook cradle, (0, 0, 1).
+    let spaced = SVector::from([-0.02, -0.01, 0.0, 1.0, 0.0, 0.0]);
+    let out = sim.run(0.0, spaced, 1.0, &mut ()).unwrap();
+    let v = [out.y[3], out.y[4], out.y[5]];
+    assert!(
+        v[0].abs() < 1e-12 && v[1].abs() < 1e-12 && (v[2] - 1.0).abs() < 1e-12,
+        "{v:?}"
+    );
+    // Touching but at rest: nothing is struck, the run goes on.
+    let rest = SVector::from([0.0, 0.0, 0.0, 0.0, 0.0, 0.0]);
+    assert!(sim.run(0.0, rest, 1.0, &mut ()).is_ok());
 }
