@@ -738,7 +738,7 @@ fn a_run_that_needs_more_steps_than_the_cap_fails_up_front() {
 }
 
 // ---------------------------------------------------------------------------------------
-// Issue 49: simultaneous contacts at the start.
+// Issue 49: simultaneous contacts at the start, a contact without friction.
 
 #[test]
 fn touching_balls_at_the_start_name_the_time_stepper() {
@@ -788,4 +788,94 @@ fn touching_balls_at_the_start_name_the_time_stepper() {
     // Touching but at rest: nothing is struck, the run goes on.
     let rest = SVector::from([0.0, 0.0, 0.0, 0.0, 0.0, 0.0]);
     assert!(sim.run(0.0, rest, 1.0, &mut ()).is_ok());
+}
+
+#[test]
+fn a_block_on_a_belt_without_friction_moves_as_a_free_oscillator() {
+    // m = 2, k = 8, belt at 0.5 m/s, F_s = F_k = 0, started "stuck" at x = 0 moving with the
+    // belt (the force needed to hold it, k x = 0, is within the static limit 0). Without
+    // friction there is no stick: x = (u/ω) sin ωt, ω = √(k/m) = 2, v = u cos ωt. Before,
+    // the block stayed stuck: x(10) = 5 with the spring pulling 40 N, no transition (the
+    // stick's end |λ| − F_s = |λ| only touches 0, at t = 0).
+    let model = Mechanical::with_masses([2.0])
+        .unwrap()
+        .with_elements(Element::on_dof(0, LinearSpring::new(8.0).unwrap()).unwrap());
+    let friction = Coulomb::new(
+        Coordinate::dof(0).unwrap(),
+        Constant::new(0.5).unwrap(),
+        0.0,
+        0.0,
+    )
+    .unwrap();
+    let mut system = StickSlip::new(&model, friction, || Dopri5::new(tol()));
+    let exact = |t: f64| (0.25 * (2.0 * t).sin(), 0.5 * (2.0 * t).cos());
+    let mut modes = Between::new(0.05, |mode, t, y| {
+        // Every sample on the free flow (and never in the stick mode).
+        let (x, v) = exact(t);
+        let off = (y[0] - x).abs().max((y[1] - v).abs());
+        if mode == "stick" { f64::INFINITY } else { off }
+    });
+    let run = run_modes(
+        &mut system,
+        SlipMode::Stick,
+        0.0,
+        SVector::from([0.0, 0.5]),
+        10.0,
+        100,
+        &mut modes,
+    )
+    .unwrap();
+    let (x, v) = exact(10.0);
+    assert!(
+        (run.outcome.y[0] - x).abs() < 1e-8 && (run.outcome.y[1] - v).abs() < 1e-8,
+        "{:?} vs ({x}, {v}); transitions {:?}",
+        run.outcome.y,
+        run.transitions
+    );
+    assert!(
+        modes.worst < 1e-8,
+        "{} at {:?}",
+        modes.worst,
+        modes.worst_at
+    );
+    assert!(run.transitions.iter().all(|&(_, m)| m != SlipMode::Stick));
+    // Started in slip from the same state: the same flow.
+    let slip = run_modes(
+        &mut system,
+        SlipMode::Backward,
+        0.0,
+        SVector::from([0.0, 0.5]),
+        10.0,
+        100,
+        &mut (),
+    )
+    .unwrap();
+    assert!(
+        (slip.outcome.y[0] - x).abs() < 1e-8 && (slip.outcome.y[1] - v).abs() < 1e-8,
+        "{:?}",
+        slip.outcome.y
+    );
+    // 1e-9 faster than the belt: v_r = (u + 1e-9) cos 2t − u crosses 0 near t = 0 and
+    // rises 1e-9 above it around t = π. Each zero of v_r ended a slip segment and the next
+    // began at v_r = 0 exactly, where a first step of 5e-13 left v_r at 0 (the increment
+    // below the rounding of u) and ended the segment again: 100 segments at t = π − 3e-5,
+    // a Zeno error. Without friction nothing changes at v_r = 0: one free segment.
+    let v0 = 0.5 + 1e-9;
+    let fast = run_modes(
+        &mut system,
+        SlipMode::Forward,
+        0.0,
+        SVector::from([0.0, v0]),
+        10.0,
+        100,
+        &mut (),
+    )
+    .unwrap();
+    let (x, v) = (v0 / 2.0 * 20.0f64.sin(), v0 * 20.0f64.cos());
+    assert!(
+        (fast.outcome.y[0] - x).abs() < 1e-8 && (fast.outcome.y[1] - v).abs() < 1e-8,
+        "{:?} vs ({x}, {v})",
+        fast.outcome.y
+    );
+    assert!(fast.transitions.is_empty(), "{:?}", fast.transitions);
 }
