@@ -7,8 +7,8 @@ use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 use nonsmooth::drive::{Coulomb, SlipMode, StepView, StickSlip, run_modes};
 use nonsmooth::excite::{Constant, Harmonic};
 use nonsmooth::filippov::{
-    Filippov, FilippovError, FilippovSimulation, Mode, ModeTransition, Region, SlidingObserver,
-    Switched, TransitionKind,
+    Filippov, FilippovError, FilippovSimulation, Mode, ModeTransition, Region, Settings,
+    SlidingObserver, Switched, TransitionKind,
 };
 use nonsmooth::force::LinearSpring;
 use nonsmooth::integrate::{DenseOutput, Dopri5, Tolerances};
@@ -1774,4 +1774,167 @@ fn filippov_two_trajectory_in_f32_and_its_error_paths() {
         ),
         "expected a repelling-surface error"
     );
+}
+
+// ---------------------------------------------------------------------------------------
+// Decisions at the surface and the inputs they meet (issue 49).
+
+#[test]
+fn a_slow_crossing_below_the_tangency_tolerance_crosses() {
+    // H = x₀. Below, F₋ = (1e-10, 1); above, F₊ = (1, 0). From (−1e-10, 0) the state
+    // reaches x₀ = 0 at t = 1 (x₁ = 1) with the normal rate h₋ = 1e-10, below the tangency
+    // tolerance (1e-9·‖∇H‖·‖F₋‖ ≈ 1e-9). F₋ is constant, so the second-order rate is 0:
+    // no test of order two can decide, and the state, which arrived at the rate h₋ > 0,
+    // goes on through the surface, where F₊ (h₊ = 1) carries it on: a crossing. Then
+    // x = (t − 1, 1), so x(2) = (1, 1). Before, the arrival was taken for a graze and the
+    // run went on with F₋ inside H > 0 to x(2) = (1e-10, 2).
+    //
+    // How close: the event is located where H leaves the rounding band of the surface
+    // (|H| ≤ 16ε, within which a state counts as on its mode's side), reached at the rate
+    // 1e-10: 16ε/1e-10 ≈ 3.6e-5 after t = 1. The crossing's place is exact to 16ε, its
+    // time (and so x(2), moved by F₊ − F₋ over that time) to 3.6e-5.
+    let slow = Switched::new(
+        |x: &SVector<f64, 2>| x[0],
+        |_x: &SVector<f64, 2>| SVector::from([1.0, 0.0]),
+        |_t, _x: &SVector<f64, 2>| SVector::from([1e-10, 1.0]),
+        |_t, _x: &SVector<f64, 2>| SVector::from([1.0, 0.0]),
+    );
+    let mut sim = FilippovSimulation::new(slow, Dopri5::new(tol2()));
+    let run = sim
+        .run(0.0, SVector::from([-1e-10, 0.0]), 2.0, &mut ())
+        .unwrap();
+    assert_eq!(run.transitions.len(), 1, "{:?}", run.transitions);
+    let tr = run.transitions[0];
+    assert_eq!(tr.kind, TransitionKind::Crossing, "{tr:?}");
+    assert_eq!(run.mode.sides, [Region::Plus]);
+    let late = 16.0 * f64::EPSILON / 1e-10;
+    assert!(tr.t >= 1.0 - 1e-12 && tr.t - 1.0 <= 1.01 * late, "{}", tr.t);
+    assert!(
+        (run.x[0] - 1.0).abs() <= 1.01 * late && (run.x[1] - 1.0).abs() <= 1.01 * late,
+        "{:?}",
+        run.x
+    );
+}
+
+/// `H = x₀` with a moving part: `∂H/∂t = rate` (a closure may make it NaN).
+struct TimeRate(f64);
+
+impl Filippov<f64, 1, 1> for TimeRate {
+    fn surface(&self, _i: usize, _t: f64, x: &SVector<f64, 1>) -> f64 {
+        x[0]
+    }
+    fn gradient(&self, _i: usize, _t: f64, _x: &SVector<f64, 1>) -> SVector<f64, 1> {
+        SVector::from([1.0])
+    }
+    fn surface_time_rate(&self, _i: usize, _t: f64, _x: &SVector<f64, 1>) -> f64 {
+        self.0
+    }
+    fn field(&self, sides: &[Region; 1], _t: f64, _x: &SVector<f64, 1>, dx: &mut SVector<f64, 1>) {
+        dx[0] = match sides[0] {
+            Region::Minus => 1.0,
+            Region::Plus => 2.0,
+        };
+    }
+}
+
+#[test]
+fn a_non_finite_gradient_or_time_rate_at_a_decision_is_an_error() {
+    // H = x₀, F₋ = 1, F₊ = 2 from x = −1: a plain crossing at t = 1, x(2) = 2. A NaN
+    // gradient made every rate NaN; the decision took NaN for a tangency with an
+    // inconclusive second-order test, stayed below, and returned x(2) = 1.
+    let nan_gradient = Switched::new(
+        |x: &SVector<f64, 1>| x[0],
+        |_x: &SVector<f64, 1>| SVector::from([f64::NAN]),
+        |_t, _x: &SVector<f64, 1>| SVector::from([1.0]),
+        |_t, _x: &SVector<f64, 1>| SVector::from([2.0]),
+    );
+    let tol = Tolerances::new(1e-10, 1e-12).unwrap();
+    let r = FilippovSimulation::new(nan_gradient, Dopri5::new(tol)).run(
+        0.0,
+        SVector::from([-1.0]),
+        2.0,
+        &mut (),
+    );
+    match &r {
+        Err(e @ FilippovError::NonFinite { surface: 0, .. }) => {
+            let msg = e.to_string();
+            assert!(msg.contains("gradient") && msg.contains("NaN"), "{msg}");
+        }
+        other => panic!("expected NonFinite, got {other:?}"),
+    }
+    // The same with a finite gradient and a time rate ∂H/∂t = 0 crosses: x(2) = 2.
+    let mut sim = FilippovSimulation::new(TimeRate(0.0), Dopri5::new(tol));
+    let run = sim.run(0.0, SVector::from([-1.0]), 2.0, &mut ()).unwrap();
+    assert!((run.x[0] - 2.0).abs() < 1e-9, "{:?}", run.x);
+    // A time rate that is NaN or infinite is named at the decision, and at a start on the
+    // surface.
+    for rate in [f64::NAN, f64::INFINITY] {
+        for x0 in [-1.0, 0.0] {
+            let r = FilippovSimulation::new(TimeRate(rate), Dopri5::new(tol)).run(
+                0.0,
+                SVector::from([x0]),
+                2.0,
+                &mut (),
+            );
+            match &r {
+                Err(e @ FilippovError::NonFinite { surface: 0, .. }) => {
+                    assert!(e.to_string().contains("∂H/∂t"), "{e}");
+                }
+                other => panic!("rate {rate}, x0 {x0}: expected NonFinite, got {other:?}"),
+            }
+        }
+    }
+}
+
+#[test]
+fn settings_outside_their_meaningful_range_are_named() {
+    let sim = FilippovSimulation::new(Corner, Dopri5::new(tol2()));
+    let base = *sim.settings();
+    // A relative tolerance ≥ 1 is no tolerance: |∇H·F| ≤ ‖∇H‖·‖F‖, so tangency = 1e300
+    // made every crossing a tangency (accepted before).
+    for (name, set) in [
+        (
+            "tangency",
+            (|s, v| s.tangency = v) as fn(&mut Settings<f64>, f64),
+        ),
+        ("coincidence", |s, v| s.coincidence = v),
+        ("drift", |s, v| s.drift = v),
+    ] {
+        for v in [1.0, 1e300, f64::INFINITY, f64::NAN, 0.0, -1e-9] {
+            let mut s = base;
+            set(&mut s, v);
+            let err = FilippovSimulation::new(Corner, Dopri5::new(tol2()))
+                .with_settings(s)
+                .err()
+                .unwrap_or_else(|| panic!("{name} = {v} accepted"));
+            assert_eq!(
+                (err.name, err.value.to_bits()),
+                (name, v.to_bits()),
+                "{err}"
+            );
+        }
+        let mut s = base;
+        set(&mut s, 0.5);
+        assert!(s.validate().is_ok(), "{name} = 0.5");
+    }
+    // Counts that overflow their loops: drift_samples = usize::MAX made the drift check
+    // report "t = NaN" (drift_samples + 1 wrapped to 0).
+    for (name, set) in [
+        (
+            "drift_samples",
+            (|s, v| s.drift_samples = v) as fn(&mut Settings<f64>, usize),
+        ),
+        ("exit_samples", |s, v| s.exit_samples = v),
+    ] {
+        for v in [usize::MAX, 1_000_001] {
+            let mut s = base;
+            set(&mut s, v);
+            let err = s.validate().unwrap_err();
+            assert_eq!(err.name, name, "{err}");
+            assert_eq!(err.value, v as f64, "{err}");
+        }
+        let mut s = base;
+        set(&mut s, 1_000_000);
+        assert!(s.validate().is_ok(), "{name} = 10⁶");
+    }
 }

@@ -12,7 +12,7 @@ use nonsmooth::drive::{
     Control, Coulomb, EventRecord, ModeError, Observer, SlipMode, StepView, StickSlip, run_modes,
     run_with_sticking,
 };
-use nonsmooth::event::{Direction, Event, Gap, NewtonImpact};
+use nonsmooth::event::{Direction, Event, EventError, Gap, NewtonImpact};
 use nonsmooth::excite::{Constant, Excitation, Harmonic};
 use nonsmooth::force::{LinearSpring, ViscousDamper};
 use nonsmooth::integrate::{DenseOutput, Dopri5, IntegrateError, Tolerances};
@@ -735,4 +735,147 @@ fn a_run_that_needs_more_steps_than_the_cap_fails_up_front() {
         matches!(r, Err(RunError::Integrate(IntegrateError::WorkExceedsCap { needed, .. })) if needed > 1e8),
         "{r:?}"
     );
+}
+
+// ---------------------------------------------------------------------------------------
+// Issue 49: simultaneous contacts at the start, a contact without friction.
+
+#[test]
+fn touching_balls_at_the_start_name_the_time_stepper() {
+    // Newton's cradle of three unit balls on a line, touching (the positions are measured
+    // from each ball's place in the chain, so every gap is 0), the first moving at 1 m/s
+    // into the others, e = 1. Ball i hits ball i + 1 when g_i = x_i − x_{i+1} rises
+    // through 0. Both contacts are closed at the start and the first is being struck: a
+    // simultaneous impact, whose outcome depends on how the impulses are shared (Moreau's
+    // LCP gives (−1/3, 2/3, 2/3), a sequence (0, 0, 1)). Before, the run stopped after its
+    // first step with an error calling it sticking.
+    let model = Mechanical::with_masses([1.0; 3]).unwrap();
+    let contact = |i: usize| {
+        let gap = Gap::below(Coordinate::relative(i, i + 1).unwrap(), ());
+        let impact = NewtonImpact::new(gap, 1.0, model.mass_matrix()).unwrap();
+        Event::new(gap, Direction::Rising).with_reset(impact)
+    };
+    let tol = Tolerances::<f64, 6>::new(1e-10, 1e-12).unwrap();
+    let mut sim = Simulation::new(model, Dopri5::new(tol)).with_events((contact(0), contact(1)));
+    let y0 = SVector::from([0.0, 0.0, 0.0, 1.0, 0.0, 0.0]);
+    let r = sim.run(0.0, y0, 1.0, &mut ());
+    match &r {
+        Err(
+            e @ RunError::Event(EventError::SimultaneousContacts {
+                t,
+                moving,
+                other,
+                rate,
+            }),
+        ) => {
+            assert_eq!((*t, *moving, *other, *rate), (0.0, 0, 1, 1.0));
+            let msg = e.to_string();
+            assert!(
+                msg.contains("nonsmooth::timestep::MoreauJean") && !msg.contains("sticking"),
+                "{msg}"
+            );
+        }
+        other => panic!("expected SimultaneousContacts, got {other:?}"),
+    }
+    // Spaced by 1 cm the impacts come one at a time: the textbook cradle, (0, 0, 1).
+    let spaced = SVector::from([-0.02, -0.01, 0.0, 1.0, 0.0, 0.0]);
+    let out = sim.run(0.0, spaced, 1.0, &mut ()).unwrap();
+    let v = [out.y[3], out.y[4], out.y[5]];
+    assert!(
+        v[0].abs() < 1e-12 && v[1].abs() < 1e-12 && (v[2] - 1.0).abs() < 1e-12,
+        "{v:?}"
+    );
+    // Touching but at rest: nothing is struck, the run goes on.
+    let rest = SVector::from([0.0, 0.0, 0.0, 0.0, 0.0, 0.0]);
+    assert!(sim.run(0.0, rest, 1.0, &mut ()).is_ok());
+}
+
+#[test]
+fn a_block_on_a_belt_without_friction_moves_as_a_free_oscillator() {
+    // m = 2, k = 8, belt at 0.5 m/s, F_s = F_k = 0, started "stuck" at x = 0 moving with the
+    // belt (the force needed to hold it, k x = 0, is within the static limit 0). Without
+    // friction there is no stick: x = (u/ω) sin ωt, ω = √(k/m) = 2, v = u cos ωt. Before,
+    // the block stayed stuck: x(10) = 5 with the spring pulling 40 N, no transition (the
+    // stick's end |λ| − F_s = |λ| only touches 0, at t = 0).
+    let model = Mechanical::with_masses([2.0])
+        .unwrap()
+        .with_elements(Element::on_dof(0, LinearSpring::new(8.0).unwrap()).unwrap());
+    let friction = Coulomb::new(
+        Coordinate::dof(0).unwrap(),
+        Constant::new(0.5).unwrap(),
+        0.0,
+        0.0,
+    )
+    .unwrap();
+    let mut system = StickSlip::new(&model, friction, || Dopri5::new(tol()));
+    let exact = |t: f64| (0.25 * (2.0 * t).sin(), 0.5 * (2.0 * t).cos());
+    let mut modes = Between::new(0.05, |mode, t, y| {
+        // Every sample on the free flow (and never in the stick mode).
+        let (x, v) = exact(t);
+        let off = (y[0] - x).abs().max((y[1] - v).abs());
+        if mode == "stick" { f64::INFINITY } else { off }
+    });
+    let run = run_modes(
+        &mut system,
+        SlipMode::Stick,
+        0.0,
+        SVector::from([0.0, 0.5]),
+        10.0,
+        100,
+        &mut modes,
+    )
+    .unwrap();
+    let (x, v) = exact(10.0);
+    assert!(
+        (run.outcome.y[0] - x).abs() < 1e-8 && (run.outcome.y[1] - v).abs() < 1e-8,
+        "{:?} vs ({x}, {v}); transitions {:?}",
+        run.outcome.y,
+        run.transitions
+    );
+    assert!(
+        modes.worst < 1e-8,
+        "{} at {:?}",
+        modes.worst,
+        modes.worst_at
+    );
+    assert!(run.transitions.iter().all(|&(_, m)| m != SlipMode::Stick));
+    // Started in slip from the same state: the same flow.
+    let slip = run_modes(
+        &mut system,
+        SlipMode::Backward,
+        0.0,
+        SVector::from([0.0, 0.5]),
+        10.0,
+        100,
+        &mut (),
+    )
+    .unwrap();
+    assert!(
+        (slip.outcome.y[0] - x).abs() < 1e-8 && (slip.outcome.y[1] - v).abs() < 1e-8,
+        "{:?}",
+        slip.outcome.y
+    );
+    // 1e-9 faster than the belt: v_r = (u + 1e-9) cos 2t − u crosses 0 near t = 0 and
+    // rises 1e-9 above it around t = π. Each zero of v_r ended a slip segment and the next
+    // began at v_r = 0 exactly, where a first step of 5e-13 left v_r at 0 (the increment
+    // below the rounding of u) and ended the segment again: 100 segments at t = π − 3e-5,
+    // a Zeno error. Without friction nothing changes at v_r = 0: one free segment.
+    let v0 = 0.5 + 1e-9;
+    let fast = run_modes(
+        &mut system,
+        SlipMode::Forward,
+        0.0,
+        SVector::from([0.0, v0]),
+        10.0,
+        100,
+        &mut (),
+    )
+    .unwrap();
+    let (x, v) = (v0 / 2.0 * 20.0f64.sin(), v0 * 20.0f64.cos());
+    assert!(
+        (fast.outcome.y[0] - x).abs() < 1e-8 && (fast.outcome.y[1] - v).abs() < 1e-8,
+        "{:?} vs ({x}, {v})",
+        fast.outcome.y
+    );
+    assert!(fast.transitions.is_empty(), "{:?}", fast.transitions);
 }

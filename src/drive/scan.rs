@@ -32,6 +32,11 @@ pub(crate) struct Scan<'a, T: Real, const N: usize, S, E, D> {
 }
 
 /// Each event's side at the current state, every event armed.
+///
+/// # Errors
+/// [`EventError::NonFinite`] for an event value that is not finite;
+/// [`EventError::SimultaneousContacts`] where the run starts with two or more impact
+/// events closed and moving into one of them ([`simultaneous_contacts`]).
 pub(crate) fn initial_sides<T: Real, const N: usize, S: Dynamics<T, N>, E: EventSet<T, N>>(
     system: &S,
     events: &E,
@@ -44,12 +49,19 @@ pub(crate) fn initial_sides<T: Real, const N: usize, S: Dynamics<T, N>, E: Event
     };
     let mut f = SVector::zeros();
     let mut have_f = false;
+    // Impact events closed at the start (see `simultaneous_contacts`).
+    let (mut closed, mut n_closed) = ([false; MAX_EVENTS], 0);
     for (i, s) in sides.side.iter_mut().enumerate().take(E::LEN) {
         let g = events.value(i, t, y);
         if !g.is_finite() {
             return Err(non_finite(i, t, g));
         }
         *s = sign_of(g);
+        let far = far_side(events, i);
+        if far != 0 && (*s == 0 || *s == far) {
+            closed[i] = true;
+            n_closed += 1;
+        }
         if *s == 0 {
             // Start on the surface: it has not been crossed; the side is the one
             // the trajectory moves to (from the rate, else from the first step).
@@ -62,7 +74,67 @@ pub(crate) fn initial_sides<T: Real, const N: usize, S: Dynamics<T, N>, E: Event
             }
         }
     }
+    if n_closed >= 2 {
+        if !have_f {
+            system.rhs(t, y, &mut f);
+        }
+        simultaneous_contacts(events, t, y, &f, &closed)?;
+    }
     Ok(sides)
+}
+
+/// The far side of an impact event (a resetting event with a direction): the side its
+/// crossings are reset away from, `+1` for a rising one, `−1` for a falling one; 0 for
+/// any other event.
+fn far_side<T: Real, const N: usize, E: EventSet<T, N>>(events: &E, i: usize) -> i8 {
+    if !events.resets(i) {
+        return 0;
+    }
+    match events.direction(i) {
+        Direction::Rising => 1,
+        Direction::Falling => -1,
+        Direction::Either => 0,
+    }
+}
+
+/// A simultaneous impact at the start: of the impact events `closed` at `(t, y)` (two or
+/// more; a closed event has `g = 0` or `g` on its far side: the bodies touch), one whose
+/// rate `ġ` (the field `f`) points to its far side is being struck while another contact
+/// is closed. The event-driven method locates one crossing at a time and resets it; for
+/// contacts closed at once the outcome depends on how the impulses are shared (Newton's
+/// cradle of touching balls: Moreau's problem of all contacts at once moves the struck
+/// balls as one body, a sequence of impacts passes the momentum along), so the run does not
+/// choose and names the time-stepper. Contacts that are closed at rest (`ġ = 0`, a stack at
+/// rest) are not struck and start as before; a single closed contact is left to the scan
+/// (an impact, or sticking).
+///
+/// # Errors
+/// [`EventError::SimultaneousContacts`] with the first event struck and the first other
+/// closed one.
+fn simultaneous_contacts<T: Real, const N: usize, E: EventSet<T, N>>(
+    events: &E,
+    t: T,
+    y: &SVector<T, N>,
+    f: &SVector<T, N>,
+    closed: &[bool; MAX_EVENTS],
+) -> Result<()> {
+    let closed_ones = || (0..E::LEN).filter(|&i| closed[i]);
+    for i in closed_ones() {
+        let Some(r) = events.rate(i, t, y, f) else {
+            continue;
+        };
+        if sign_of(r) != 0 && sign_of(r) == far_side(events, i) {
+            let other = closed_ones().find(|&j| j != i).unwrap_or(i);
+            return Err(EventError::SimultaneousContacts {
+                t: to_f64(t),
+                moving: i,
+                other,
+                rate: to_f64(r),
+            }
+            .into());
+        }
+    }
+    Ok(())
 }
 
 impl<T: Real, const N: usize, S: Dynamics<T, N>, E: EventSet<T, N>, D: DenseOutput<T, N>>

@@ -20,6 +20,14 @@
 //! - **Stick**: `M q̈ = f + λ w` with `λ` as above (plus a Baumgarte term `−α v_r` that damps
 //!   the drift of `v_r` from integration error), until `|λ|` reaches `F_s` (event); then
 //!   slip starts in direction `−sgn λ` (the friction force saturates at `sgn λ · F_k`).
+//! - **No friction** (`F_s = F_k = 0`): no stick and no mode change. The contact carries
+//!   no force: a slip segment is the free motion to `t_end`, with no event at `v_r = 0`,
+//!   where nothing changes (both slip modes are the free motion); its name is the
+//!   direction it started in, which `v_r` may leave later. A start in
+//!   [`SlipMode::Stick`] (consistent only with `λ = 0`) slips at once in the direction
+//!   `v_r` starts to move (`−sgn λ`, or `−sgn λ̇` where `λ = 0`, forward where both
+//!   vanish). Without the event no segment can end at a zero of `v_r` it never leaves
+//!   (a restart at `v_r = 0` whose first step leaves `v_r` exactly 0).
 //!
 //! Transitions are located on the dense output like any event, so a run to `t_end` passes
 //! through the same modes at the same times as a longer one.
@@ -316,7 +324,8 @@ where
     }
 
     /// The mode a state is in: the sign of `v_r`, or, at `v_r = 0`, stick if the force
-    /// needed to hold it is within the static limit, else slip in direction `−sgn λ`.
+    /// needed to hold it is within the static limit, else slip in direction `−sgn λ`
+    /// (never stick without friction, `F_s = 0`: see the [module docs](self)).
     pub fn mode_at(&self, t: T, y: &SVector<T, M>) -> SlipMode {
         let v = self.friction.slip_velocity(t, y);
         if v > T::zero() {
@@ -330,9 +339,33 @@ where
 
     /// The mode at `v_r = 0`: stick while the force needed to hold it is below the static
     /// limit, or at the limit and not growing past it; else slip in direction `−sgn λ`.
+    ///
+    /// Without friction (`F_s = 0`, hence `F_k = 0`) there is no stick: the contact carries
+    /// no force, and the body moves as it would without it. Holding it would need `λ = 0`
+    /// along the way, and the stick mode's end, `|λ| − F_s = |λ|` rising through 0, never
+    /// changes sign (`|λ|` only touches 0), so a stick entered there would last for good.
+    /// The slip direction is the way `v_r` starts to move on the free flow: with
+    /// `v̇_r = −λ·wᵀM⁻¹w` there, `−sgn λ`; where `λ = 0`, `−sgn λ̇` (`λ̇` along the flow,
+    /// by a central difference); forward where both vanish. Both slip modes have the same
+    /// field then (`F_k = 0`): the direction only names the segment.
     fn mode_on_surface(&self, t: T, y: &SVector<T, M>) -> SlipMode {
         let rhs = self.rhs(None);
         let lambda = rhs.multiplier(t, y).1;
+        if self.friction.static_limit == T::zero() {
+            let trend = if lambda == T::zero() {
+                let mut dy = SVector::zeros();
+                rhs.rhs(t, y, &mut dy);
+                let scale = ModeEnd(rhs).time_scale(t);
+                rate_along_flow(|s, z| rhs.multiplier(s, z).1, t, y, &dy, scale)
+            } else {
+                lambda
+            };
+            return if trend > T::zero() {
+                SlipMode::Backward
+            } else {
+                SlipMode::Forward
+            };
+        }
         let holds = lambda.abs() < self.friction.static_limit
             || (lambda.abs() == self.friction.static_limit && {
                 let mut dy = SVector::zeros();
@@ -461,6 +494,15 @@ where
                     stats: Default::default(),
                 },
                 next: Some(next),
+            });
+        }
+        if self.friction.static_limit == T::zero() {
+            // No friction: the free motion to the end, nothing changes where v_r = 0.
+            let mut sim = Simulation::new(self.rhs(Some(T::zero())), (self.stepper)());
+            let outcome = sim.run(t, y, t_end, observer)?;
+            return Ok(Segment {
+                outcome,
+                next: None,
             });
         }
         let (slip_force, direction) = match mode {

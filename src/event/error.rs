@@ -39,6 +39,28 @@ pub enum EventError {
         /// The state there.
         state: Vec<f64>,
     },
+    /// The run starts with two or more impact surfaces closed (bodies touching: `g = 0`, or
+    /// `g` on the side the impact's reset moves away from) and the state moving into one
+    /// of them: a simultaneous impact at the start. Its outcome depends on how the impulses
+    /// are shared among the contacts (for touching balls struck at one end, Moreau's
+    /// complementarity problem of all contacts at once moves the struck balls as one body;
+    /// impacts taken in sequence pass the momentum along), which the event-driven method,
+    /// one located impact at a time, cannot decide. Use the time-stepper
+    /// [`MoreauJean`](crate::timestep::MoreauJean), which solves all contacts at once, or
+    /// start with the contacts apart.
+    #[error(
+        "events {moving} and {other} start closed at t = {t}, event {moving} moving into its surface (rate {rate}): a simultaneous impact, which the event-driven method (one impact at a time) cannot resolve; use the time-stepper nonsmooth::timestep::MoreauJean (all contacts at once), or start with the contacts apart"
+    )]
+    SimultaneousContacts {
+        /// The start time.
+        t: f64,
+        /// The impact event whose state moves into its surface.
+        moving: usize,
+        /// Another impact event closed at the start.
+        other: usize,
+        /// The rate `ġ` of event `moving` (its sign points into the surface).
+        rate: f64,
+    },
     /// An event or reset index outside the state vector.
     #[error("event or reset index {index} out of range (state dimension {len})")]
     IndexOutOfRange {

@@ -37,6 +37,12 @@
 //! - **Start on the surface.** A trajectory that starts exactly on a surface (`g(t₀) = 0`)
 //!   has not crossed it: no event at `t₀` in either direction; the side is the one it moves
 //!   to (from the rate, or from the end of the first step).
+//! - **Simultaneous contacts at the start.** Two or more impact events (resetting, with a
+//!   direction) closed at `t₀` (`g = 0`, or `g` on the far side: bodies touching) with the
+//!   state moving into one of them is a simultaneous impact, which one located impact at
+//!   a time cannot resolve: the run stops with [`EventError::SimultaneousContacts`], which
+//!   names the time-stepper ([`MoreauJean`](crate::timestep::MoreauJean)). Contacts closed
+//!   at rest start as before.
 //! - **Non-finite values.** `g` = NaN or ±∞ at a step end stops the run with
 //!   [`EventError::NonFinite`]; interior samples that are not finite are not crossings.
 //! - **Indices.** Event functions, resets and observers check their component indices

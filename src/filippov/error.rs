@@ -85,14 +85,20 @@ pub enum FilippovError {
         /// The last mode's name.
         mode: &'static str,
     },
-    /// A surface's value or gradient is not finite.
-    #[error("surface {surface} is not finite at t = {t} (H = {value})")]
+    /// A surface's value, gradient or time rate, a normal rate or a second-order rate met
+    /// where the run decides a mode (a start, an arrival, an exit) or checks the drift is
+    /// not finite.
+    #[error("surface {surface}: {quantity} is not finite at t = {t} ({value})")]
     NonFinite {
         /// Time.
         t: f64,
         /// The surface.
         surface: usize,
-        /// `H` (or the first non-finite gradient component).
+        /// What is not finite: `"the value H"`, `"the gradient ∇H"`, `"the time rate
+        /// ∂H/∂t"`, a normal rate `∇H·F± + ∂H/∂t` (a field that is not finite) or the
+        /// second-order rate of the tangency test.
+        quantity: &'static str,
+        /// Its value (for the gradient, its first non-finite component).
         value: f64,
     },
     /// A crossing with zero normal rate (a grazing decided by the second-order test): its

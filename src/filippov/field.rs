@@ -4,10 +4,11 @@
 
 use nalgebra::{SMatrix, SVector};
 
+use super::error::{FilippovError, Result};
 use super::system::{Filippov, Mode, Region};
 use crate::drive::modes::rate_along_flow;
 use crate::event::{Direction, EventSet};
-use crate::scalar::lit;
+use crate::scalar::{lit, to_f64};
 use crate::{Dynamics, Real};
 
 /// The largest `|H|`, relative to the surface's [`scale`], that counts as on the surface
@@ -43,6 +44,8 @@ impl<Sys, const S: usize> Copy for ModeField<'_, Sys, S> {}
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Rates<T: Real, const N: usize> {
     pub(crate) grad: SVector<T, N>,
+    /// `∂H/∂t`.
+    pub(crate) h_t: T,
     pub(crate) f_minus: SVector<T, N>,
     pub(crate) f_plus: SVector<T, N>,
     pub(crate) h_minus: T,
@@ -111,6 +114,7 @@ where
     sys.field(&with_side(sides, i, Region::Plus), t, x, &mut f_plus);
     Rates {
         grad,
+        h_t,
         h_minus: grad.dot(&f_minus) + h_t,
         h_plus: grad.dot(&f_plus) + h_t,
         f_minus,
@@ -118,10 +122,74 @@ where
     }
 }
 
-/// The sign with which the field of `side` moves the state off surface `i` from `(t, x)`:
-/// the sign of `h = ∇H·F + ∂H/∂t` where `|h|` exceeds `tangency` times `‖∇H‖·‖F‖`, else
-/// (a tangency) the sign of the second derivative `L²_F H = d/dt (∇H·F + ∂H/∂t)` along `F`
-/// (central differences), 0 if that vanishes too.
+/// [`rates`] where a mode is decided (an arrival, an exit, a start on the surface): every
+/// quantity the decision reads must be finite. The sliding field evaluates the rates in
+/// every stage without this check; a non-finite value there reaches the stepper, or the
+/// next decision.
+///
+/// # Errors
+/// [`FilippovError::NonFinite`] naming the first non-finite one of `∇H` (its first such
+/// component), `∂H/∂t`, `h₋` and `h₊` (the last two, with `∇H` and `∂H/∂t` finite: a
+/// field that is not).
+pub(crate) fn rates_checked<T, const N: usize, const S: usize, Sys>(
+    sys: &Sys,
+    i: usize,
+    sides: &[Region; S],
+    t: T,
+    x: &SVector<T, N>,
+) -> Result<Rates<T, N>>
+where
+    T: Real,
+    Sys: Filippov<T, N, S>,
+{
+    let r = rates(sys, i, sides, t, x);
+    let bad = |quantity, value: T| FilippovError::NonFinite {
+        t: to_f64(t),
+        surface: i,
+        quantity,
+        value: to_f64(value),
+    };
+    if let Some(g) = r.grad.iter().find(|g| !g.is_finite()) {
+        return Err(bad("the gradient ∇H", *g));
+    }
+    if !r.h_t.is_finite() {
+        return Err(bad("the time rate ∂H/∂t", r.h_t));
+    }
+    if !r.h_minus.is_finite() {
+        return Err(bad("the normal rate ∇H·F₋ + ∂H/∂t", r.h_minus));
+    }
+    if !r.h_plus.is_finite() {
+        return Err(bad("the normal rate ∇H·F₊ + ∂H/∂t", r.h_plus));
+    }
+    Ok(r)
+}
+
+/// The sign with which the field `F` of `side` moves the state off surface `i` from
+/// `(t, x)`, with `h = ∇H·F + ∂H/∂t` its normal rate (`rates`, finite):
+/// 1. **transversal**: `sgn h` where `|h| > tangency·‖∇H‖·‖F‖`;
+/// 2. **tangency** (`|h|` within that band): the sign of the second-order rate
+///    `L²_F H = d/dt (∇H·F + ∂H/∂t)` along `F` (a central difference over `t₊ − t₋`), where
+///    `|L²_F H| > ρ`, its rounding (below);
+/// 3. **inconclusive** second order (zero, or within its rounding): `sgn h` — a state that
+///    reached the surface at the rate `h ≠ 0` goes on that way, as the flow of `F` does
+///    when nothing of second order turns it back (a slow crossing, not a graze); 0 only if
+///    `h = 0` as well.
+///
+/// The rounding of the central difference is that of the two rates it is the difference
+/// of, over its span:
+/// $$ \rho = \frac{64\,\varepsilon\,(\lVert\nabla H\rVert\lVert F\rVert
+///    + |\partial_t H|)}{t_+ - t_-}. $$
+///
+/// A second-order rate above its rounding that opposes `h` decides (rule 2): inside the
+/// tangency band the flow of `F` goes past the surface by at most `h²/(2|L²_F H|)` before
+/// it turns back, and the tangency setting is the size of rate below which that touch is
+/// taken for a graze. One within its rounding says nothing about the turn, and with it the
+/// state would be held on the wrong side of the surface for as long as `F` takes to bring
+/// it back (forever for a constant field), so it does not decide (rule 3).
+///
+/// # Errors
+/// [`FilippovError::NonFinite`] if the second-order rate is not finite (a field or
+/// gradient that is not, next to the point).
 pub(crate) fn departure<T, const N: usize, const S: usize, Sys>(
     sys: &Sys,
     i: usize,
@@ -130,15 +198,25 @@ pub(crate) fn departure<T, const N: usize, const S: usize, Sys>(
     (t, x): (T, &SVector<T, N>),
     rates: &Rates<T, N>,
     tangency: T,
-) -> i8
+) -> Result<i8>
 where
     T: Real,
     Sys: Filippov<T, N, S>,
 {
+    let sign = |v: T| -> i8 {
+        if v > T::zero() {
+            1
+        } else if v < T::zero() {
+            -1
+        } else {
+            0
+        }
+    };
     let h = rates.rate(side);
     let f = rates.field(side);
-    if h.abs() > tangency * rates.grad.norm() * f.norm() {
-        return if h > T::zero() { 1 } else { -1 };
+    let size = rates.grad.norm() * f.norm();
+    if h.abs() > tangency * size {
+        return Ok(sign(h));
     }
     let region = with_side(sides, i, side);
     let g = |t: T, y: &SVector<T, N>| {
@@ -146,14 +224,23 @@ where
         sys.field(&region, t, y, &mut fy);
         sys.gradient(i, t, y).dot(&fy) + sys.surface_time_rate(i, t, y)
     };
-    let second = rate_along_flow(g, t, x, f, sys.time_scale(t));
-    if second > T::zero() {
-        1
-    } else if second < T::zero() {
-        -1
-    } else {
-        0
+    let scale = sys.time_scale(t);
+    let second = rate_along_flow(g, t, x, f, scale);
+    if !second.is_finite() {
+        return Err(FilippovError::NonFinite {
+            t: to_f64(t),
+            surface: i,
+            quantity: "the second-order rate L²H (along the field, by central differences)",
+            value: to_f64(second),
+        });
     }
+    let (up, down) = crate::excite::difference_points(t, scale);
+    let rounding = lit::<T>(64.0) * T::default_epsilon() * (size + rates.h_t.abs()) / (up - down);
+    Ok(if second.abs() > rounding {
+        sign(second)
+    } else {
+        sign(h)
+    })
 }
 
 /// Moves `x` onto `H_i = 0` along `∇H` (Newton steps `x ← x − H ∇H/‖∇H‖²`) until `|H|` is

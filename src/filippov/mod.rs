@@ -32,6 +32,13 @@
 //! so a grazing arrival (`h₋ = 0`, `L²H < 0`) stays in its region, a field tangent on the
 //! far side that turns back into the surface (`h₊ = 0`, `L²_{F₊}H < 0`) makes the state
 //! slide, and an exit where `α` only touches a bound (`L²H` pointing back) goes on sliding.
+//! Where the second-order test is inconclusive (`L²H` zero, or within the rounding of the
+//! central difference it is computed by) the first-order sign decides: a state that reached
+//! the surface at a rate below the tolerance but not zero, with nothing of second order to
+//! turn it back (a constant field), crosses, as the flow does.
+//!
+//! Every quantity a decision reads (`H`, `∇H`, `∂_t H`, `h±`, `L²H`) must be finite; one
+//! that is not stops the run with [`FilippovError::NonFinite`] naming it.
 //!
 //! **Drift**: `∇H·F_s = −∂_t H` holds at every stage of a step, so for a linear surface a
 //! Runge–Kutta step keeps `H` constant to rounding; for a curved one the state is projected
@@ -152,7 +159,7 @@ pub use friction::CoulombFriction;
 pub use load::RelayLoad;
 pub use relay::LinearRelay;
 pub use run::{
-    FilippovRun, FilippovSimulation, ModeTransition, Plain, Settings, SlidingObserver,
+    FilippovRun, FilippovSimulation, MAX_SAMPLES, ModeTransition, Plain, Settings, SlidingObserver,
     TransitionKind,
 };
 pub use system::{Filippov, Mode, Region, Switched};

@@ -5,7 +5,7 @@
 use nalgebra::SVector;
 
 use super::error::{FilippovError, Result};
-use super::field::{ModeField, band, departure, project, rates, scale, with_side};
+use super::field::{ModeField, band, departure, project, rates, rates_checked, scale, with_side};
 use super::system::{Filippov, Mode, Region};
 use crate::Real;
 use crate::drive::{Control, EventRecord, Observer, Scan, StepView, Termination};
@@ -187,21 +187,24 @@ pub struct Settings<T> {
     /// Absolute event-time tolerance (default 10⁻¹², plus 4·ε·|t|).
     pub event_tol: T,
     /// A normal rate `|∇H·F + ∂H/∂t|` below this times `‖∇H‖·‖F‖` is a tangency, decided
-    /// by the second-order test (default 10⁻⁹, at least `1000·ε`).
+    /// by the second-order test where that is conclusive, else by the rate's sign (see the
+    /// [module docs](super); default 10⁻⁹, at least `1000·ε`; in `(0, 1)`).
     pub tangency: T,
     /// Another surface within this (relative) of zero at an event is met at once: a
-    /// codimension-2 point (default 10⁻⁹, at least `1000·ε`).
+    /// codimension-2 point (default 10⁻⁹, at least `1000·ε`; in `(0, 1)`).
     pub coincidence: T,
     /// The largest relative `|H|` allowed while sliding, checked at step ends and at
     /// [`drift_samples`](Self::drift_samples) interior points of each step (default 10⁻⁹,
-    /// at least `1000·ε`;
+    /// at least `1000·ε`; in `(0, 1)`;
     /// a linear surface is held to rounding, a curved one to the local error between the
     /// projections at step ends).
     pub drift: T,
-    /// Interior points per sliding step at which the drift is checked (default 3).
+    /// Interior points per sliding step at which the drift is checked (default 3, at most
+    /// [`MAX_SAMPLES`]).
     pub drift_samples: usize,
     /// Interior samples per sliding step of the exit event `min(α, 1−α)` (default 3), so
-    /// that an excursion of `α` out of `[0, 1]` and back inside one step is found.
+    /// that an excursion of `α` out of `[0, 1]` and back inside one step is found (at most
+    /// [`MAX_SAMPLES`]).
     pub exit_samples: usize,
     /// The step cap per run (default 10⁸).
     pub max_steps: usize,
@@ -227,17 +230,53 @@ impl<T: Real> Default for Settings<T> {
     }
 }
 
+/// The largest [`Settings::drift_samples`] and [`Settings::exit_samples`]: a million
+/// samples per step is far beyond any use, and the bound keeps the sample loops' counts
+/// (`samples + 1` intervals) from overflowing.
+pub const MAX_SAMPLES: usize = 1_000_000;
+
 impl<T: Real> Settings<T> {
     /// Checks every setting.
     ///
+    /// - `event_tol` is finite and `> 0`.
+    /// - The relative tolerances `tangency`, `coincidence` and `drift` are in `(0, 1)`. At 1
+    ///   and above they no longer tell anything apart: by Cauchy–Schwarz
+    ///   `|∇H·F| ≤ ‖∇H‖·‖F‖`, so `tangency ≥ 1` makes every crossing of a fixed surface a
+    ///   tangency (decided by the second-order test alone); `coincidence ≥ 1` or
+    ///   `drift ≥ 1` accept `|H|` as large as the surface's scale
+    ///   `max(1, ‖∇H‖∞·‖x‖∞)` (the size of `H` over the state itself) as "on the surface".
+    /// - `drift_samples` and `exit_samples` are at most [`MAX_SAMPLES`]; `max_steps` and
+    ///   `max_stalls` are `> 0`.
+    ///
     /// # Errors
-    /// [`ParameterError`] naming the first setting that is not finite and positive (or,
-    /// for the counts, zero).
+    /// [`ParameterError`] naming the first setting that breaks its rule, with its value.
     pub fn validate(&self) -> std::result::Result<(), ParameterError> {
         positive("event_tol", self.event_tol)?;
-        positive("tangency", self.tangency)?;
-        positive("coincidence", self.coincidence)?;
-        positive("drift", self.drift)?;
+        for (name, value) in [
+            ("tangency", self.tangency),
+            ("coincidence", self.coincidence),
+            ("drift", self.drift),
+        ] {
+            if !(value > T::zero() && value < T::one()) {
+                return Err(ParameterError::new(
+                    name,
+                    to_f64(value),
+                    "in (0, 1) (a relative tolerance)",
+                ));
+            }
+        }
+        for (name, count) in [
+            ("drift_samples", self.drift_samples),
+            ("exit_samples", self.exit_samples),
+        ] {
+            if count > MAX_SAMPLES {
+                return Err(ParameterError::new(
+                    name,
+                    count as f64,
+                    "at most MAX_SAMPLES = 10⁶",
+                ));
+            }
+        }
         if self.max_steps == 0 {
             return Err(ParameterError::new("max_steps", 0.0, "> 0"));
         }
@@ -325,10 +364,10 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
     where
         Sys: Filippov<T, N, S>,
     {
-        let r = rates(&self.system, i, sides, t, x);
+        let r = rates_checked(&self.system, i, sides, t, x)?;
         let tang = self.settings.tangency;
-        let sm = departure(&self.system, i, sides, Region::Minus, (t, x), &r, tang);
-        let sp = departure(&self.system, i, sides, Region::Plus, (t, x), &r, tang);
+        let sm = departure(&self.system, i, sides, Region::Minus, (t, x), &r, tang)?;
+        let sp = departure(&self.system, i, sides, Region::Plus, (t, x), &r, tang)?;
         let repelling = || FilippovError::Repelling {
             t: to_f64(t),
             surface: i,
@@ -369,7 +408,8 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
     /// the side both move the state to (the second-order test at a tangency).
     ///
     /// # Errors
-    /// [`FilippovError::NonFinite`] for a non-finite `H_i`; [`FilippovError::Codimension2`]
+    /// [`FilippovError::NonFinite`] for a non-finite `H_i` or `∇H_i`, or, on a surface, a
+    /// non-finite rate the decision reads; [`FilippovError::Codimension2`]
     /// on two surfaces at once; [`FilippovError::Repelling`] on a surface both fields leave;
     /// [`FilippovError::Degenerate`] where both are tangent to second order.
     pub fn mode_at<const N: usize, const S: usize>(
@@ -383,8 +423,7 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
         let mut sides = [Region::Plus; S];
         let mut on: Option<usize> = None;
         for (i, side) in sides.iter_mut().enumerate() {
-            let h = self.surface_checked(i, t, x)?;
-            let grad = self.system.gradient(i, t, x);
+            let (h, grad) = self.surface_checked(i, t, x)?;
             let tol = band::<T>() * scale(&grad, x);
             if h.abs() <= tol {
                 if let Some(first) = on {
@@ -411,24 +450,34 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
         })
     }
 
+    /// `H_i` and `∇H_i` at `(t, x)`.
+    ///
+    /// # Errors
+    /// [`FilippovError::NonFinite`] unless both are finite.
     fn surface_checked<const N: usize, const S: usize>(
         &self,
         i: usize,
         t: T,
         x: &SVector<T, N>,
-    ) -> Result<T>
+    ) -> Result<(T, SVector<T, N>)>
     where
         Sys: Filippov<T, N, S>,
     {
         let h = self.system.surface(i, t, x);
+        let grad = self.system.gradient(i, t, x);
+        let bad = |quantity, value: T| FilippovError::NonFinite {
+            t: to_f64(t),
+            surface: i,
+            quantity,
+            value: to_f64(value),
+        };
         if !h.is_finite() {
-            return Err(FilippovError::NonFinite {
-                t: to_f64(t),
-                surface: i,
-                value: to_f64(h),
-            });
+            return Err(bad("the value H", h));
         }
-        Ok(h)
+        if let Some(g) = grad.iter().find(|g| !g.is_finite()) {
+            return Err(bad("the gradient ∇H", *g));
+        }
+        Ok((h, grad))
     }
 
     /// The next mode after the terminal event `k` of `mode` at `(t, x)`, with the
@@ -457,8 +506,7 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
             }
             // α left [0, 1]: exit to the side of the bound reached, if that field moves
             // the state off the surface (second-order test at the tangency).
-            let r = rates(&self.system, i, &mode.sides, t, x);
-            let a = r.alpha();
+            let a = rates_checked(&self.system, i, &mode.sides, t, x)?.alpha();
             let slack = lit::<T>(1e3) * self.settings.tangency;
             let clearly_out = a < -slack || a > T::one() + slack;
             let target = if a < lit(0.5) {
@@ -467,7 +515,7 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
                 Region::Plus
             };
             project(&self.system, i, t, x);
-            let r2 = rates(&self.system, i, &mode.sides, t, x);
+            let r2 = rates_checked(&self.system, i, &mode.sides, t, x)?;
             let s = departure(
                 &self.system,
                 i,
@@ -476,7 +524,7 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
                 (t, x),
                 &r2,
                 self.settings.tangency,
-            );
+            )?;
             if !clearly_out && (s == 0 || (s > 0) != (target == Region::Plus)) {
                 return Ok((mode, i, TransitionKind::Graze));
             }
@@ -488,8 +536,8 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
         }
         // A surface reached from the mode's side: first, no other surface there.
         for j in (0..S).filter(|&j| j != k) {
-            let h = self.surface_checked(j, t, x)?;
-            let tol = self.settings.coincidence * scale(&self.system.gradient(j, t, x), x);
+            let (h, grad) = self.surface_checked(j, t, x)?;
+            let tol = self.settings.coincidence * scale(&grad, x);
             if h.abs() <= tol {
                 return Err(FilippovError::Codimension2 {
                     t: to_f64(t),
@@ -552,7 +600,9 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
     /// [`FilippovError::Codimension2`] where two surfaces are met at once;
     /// [`FilippovError::Repelling`] / [`FilippovError::Degenerate`] where no side can be
     /// chosen; [`FilippovError::Drift`] if sliding leaves its surface by more than the drift
-    /// tolerance; [`FilippovError::NoProgress`] if transitions repeat at one instant.
+    /// tolerance; [`FilippovError::NoProgress`] if transitions repeat at one instant;
+    /// [`FilippovError::NonFinite`] where a surface's value, gradient or time rate, or a
+    /// rate a decision reads, is not finite.
     pub fn run<const N: usize, const S: usize, O: SlidingObserver<T, N, S>>(
         &mut self,
         t0: T,
@@ -800,7 +850,8 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
     /// and [`Settings::drift_samples`] interior points).
     ///
     /// # Errors
-    /// [`FilippovError::Drift`] if it exceeds [`Settings::drift`].
+    /// [`FilippovError::Drift`] if it exceeds [`Settings::drift`];
+    /// [`FilippovError::NonFinite`] if `H_i` or `∇H_i` is not finite at a sample.
     fn drift_on_step<const N: usize, const S: usize>(&self, i: usize, ta: T, tb: T) -> Result<T>
     where
         Sys: Filippov<T, N, S>,
@@ -816,6 +867,8 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
             let h = self.system.surface(i, t, &y);
             let rel = h.abs() / scale(&self.system.gradient(i, t, &y), &y);
             if !(rel <= self.settings.drift) {
+                // Not finite is not a drift: check H and ∇H here, off the common path.
+                self.surface_checked(i, t, &y)?;
                 return Err(FilippovError::Drift {
                     t: to_f64(t),
                     surface: i,
