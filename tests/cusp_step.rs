@@ -377,3 +377,59 @@ fn two_degrees_of_freedom_creep() {
         assert!(d[0].max(d[1]) <= 1e3 * rtol * 1e-4 && d[2].max(d[3]) <= 1e3 * rtol * 1e-2);
     }
 }
+
+/// `ẍ = −sgn(ẋ)|ẋ|^{1/4}` with or without the cusp declared.
+struct Quarter(bool);
+
+impl Dynamics<f64, 2> for Quarter {
+    fn rhs(&self, _t: f64, y: &SVector<f64, 2>, dy: &mut SVector<f64, 2>) {
+        dy[0] = y[1];
+        dy[1] = -y[1].signum() * y[1].abs().powf(0.25);
+    }
+    fn velocity_exponent(&self) -> Option<f64> {
+        self.0.then_some(0.25)
+    }
+}
+
+/// `ẍ = −c·ẋ`: stiff, but no cusp.
+struct Damped(f64);
+
+impl Dynamics<f64, 2> for Damped {
+    fn rhs(&self, _t: f64, y: &SVector<f64, 2>, dy: &mut SVector<f64, 2>) {
+        dy[0] = y[1];
+        dy[1] = -self.0 * y[1];
+    }
+}
+
+#[test]
+fn an_undeclared_cusp_is_named_instead_of_crept_through() {
+    // Before, CuspSwitch::dopri5 on the undeclared cusp crept with steps of ~1e-8 s and
+    // needed 1e8 steps to reach t = 2.4.
+    let tol = Tolerances::new(1e-8, 1e-10).unwrap();
+    let y0 = Vector2::new(0.0, 1.0);
+    let mut sim = Simulation::new(Quarter(false), CuspSwitch::dopri5(tol, 1e-6).unwrap());
+    let e = sim.run(0.0, y0, 5.0, &mut ()).unwrap_err();
+    let steps = sim.stepper().stats().accepted;
+    println!("undeclared: {e} after {steps} steps");
+    assert!(e.to_string().contains("cusp_exponent"), "{e}");
+    assert!(steps < 100_000, "{steps} steps");
+    match e {
+        nonsmooth::drive::RunError::Integrate(
+            nonsmooth::integrate::IntegrateError::UndeclaredCusp {
+                exponent, index, ..
+            },
+        ) => {
+            assert_eq!(index, 0);
+            assert!((exponent - 0.25).abs() < 0.05, "q ≈ {exponent}");
+        }
+        other => panic!("{other:?}"),
+    }
+    // Declared: the implicit step takes it to rest (v = 0 at t = 4/3·1^{3/4} = 1.333…).
+    let mut sim = Simulation::new(Quarter(true), CuspSwitch::dopri5(tol, 1e-6).unwrap());
+    let out = sim.run(0.0, y0, 5.0, &mut ()).unwrap();
+    assert!(out.y[1].abs() < 1e-6, "{:?}", out.y);
+    // A stiff linear damping (ρ = 1e6 at every velocity) is not taken for a cusp.
+    let mut sim = Simulation::new(Damped(1e6), CuspSwitch::dopri5(tol, 1e-6).unwrap());
+    sim.run(0.0, Vector2::new(0.0, 1e-7), 0.01, &mut ())
+        .unwrap();
+}

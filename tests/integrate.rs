@@ -336,3 +336,86 @@ fn f32_integration() {
     }
     assert!((st.current().1[0] - 3.0_f32.cos()).abs() < 1e-4);
 }
+
+/// `ẍ = −x`, autonomous: the error after 10 s does not depend on where the clock starts.
+struct Harmonic1;
+impl Dynamics<f64, 2> for Harmonic1 {
+    fn rhs(&self, _t: f64, y: &Vector2<f64>, dy: &mut Vector2<f64>) {
+        dy[0] = y[1];
+        dy[1] = -y[0];
+    }
+}
+
+/// The error of a run of `ẍ = −x` from `(1, 0)` at `t0` to `t0 + 10`.
+fn clock_error<St: Stepper<f64, 2>>(st: St, t0: f64) -> f64 {
+    let mut sim = nonsmooth::drive::Simulation::new(Harmonic1, st);
+    let span = (t0 + 10.0) - t0;
+    let out = sim
+        .run(t0, Vector2::new(1.0, 0.0), t0 + 10.0, &mut ())
+        .unwrap();
+    let exact = Vector2::new(span.cos(), -span.sin());
+    (out.y - exact).norm()
+}
+
+#[test]
+fn adaptive_steppers_keep_their_accuracy_far_from_t_0() {
+    // A run counts its time from its start (Stepper::start: the clock is t₀ + τ, τ the
+    // sum of the steps). Before, far from 0 the state advanced by h and the clock by
+    // fl(t + h) − t, and at rtol 1e-10 the errors from 1e9 / 1e12 were 3.2e-7 / 1.1e-3
+    // (DOPRI5) against 3.0e-10 from 0; now they are those from 0.
+    let tol = Tolerances::new(1e-10, 1e-10).unwrap();
+    for t0 in [1e9, 1e12] {
+        let pairs = [
+            (
+                "DOPRI5",
+                clock_error(Dopri5::new(tol), 0.0),
+                clock_error(Dopri5::new(tol), t0),
+            ),
+            (
+                "DOP853",
+                clock_error(Dop853::new(tol), 0.0),
+                clock_error(Dop853::new(tol), t0),
+            ),
+            (
+                "Tsit5",
+                clock_error(nonsmooth::integrate::Tsit5::new(tol), 0.0),
+                clock_error(nonsmooth::integrate::Tsit5::new(tol), t0),
+            ),
+            (
+                "Vern6",
+                clock_error(nonsmooth::integrate::Vern6::new(tol), 0.0),
+                clock_error(nonsmooth::integrate::Vern6::new(tol), t0),
+            ),
+        ];
+        for (name, from0, far) in pairs {
+            println!("{name}: error {from0:.2e} from 0, {far:.2e} from {t0:e}");
+            assert!(
+                far <= 2.0 * from0 && from0 < 1e-8,
+                "{name} from {t0:e}: {far:e} against {from0:e}"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_relative_tolerance_below_the_arithmetic_is_refused() {
+    // rtol = atol = 1e-300 was accepted, and Tsit5 crept to the step cap near t = 0.
+    for (rtol, atol) in [(1e-300, 1e-300), (1e-17, 1e-10), (f64::EPSILON / 2.0, 1.0)] {
+        let e = Tolerances::<f64, 2>::new(rtol, atol)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("rtol") && e.contains("machine epsilon"), "{e}");
+        assert!(Tolerances::<f64, 2>::per_component(rtol, [atol; 2]).is_err());
+    }
+    assert!(Tolerances::<f64, 2>::new(f64::EPSILON, 1e-300).is_ok());
+    assert!(Tolerances::<f32, 2>::new(1e-8, 1e-8).is_err());
+    // Set through the public field: refused by the run's check.
+    let mut tol = Tolerances::<f64, 2>::new(1e-10, 1e-10).unwrap();
+    tol.rtol[1] = 1e-300;
+    let mut sim =
+        nonsmooth::drive::Simulation::new(Harmonic1, nonsmooth::integrate::Tsit5::new(tol));
+    let e = sim
+        .run(0.0, Vector2::new(1.0, 0.0), 2.0, &mut ())
+        .unwrap_err();
+    assert!(e.to_string().contains("rtol"), "{e}");
+}

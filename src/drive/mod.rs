@@ -473,7 +473,7 @@ impl<T: Real, const N: usize, S: Dynamics<T, N>, St: Stepper<T, N>, E: EventSet<
         }
         check_state(&y0)?;
         self.preflight(t0, t_end, observer)?;
-        self.stepper.reset_state(t0, y0);
+        self.stepper.start(t0, y0);
         self.history.clear();
         observer.on_start(t0, &y0);
         self.advance(t_end, observer)

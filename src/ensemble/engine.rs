@@ -451,6 +451,8 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
             st: Box::new(LaneState {
                 packed,
                 t: V::splat(t),
+                origin: V::splat(t),
+                tau: z,
                 y: core::array::from_fn(|c| V::splat(first.y0[c])),
                 f: [z; M],
                 h: V::splat(1e-6),
@@ -537,6 +539,8 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
         };
         m.pack_lane(&mut self.st.packed, i);
         self.st.t.set_lane(i, t0);
+        self.st.origin.set_lane(i, t0);
+        self.st.tau.set_lane(i, 0.0);
         for c in 0..M {
             self.st.y[c].set_lane(i, y0[c]);
             self.st.f[c].set_lane(i, f0[c]);
@@ -699,6 +703,8 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
         let mut half = Box::new(LaneState {
             packed: member.pack::<H<V>>(),
             t: splat(st.t),
+            origin: splat(st.origin),
+            tau: splat(st.tau),
             y: st.y.map(splat),
             f: st.f.map(splat),
             h: splat(st.h),
@@ -719,6 +725,8 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
         for (k, &i) in busy.iter().enumerate() {
             let mv = |dst: H<V>, src: V| dst.with_lane(k, src.lane(i));
             half.t = mv(half.t, st.t);
+            half.origin = mv(half.origin, st.origin);
+            half.tau = mv(half.tau, st.tau);
             for c in 0..M {
                 half.y[c] = mv(half.y[c], st.y[c]);
                 half.f[c] = mv(half.f[c], st.f[c]);
@@ -799,6 +807,8 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
                         return;
                     }
                     self.st.t.set_lane(i, t);
+                    let origin = self.st.origin.get_lane(i);
+                    self.st.tau.set_lane(i, t - origin);
                     for c in 0..M {
                         self.st.y[c].set_lane(i, y[c]);
                         self.st.f[c].set_lane(i, f[c]);

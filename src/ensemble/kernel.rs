@@ -21,6 +21,10 @@ use crate::lanes::{LaneMath, Lanes, Simd, TRUE};
 pub(crate) struct LaneState<V: Lanes, D: LaneDynamics<M>, const M: usize> {
     pub(crate) packed: D::Packed<V>,
     pub(crate) t: V,
+    /// Each trajectory's start, the origin of its clock (`Stepper::start`): `t = origin + tau`.
+    pub(crate) origin: V,
+    /// The time elapsed since `origin`, advanced by the steps.
+    pub(crate) tau: V,
     pub(crate) y: [V; M],
     pub(crate) f: [V; M],
     pub(crate) h: V,
@@ -421,19 +425,22 @@ fn body<V: Lanes, D: LaneDynamics<M>, const M: usize>(
     out.ends = 0;
     out.near_landing = 0;
     let (t, y, h) = (st.t, st.y, st.h);
-    // The trial step, cut to land on the lane's limit (clamp_to_limit).
-    let rest = st.limit - t;
+    // The trial step on the elapsed time, cut to land on the lane's limit
+    // (Core::trial_step).
+    let rest = (st.limit - st.origin) - st.tau;
     let lands = h.ge(rest * s(0.99));
     let hs = lands.select(rest, h);
+    let tau_try = st.tau + hs;
+    let t_new = lands.select(st.limit, st.origin + tau_try);
+    let tau_new = lands.select(st.limit - st.origin, tau_try);
     let too_small =
-        (hs.lt((min_step_rel * t.abs()).max(h_min)) | !(t + hs).gt(t)) & !lands & st.active;
+        (hs.lt((min_step_rel * t.abs()).max(h_min)) | !t_new.gt(t)) & !lands & st.active;
     if too_small.bits() != 0 {
         out.too_small = too_small.bits();
         t.store(&mut out.buf[row::T0]);
         hs.store(&mut out.buf[row::H]);
         return;
     }
-    let t_new = lands.select(st.limit, t + hs);
     let yn = stages::<V, D, M>((&st.packed, &st.y, &st.f), k, (t, hs, t_new), &mut st.kk);
     let kk = &st.kk;
     let k1 = kk[0];
@@ -483,6 +490,7 @@ fn body<V: Lanes, D: LaneDynamics<M>, const M: usize>(
     st.limit = accepted.select(st.landing.min(t_new + st.scale), st.limit);
     // Accepted lanes: the new state, the next step, the dense output.
     st.t = accepted.select(t_new, st.t);
+    st.tau = accepted.select(tau_new, st.tau);
     st.h = accepted.select(lands.select(h_next.max(h), h_next), st.h);
     t.store(&mut out.buf[row::T0]);
     t_new.store(&mut out.buf[row::T1]);

@@ -635,7 +635,7 @@ impl<T: Real, Sys, St> FilippovSimulation<T, Sys, St> {
         if let Some(i) = start_mode.sliding {
             project(&self.system, i, t0, &mut x);
         }
-        self.stepper.reset_state(t0, x);
+        self.stepper.start(t0, x);
         let stats0 = *self.stepper.stats();
         let mut state = RunState {
             mode: start_mode,

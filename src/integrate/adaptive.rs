@@ -177,6 +177,10 @@ impl<T: Real, const N: usize, M: Method<T, N>> Stepper<T, N> for Adaptive<T, N, 
         self.core.reset(t, y);
     }
 
+    fn start(&mut self, t: T, y: SVector<T, N>) {
+        self.core.start(t, y);
+    }
+
     fn step<S: Dynamics<T, N>>(&mut self, sys: &S, t_limit: T) -> Result<(), IntegrateError> {
         let parts = StepParts {
             tol: &self.tol,

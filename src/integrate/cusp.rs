@@ -62,7 +62,10 @@
 //! implicit step where the declared cusp is active and the explicit stepper is
 //! stiffness-bound, detected from the declared cusp and the step-size history:
 //! - a system declares the cusp ([`Dynamics::cusp_exponent`]); without it the switch is
-//!   the explicit stepper alone;
+//!   the explicit stepper alone, which stops with [`IntegrateError::UndeclaredCusp`] where
+//!   an undeclared cusp holds it stiffness-bound for 50 steps in a row (its rate, probed
+//!   as below at `v` and `v/2`, grows as the velocity shrinks) instead of creeping to the
+//!   step cap;
 //! - after an accepted step of size `h` that ends with a velocity `|v_i| < v_band`, the
 //!   cusp's relaxation rate is estimated by a secant in that velocity at the step's end,
 //!   `ρ_i = |a_i(v_i) − a_i(v_i/2)|/|v_i/2|` (one extra evaluation; the secant of
@@ -440,6 +443,8 @@ pub struct CuspSwitch<T: Real, const N: usize, E: Stepper<T, N>> {
     on_implicit: bool,
     stiff_run: u32,
     soft_run: u32,
+    /// Explicit steps in a row that an undeclared cusp holds stiffness-bound.
+    stall_run: u32,
     t: T,
     y: SVector<T, N>,
     dense: CuspSwitchDense<T, N, E::Dense>,
@@ -447,6 +452,10 @@ pub struct CuspSwitch<T: Real, const N: usize, E: Stepper<T, N>> {
     own_evals: u64,
     counts: SwitchCounts,
 }
+
+/// Explicit steps in a row, on a system that declares no cusp, held stiffness-bound by one
+/// before the run stops with [`IntegrateError::UndeclaredCusp`].
+const STALL_RUN: u32 = 50;
 
 /// Explicit steps in a row with `h·ρ > 1/2` before the hand-over to the implicit step.
 const ENTER_RUN: u32 = 3;
@@ -529,6 +538,7 @@ where
             on_implicit: false,
             stiff_run: 0,
             soft_run: 0,
+            stall_run: 0,
             t: T::zero(),
             y: SVector::zeros(),
             dense,
@@ -631,6 +641,13 @@ where
         self.implicit.reset_state(t, y);
     }
 
+    fn start(&mut self, t: T, y: SVector<T, N>) {
+        self.t = t;
+        self.y = y;
+        self.explicit.start(t, y);
+        self.implicit.start(t, y);
+    }
+
     fn step<S: Dynamics<T, N>>(&mut self, sys: &S, t_limit: T) -> Result<(), IntegrateError> {
         let r = if self.on_implicit {
             self.implicit_step(sys, t_limit)
@@ -686,6 +703,9 @@ where
         self.dense.explicit = self.explicit.dense().clone();
         self.dense.on_implicit = false;
         let dense = self.dense.explicit.clone();
+        if sys.cusp_exponent().is_none() {
+            return self.undeclared_cusp(sys, &dense);
+        }
         let stiff = self
             .stiffness(sys, &dense)
             .is_some_and(|hr| hr > lit(ENTER_HRHO));
@@ -737,6 +757,72 @@ where
             self.explicit.reset_state(self.t, self.y);
         }
         Ok(())
+    }
+}
+
+impl<T: Real, const N: usize, E: Stepper<T, N>> CuspSwitch<T, N, E>
+where
+    E::Dense: Clone,
+{
+    /// On a system that declares no cusp: whether the explicit step just taken was held
+    /// stiffness-bound by a cusp in a velocity of the band, and after [`STALL_RUN`] such
+    /// steps in a row, [`IntegrateError::UndeclaredCusp`]. A step counts when, for some
+    /// `0 < |v_i| < v_band`, the secant rates `ρ₁` over `[v/2, v]` and `ρ₂` over
+    /// `[v/4, v/2]` give `h·ρ₁ > 1/2` (stiffness-bound, as the hand-over's test) and
+    /// `ρ₂ > 1.1·ρ₁`: the rate grows as the velocity shrinks, `ρ₂/ρ₁ = 2^{1−q}` for a power
+    /// `|v|^q` (`q < 0.86`), where a linear damping (`q = 1`) or a smooth law keeps it
+    /// (two extra evaluations per step in the band).
+    fn undeclared_cusp<S: Dynamics<T, N>, D: DenseOutput<T, N>>(
+        &mut self,
+        sys: &S,
+        dense: &D,
+    ) -> Result<(), IntegrateError> {
+        let n = N / 2;
+        let (t0, t1) = dense.span();
+        let h = t1 - t0;
+        let y = *dense.endpoints().1;
+        let f = *dense.end_derivatives().1;
+        let mut found = None;
+        for i in 0..n {
+            let v = y[n + i];
+            if !(v.abs() < self.band) || v == T::zero() {
+                continue;
+            }
+            let mut at = |w: T| {
+                let mut probe = y;
+                probe[n + i] = w;
+                let mut fp = SVector::zeros();
+                sys.rhs(t1, &probe, &mut fp);
+                self.own_evals += 1;
+                self.counts.probes += 1;
+                fp[n + i]
+            };
+            let (half, quarter) = (v * lit(0.5), v * lit(0.25));
+            let (a2, a4) = (at(half), at(quarter));
+            let rho1 = ((f[n + i] - a2) / half).abs();
+            let rho2 = ((a2 - a4) / quarter).abs();
+            if h * rho1 > lit(ENTER_HRHO) && rho2 > lit::<T>(1.1) * rho1 {
+                let q = T::one() - (rho2 / rho1).log2();
+                found = Some((i, v, q));
+                break;
+            }
+        }
+        self.stall_run = if found.is_some() {
+            self.stall_run + 1
+        } else {
+            0
+        };
+        match found {
+            Some((index, v, q)) if self.stall_run >= STALL_RUN => {
+                Err(IntegrateError::UndeclaredCusp {
+                    t: to_f64(t1),
+                    index,
+                    velocity: to_f64(v),
+                    exponent: to_f64(q),
+                })
+            }
+            _ => Ok(()),
+        }
     }
 }
 

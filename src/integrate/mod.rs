@@ -175,6 +175,23 @@ pub enum IntegrateError {
     /// A parameter of the integrator is invalid.
     #[error(transparent)]
     Parameter(#[from] ParameterError),
+    /// A [`CuspSwitch`] run is stiffness-bound by a velocity cusp that the system does not
+    /// declare: the relaxation rate of velocity `index` grows as `|v|` shrinks, as a power
+    /// `|v|^{q−1}` with `q < 1` does, and the explicit stepper creeps (it would take steps
+    /// of nanoseconds to the step cap).
+    #[error(
+        "velocity {index} has a cusp where the explicit stepper is stiffness-bound (at t = {t}, v = {velocity:e}: a relaxation rate growing as |v|^(q-1), q ≈ {exponent:.3}) but the system declares none: declare it (Dynamics::cusp_exponent) so that CuspSwitch steps it implicitly"
+    )]
+    UndeclaredCusp {
+        /// Where.
+        t: f64,
+        /// The velocity's index (in `0..N/2`).
+        index: usize,
+        /// Its value.
+        velocity: f64,
+        /// The exponent `q` estimated from the rates at `v/2` and `v/4`.
+        exponent: f64,
+    },
 }
 
 /// Per-component absolute and relative tolerances.
@@ -186,13 +203,29 @@ pub struct Tolerances<T, const N: usize> {
     pub atol: SVector<T, N>,
 }
 
+/// `rtol`, checked: finite, and at least the machine epsilon `ε` of `T` (a relative
+/// error below the spacing of the numbers cannot be reached: the step would shrink without
+/// end, as it did at `rtol = 10⁻³⁰⁰`, creeping to the step cap).
+fn reachable_rtol<T: Real>(rtol: T) -> Result<T, ParameterError> {
+    positive("rtol", rtol)?;
+    if rtol < T::default_epsilon() {
+        return Err(ParameterError::new(
+            "rtol",
+            to_f64(rtol),
+            "at least the machine epsilon (2.2e-16 for f64, 1.2e-7 for f32): smaller relative errors are below the arithmetic's reach",
+        ));
+    }
+    Ok(rtol)
+}
+
 impl<T: Real, const N: usize> Tolerances<T, N> {
     /// The same `rtol` and `atol` for every component.
     ///
     /// # Errors
-    /// [`ParameterError`] unless both are finite and > 0.
+    /// [`ParameterError`] unless both are finite and > 0 and `rtol` is at least the
+    /// machine epsilon of `T` (below it no step can meet the tolerance).
     pub fn new(rtol: T, atol: T) -> Result<Self, ParameterError> {
-        positive("rtol", rtol)?;
+        reachable_rtol(rtol)?;
         positive("atol", atol)?;
         Ok(Self {
             rtol: SVector::repeat(rtol),
@@ -203,9 +236,10 @@ impl<T: Real, const N: usize> Tolerances<T, N> {
     /// One `rtol` and an `atol` per component (e.g. metres for `x`, m/s for `ẋ`).
     ///
     /// # Errors
-    /// [`ParameterError`] unless all are finite and > 0.
+    /// [`ParameterError`] unless all are finite and > 0 and `rtol` is at least the machine
+    /// epsilon of `T`.
     pub fn per_component(rtol: T, atol: [T; N]) -> Result<Self, ParameterError> {
-        positive("rtol", rtol)?;
+        reachable_rtol(rtol)?;
         for a in atol {
             positive("atol", a)?;
         }
@@ -215,14 +249,15 @@ impl<T: Real, const N: usize> Tolerances<T, N> {
         })
     }
 
-    /// Checks every component (finite and > 0): the fields are public, so a value set
-    /// through them is checked here, by [`Stepper::check`] before each run.
+    /// Checks every component (finite and > 0, `rtol` at least the machine epsilon): the
+    /// fields are public, so a value set through them is checked here, by
+    /// [`Stepper::check`] before each run.
     ///
     /// # Errors
     /// [`ParameterError`] naming `rtol` or `atol`.
     pub fn validate(&self) -> Result<(), ParameterError> {
         for i in 0..N {
-            positive("rtol", self.rtol[i])?;
+            reachable_rtol(self.rtol[i])?;
             positive("atol", self.atol[i])?;
         }
         Ok(())
@@ -482,8 +517,21 @@ pub trait Stepper<T: Real, const N: usize> {
     type Dense: DenseOutput<T, N>;
 
     /// Sets the state to `(t, y)` and drops every cached derivative (the next step
-    /// re-evaluates `f(t, y)`). The step-size history is kept.
+    /// re-evaluates `f(t, y)`). The step-size history is kept, and so is the clock's
+    /// origin (see [`start`](Self::start)).
     fn reset_state(&mut self, t: T, y: SVector<T, N>);
+
+    /// Starts a run at `(t, y)`: [`reset_state`](Self::reset_state), and the crate's
+    /// steppers count the run's time from `t`. They keep the elapsed time
+    /// `τ = t − t_start` and advance it by their steps, the clock being `t_start + τ`: a run
+    /// started far from `t = 0` takes the steps, and reaches the accuracy, of the same run
+    /// started at 0 (the clock and the state would otherwise drift apart by up to half an
+    /// ulp of `t` per step, 6·10⁻⁵ at `t = 10¹²`). The drivers call it at the start of a
+    /// run and [`reset_state`](Self::reset_state) at its events. Default:
+    /// [`reset_state`](Self::reset_state).
+    fn start(&mut self, t: T, y: SVector<T, N>) {
+        self.reset_state(t, y);
+    }
 
     /// Advances by one accepted step, never past `t_limit`.
     ///
@@ -522,18 +570,15 @@ pub trait Stepper<T: Real, const N: usize> {
     }
 }
 
-/// `true` if a trial step `hs` from `t` is below the minimum or does not advance `t` at all
-/// in floating point (`t + hs == t`, or `hs` NaN): the step fails instead of looping.
-#[inline(always)]
-pub(crate) fn step_too_small<T: Real>(t: T, hs: T, h_min: T) -> bool {
-    hs < min_step(t, h_min) || !(t + hs > t)
-}
-
 /// The state every one-step method keeps: `(t, y)`, the cached derivative `f(t, y)` (the
 /// first-same-as-last stage), the proposed next step and the work counters.
 #[derive(Debug, Clone)]
 pub(crate) struct Core<T: Real, const N: usize> {
     pub(crate) t: T,
+    /// The run's start ([`Stepper::start`]): the clock is `origin + tau`.
+    origin: T,
+    /// The time elapsed since `origin`, advanced by the steps.
+    tau: T,
     pub(crate) y: SVector<T, N>,
     pub(crate) f: SVector<T, N>,
     f_valid: bool,
@@ -546,6 +591,8 @@ impl<T: Real, const N: usize> Core<T, N> {
     pub(crate) fn new(h: Option<T>) -> Self {
         Self {
             t: T::zero(),
+            origin: T::zero(),
+            tau: T::zero(),
             y: SVector::zeros(),
             f: SVector::zeros(),
             f_valid: false,
@@ -555,12 +602,45 @@ impl<T: Real, const N: usize> Core<T, N> {
         }
     }
 
-    /// Sets the state and drops the derivative cache.
+    /// Sets the state and drops the derivative cache (the clock's origin is kept).
     pub(crate) fn reset(&mut self, t: T, y: SVector<T, N>) {
         self.t = t;
+        self.tau = t - self.origin;
         self.y = y;
         self.f_valid = false;
         self.initialized = true;
+    }
+
+    /// Starts a run at `(t, y)`: the clock's origin is `t` ([`Stepper::start`]).
+    pub(crate) fn start(&mut self, t: T, y: SVector<T, N>) {
+        self.origin = t;
+        self.reset(t, y);
+    }
+
+    /// The step `(hs, t_new, tau_new)` of a trial `h` from the state, cut to land on
+    /// `t_limit` when it would reach it ([`clamp_to_limit`], on the elapsed time), and
+    /// whether it lands. The clock is `origin + τ`: with the origin at 0 this is `t + h`.
+    #[inline(always)]
+    pub(crate) fn trial_step(&self, h: T, t_limit: T) -> (T, T, T, bool) {
+        let (hs, lands) = clamp_to_limit(self.tau, h, t_limit - self.origin);
+        if lands {
+            (hs, t_limit, t_limit - self.origin, true)
+        } else {
+            let tau = self.tau + hs;
+            (hs, self.origin + tau, tau, false)
+        }
+    }
+
+    /// The fixed step `h` from the state, `(h, t_new, tau_new)`, or the rest to `t_limit`
+    /// where that is within `10⁻⁹` of a step (it lands there).
+    pub(crate) fn fixed_step(&self, h: T, t_limit: T) -> (T, T, T) {
+        let rest = (t_limit - self.origin) - self.tau;
+        if h >= rest * (T::one() - lit(1e-9)) {
+            (rest, t_limit, t_limit - self.origin)
+        } else {
+            let tau = self.tau + h;
+            (h, self.origin + tau, tau)
+        }
     }
 
     /// Checks that there is a state and that `t_limit` lies ahead, and caches `f(t, y)`.
@@ -638,14 +718,13 @@ impl<T: Real, const N: usize> Core<T, N> {
         let t = self.t;
         let mut nonfinite = 0u32;
         loop {
-            let (hs, lands) = clamp_to_limit(t, h, t_limit);
-            if step_too_small(t, hs, ctrl.opts.h_min) && !lands {
+            let (hs, t_new, tau_new, lands) = self.trial_step(h, t_limit);
+            if (hs < min_step(t, ctrl.opts.h_min) || !(t_new > t)) && !lands {
                 return Err(IntegrateError::StepSizeTooSmall {
                     t: to_f64(t),
                     h: to_f64(hs),
                 });
             }
-            let t_new = if lands { t_limit } else { t + hs };
             let tr = trial(&mut self.stats, hs, t_new)?;
             let err = match tr.err {
                 Some(e) => e,
@@ -662,6 +741,7 @@ impl<T: Real, const N: usize> Core<T, N> {
                 return Ok(Accepted {
                     hs,
                     t_new,
+                    tau_new,
                     lands,
                     h,
                     h_next,
@@ -680,6 +760,7 @@ impl<T: Real, const N: usize> Core<T, N> {
     #[inline(always)]
     pub(crate) fn accept(&mut self, a: &Accepted<T, N>) {
         self.t = a.t_new;
+        self.tau = a.tau_new;
         self.y = a.y;
         self.f = a.f;
         self.h = Some(if a.lands { a.h_next.max(a.h) } else { a.h_next });
@@ -704,12 +785,14 @@ impl<T: Real, const N: usize> Trial<T, N> {
     }
 }
 
-/// The accepted trial of [`Core::adapt`]: its size `hs`, end `t_new`, whether it was cut
+/// The accepted trial of [`Core::adapt`]: its size `hs`, end `t_new` (and `tau_new`), whether it was cut
 /// to land on the limit, the untruncated proposal `h`, the controller's next step, and
 /// the new state and derivative.
 pub(crate) struct Accepted<T: Real, const N: usize> {
     pub(crate) hs: T,
     pub(crate) t_new: T,
+    /// The elapsed time since the clock's origin at `t_new`.
+    pub(crate) tau_new: T,
     pub(crate) lands: bool,
     pub(crate) h: T,
     pub(crate) h_next: T,

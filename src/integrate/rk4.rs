@@ -117,6 +117,10 @@ impl<T: Real, const N: usize> Stepper<T, N> for Rk4<T, N> {
         self.core.reset(t, y);
     }
 
+    fn start(&mut self, t: T, y: SVector<T, N>) {
+        self.core.start(t, y);
+    }
+
     fn current(&self) -> (T, &SVector<T, N>) {
         (self.core.t, &self.core.y)
     }
@@ -137,12 +141,7 @@ impl<T: Real, const N: usize> Stepper<T, N> for Rk4<T, N> {
         self.core.begin(sys, t_limit)?;
         let (t, y) = (self.core.t, self.core.y);
         // Land exactly on the limit when the remaining span is within 1e-9 of a step.
-        let rest = t_limit - t;
-        let (h, t_new) = if self.h >= rest * (T::one() - lit(1e-9)) {
-            (rest, t_limit)
-        } else {
-            (self.h, t + self.h)
-        };
+        let (h, t_new, tau_new) = self.core.fixed_step(self.h, t_limit);
         if !(t_new > t) {
             // A step below the time resolution at t: no progress is possible.
             return Err(IntegrateError::StepSizeTooSmall {
@@ -169,6 +168,7 @@ impl<T: Real, const N: usize> Stepper<T, N> for Rk4<T, N> {
         self.core.accept(&Accepted {
             hs: self.h,
             t_new,
+            tau_new,
             lands: false,
             h: self.h,
             h_next: self.h,

@@ -850,6 +850,11 @@ where
         self.cooldown_onset = false;
     }
 
+    fn start(&mut self, t: T, y: SVector<T, 2>) {
+        self.reset_state(t, y);
+        self.time.start(t, y);
+    }
+
     fn step<S: Dynamics<T, 2>>(&mut self, sys: &S, t_limit: T) -> Result<(), IntegrateError> {
         if !(t_limit > self.t) {
             // The time stepper reports the span error (or that it has no state).
