@@ -516,12 +516,13 @@ impl<T: Real, S: Lagrangian<T>, C: ContactSet<T>> MoreauJean<T, S, C> {
     /// # Errors
     /// [`TimeStepError::Dimension`] if `q` or `v` does not have `dofs()` entries;
     /// [`TimeStepError::Parameter`] unless `t0 ≤ t_end` are finite;
-    /// [`TimeStepError::Clock`] if the clock cannot resolve the step (`ε·max(|t0|, |t_end|)
-    /// > h/1024`: every step then has length `h` to within 0.1 %, never 0);
-    /// [`TimeStepError::MassMatrix`] / [`TimeStepError::MassAsymmetric`] for a mass matrix
-    /// that is not symmetric positive definite, [`TimeStepError::IterationMatrix`] for a
-    /// singular iteration matrix of the implicit forces; [`TimeStepError::NonFinite`] for a non-finite force,
-    /// gap, Jacobian entry or state; [`TimeStepError::Contact`] if a step's contact problem
+    /// [`TimeStepError::Clock`] if the clock cannot resolve the step, where
+    /// `ε·max(|t0|, |t_end|)` exceeds `h/1024` (below it every step has length `h` to
+    /// within 0.1 %, never 0); [`TimeStepError::MassMatrix`] /
+    /// [`TimeStepError::MassAsymmetric`] for a mass matrix that is not symmetric positive
+    /// definite, [`TimeStepError::IterationMatrix`] for a singular iteration matrix of the
+    /// implicit forces; [`TimeStepError::NonFinite`] for a non-finite force, gap, Jacobian
+    /// entry or state; [`TimeStepError::Contact`] if a step's contact problem
     /// is not solved (with the step, its time and the residual reached). The state is that
     /// of the last completed step after an error.
     pub fn run<O: StepObserver<T>>(
