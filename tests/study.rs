@@ -1487,3 +1487,49 @@ fn a_shard_whose_manifest_was_edited_is_refused() {
         "{err}"
     );
 }
+
+/// Issue 49: in a described system, `between = [0, 1, 1]` passed `study check` with the
+/// third index dropped (`between = [0]` was refused). A `between` of any length other than
+/// 2 is an error naming the field and the length, on an element and on a surface.
+#[test]
+fn a_between_of_another_length_than_two_is_refused() {
+    let element = "law = \"hertz\"\nbetween = [1, 0]";
+    let surface = "[[system.surfaces]]\nbetween = [1, 0]";
+    for (from, to, field, len) in [
+        (
+            element,
+            "law = \"hertz\"\nbetween = [1, 0, 1]",
+            "system.elements[2].between",
+            3,
+        ),
+        (
+            element,
+            "law = \"hertz\"\nbetween = [1]",
+            "system.elements[2].between",
+            1,
+        ),
+        (
+            element,
+            "law = \"hertz\"\nbetween = []",
+            "system.elements[2].between",
+            0,
+        ),
+        (
+            surface,
+            "[[system.surfaces]]\nbetween = [1, 0, 0, 1]",
+            "system.surfaces[0].between",
+            4,
+        ),
+    ] {
+        let text = DAMPER.replacen(from, to, 1);
+        assert_ne!(text, DAMPER, "{to}");
+        match Study::from_toml(&text) {
+            Err(StudyError::InvalidSpec { field: f, message }) => {
+                assert_eq!(f, field, "{message}");
+                assert!(message.contains(&format!("length {len}")), "{message}");
+            }
+            Ok(_) => panic!("{to}: accepted, expected an error naming {field}"),
+            Err(e) => panic!("{to}: expected an error naming {field}, got {e:?}"),
+        }
+    }
+}

@@ -100,9 +100,10 @@ pub struct ElementSpec {
     /// The degree of freedom `i` (from 0) the law acts on, or
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub dof: Option<usize>,
-    /// the pair `[i, j]` of the relative coordinate `q_i − q_j`.
+    /// the pair `[i, j]` of the relative coordinate `q_i − q_j` (read as a list: any other
+    /// length is an error of the spec naming the field, not an index dropped or missing).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub between: Option<[usize; 2]>,
+    pub between: Option<Vec<usize>>,
     /// `"upper"` or `"lower"`: the side of a `hertz` stop (default `"upper"`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub side: Option<String>,
@@ -131,9 +132,10 @@ pub struct SurfaceSpec {
     /// The degree of freedom (from 0), or
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub dof: Option<usize>,
-    /// the pair `[i, j]` of the relative coordinate `q_i − q_j`.
+    /// the pair `[i, j]` of the relative coordinate `q_i − q_j` (as on an element: exactly
+    /// two indices).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub between: Option<[usize; 2]>,
+    pub between: Option<Vec<usize>>,
     /// The stop's position on the coordinate.
     pub position: SpecValue,
     /// `"upper"` (the coordinate reaches the stop from below; the default) or `"lower"`.
@@ -390,7 +392,7 @@ impl Described {
         let mut elements = Vec::with_capacity(self.elements.len());
         for (i, e) in self.elements.iter().enumerate() {
             let f = format!("system.elements[{i}]");
-            let c = coordinate::<N>(&f, e.dof, e.between)?;
+            let c = coordinate::<N>(&f, e.dof, e.between.as_deref())?;
             elements.push(Element::new(c, self.law(p, &f, e)?));
         }
         let omega = p.get("omega");
@@ -498,7 +500,7 @@ impl Described {
         let mut gaps = Vec::with_capacity(self.surfaces.len());
         for (i, s) in self.surfaces.iter().enumerate() {
             let f = format!("system.surfaces[{i}]");
-            let c = coordinate::<N>(&f, s.dof, s.between)?;
+            let c = coordinate::<N>(&f, s.dof, s.between.as_deref())?;
             let position = value(p, &s.position);
             let c = c.with_offset(-position).map_err(|_| {
                 build_error(
@@ -674,7 +676,7 @@ fn check_element(
             format!("unknown law {:?}; known: {}", e.law, known.join(", ")),
         ));
     };
-    check_coordinate(f, e.dof, e.between, n)?;
+    check_coordinate(f, e.dof, e.between.as_deref(), n)?;
     check_side(&format!("{f}.side"), e.side.as_deref())?;
     if e.side.is_some() && e.law != "hertz" {
         return Err(invalid(
@@ -737,7 +739,7 @@ fn check_surfaces(
     }
     for (i, s) in surfaces.iter().enumerate() {
         let f = format!("system.surfaces[{i}]");
-        check_coordinate(&f, s.dof, s.between, n)?;
+        check_coordinate(&f, s.dof, s.between.as_deref(), n)?;
         check_side(&format!("{f}.side"), s.side.as_deref())?;
         names.note(format!("{f}.position"), &s.position)?;
         if let Some(e) = &s.restitution {
@@ -770,11 +772,11 @@ fn build_error(field: String, v: &SpecValue, message: String) -> BuildError {
     }
 }
 
-/// Exactly one of `dof` and `between`, within the `n` degrees of freedom.
+/// Exactly one of `dof` and `between` (a pair), within the `n` degrees of freedom.
 fn check_coordinate(
     f: &str,
     dof: Option<usize>,
-    between: Option<[usize; 2]>,
+    between: Option<&[usize]>,
     n: usize,
 ) -> Result<(), StudyError> {
     match (dof, between) {
@@ -783,11 +785,20 @@ fn check_coordinate(
             format!("{f}.dof"),
             format!("{i} is not a degree of freedom of {n} (0 to {})", n - 1),
         )),
-        (None, Some([i, j])) if i < n && j < n && i != j => Ok(()),
-        (None, Some([i, j])) => Err(invalid(
+        (None, Some(&[i, j])) if i < n && j < n && i != j => Ok(()),
+        (None, Some(&[i, j])) => Err(invalid(
             format!("{f}.between"),
             format!(
                 "[{i}, {j}] must be two different degrees of freedom of {n} (0 to {})",
+                n - 1
+            ),
+        )),
+        (None, Some(other)) => Err(invalid(
+            format!("{f}.between"),
+            format!(
+                "{other:?} has length {}: expected a pair [i, j] of two different degrees of \
+                 freedom of {n} (0 to {})",
+                other.len(),
                 n - 1
             ),
         )),
@@ -817,12 +828,13 @@ fn check_side(field: &str, side: Option<&str>) -> Result<(), StudyError> {
 fn coordinate<const N: usize>(
     f: &str,
     dof: Option<usize>,
-    between: Option<[usize; 2]>,
+    between: Option<&[usize]>,
 ) -> Result<Coordinate<f64, N>, BuildError> {
     let c = match (dof, between) {
         (Some(i), _) => Coordinate::dof(i),
-        (None, Some([i, j])) => Coordinate::relative(i, j),
-        (None, None) => Coordinate::dof(usize::MAX),
+        (None, Some(&[i, j])) => Coordinate::relative(i, j),
+        // Neither, or not a pair: refused by the check; an index out of range here.
+        (None, _) => Coordinate::dof(usize::MAX),
     };
     c.map_err(|e| BuildError {
         field: format!("{f}.{}", if dof.is_some() { "dof" } else { "between" }),
@@ -939,9 +951,11 @@ mod tests {
         assert_eq!(spec_name("linear_spring", "k"), "k");
         assert!(check_side("f", Some("sideways")).is_err());
         assert!(check_coordinate("f", Some(2), None, 2).is_err());
-        assert!(check_coordinate("f", None, Some([1, 1]), 2).is_err());
+        assert!(check_coordinate("f", None, Some(&[1, 1]), 2).is_err());
         assert!(check_coordinate("f", None, None, 2).is_err());
-        assert!(check_coordinate("f", None, Some([1, 0]), 2).is_ok());
+        assert!(check_coordinate("f", None, Some(&[1, 0]), 2).is_ok());
+        assert!(check_coordinate("f", None, Some(&[1, 0, 1]), 2).is_err());
+        assert!(check_coordinate("f", None, Some(&[1]), 2).is_err());
     }
 
     #[test]
