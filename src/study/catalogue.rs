@@ -14,7 +14,7 @@ use super::StudyError;
 use super::mechanical::{Described, Description};
 use super::system::{ParameterDef, ParameterPoint, PointRun, PointStart, RunSettings, StudySystem};
 use super::{lanes, scalar};
-use crate::ensemble::{Ensemble, F64x8, F64x16, Simd};
+use crate::ensemble::Ensemble;
 use crate::event::Stop;
 use crate::integrate::{Dopri5, Tolerances};
 use crate::lyapunov::{Norm, TwoTrajectory};
@@ -271,19 +271,12 @@ impl Paper {
                     .push((k, LaneStart { param: 0.0, ..st })),
             }
         }
-        // Sixteen lanes pay on AVX-512, eight on AVX2 (the `ensemble` module docs); the
-        // records are the same either way.
-        let run_lanes = if Simd::Auto.resolve() == Simd::Avx512 {
-            sweep_starts::<F64x16, Member, Stop, 2>
-        } else {
-            sweep_starts::<F64x8, Member, Stop, 2>
-        };
         for group in groups.values() {
             let stop = Self::impact_stop(group[0].1.system.params());
             let starts: Vec<LaneStart<Member, 2>> = group.iter().map(|(_, st)| *st).collect();
             let run = Ensemble::new(tol)
                 .map_err(|e| SweepError::failed(0.0, e))
-                .and_then(|e| run_lanes(&e, &settings, &starts, Some(stop)));
+                .and_then(|e| sweep_starts(&e, &settings, &starts, Some(stop)));
             match run {
                 Err(e) => {
                     for (k, _) in group {
@@ -463,7 +456,7 @@ impl StudySystem for Duffing {
             let model = d.model::<f64>().map_err(|e| e.to_string())?;
             Ok((model, Vec::<Stop>::new(), d.period(), y0.clone()))
         });
-        lanes::run_smooth_batch::<2, 4, lanes::ByMachine, _, _>(s, starts.collect())
+        lanes::run_smooth_batch::<2, 4, _, _>(s, starts.collect())
     }
 }
 
@@ -583,7 +576,7 @@ impl StudySystem for TwoDof {
             let stop = d.stop::<f64>().map_err(e)?;
             Ok((model, vec![stop], TwoDofImpact::period(omega), y0.clone()))
         });
-        lanes::run_smooth_batch::<4, 8, lanes::ByMachine, _, _>(s, starts.collect())
+        lanes::run_smooth_batch::<4, 8, _, _>(s, starts.collect())
     }
 }
 

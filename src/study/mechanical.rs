@@ -1063,7 +1063,7 @@ impl Described {
             let period = std::f64::consts::TAU / p.value(OMEGA);
             Ok((model, gaps, period, y0.clone()))
         });
-        super::lanes::run_smooth_batch::<M, M2, super::lanes::Eight, _, _>(s, starts.collect())
+        super::lanes::run_smooth_batch::<M, M2, _, _>(s, starts.collect())
     }
 }
 
