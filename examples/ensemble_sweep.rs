@@ -37,7 +37,7 @@ fn stop() -> Stop {
     }
 }
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
+fn main() -> nonsmooth::Result<()> {
     let quick = std::env::args().any(|a| a == "--quick");
     let step = if quick { 0.05 } else { 0.005 };
     let rtol = 1e-8;

@@ -55,7 +55,7 @@ impl Observer<f64, 2> for Collect {
     }
 }
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
+fn main() -> nonsmooth::Result<()> {
     let args: Vec<String> = std::env::args().collect();
     let quick = args.iter().any(|a| a == "--quick");
     // `--simd baseline|avx2|avx512` caps the run-time dispatch (default: the widest).

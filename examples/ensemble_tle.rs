@@ -21,7 +21,7 @@ use nonsmooth::lyapunov::{
 use nonsmooth::systems::paper::lyapunov::{D0 as PAPER_D0, norm as paper_norm};
 use nonsmooth::systems::paper::{Member, PAPER};
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
+fn main() -> nonsmooth::Result<()> {
     let args: Vec<String> = std::env::args().collect();
     let quick = args.iter().any(|a| a == "--quick");
     let every: usize = args

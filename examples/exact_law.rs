@@ -695,7 +695,7 @@ fn cusp_table(reps: usize, w1_periods: u32, regime_periods: u32) -> nonsmooth::R
     Ok(())
 }
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
+fn main() -> nonsmooth::Result<()> {
     let quick = std::env::args().any(|a| a == "--quick");
     if std::env::args().any(|a| a == "--cusp") {
         let reps = if quick { 1 } else { 3 };

@@ -108,8 +108,11 @@ fn interpolate(ts: &[f64], ys: &[f64], t: f64) -> f64 {
     ys[k - 1] + (ys[k] - ys[k - 1]) * (t - t0) / (t1 - t0)
 }
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let args = parse()?;
+fn main() -> nonsmooth::Result<()> {
+    let args = parse().unwrap_or_else(|e| {
+        eprintln!("{e}");
+        std::process::exit(2)
+    });
     std::fs::create_dir_all(&args.out)?;
     let duration = (args.to - args.from) / args.rate;
     let forcing = Forcing::ramp(args.from, args.rate);

@@ -105,8 +105,11 @@ fn parse() -> Result<Args, String> {
     Ok(a)
 }
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let args = parse()?;
+fn main() -> nonsmooth::Result<()> {
+    let args = parse().unwrap_or_else(|e| {
+        eprintln!("{e}");
+        std::process::exit(2)
+    });
     std::fs::create_dir_all(&args.out)?;
     let forcing = Forcing::constant(args.omega);
 
@@ -219,7 +222,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         report = Some(r);
     }
     let wall = wall.elapsed();
-    let report = report.ok_or("no stage ran")?;
+    let report = report.ok_or_else(|| nonsmooth::Error::Output("no stage ran".into()))?;
 
     // 3. The table, with the linearized standard deviations at the fit: J = ∂x_sim/∂ln p
     //    by central differences (step 1e-2, large against the integrator's error),

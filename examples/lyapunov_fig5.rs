@@ -88,8 +88,11 @@ fn chaotic_windows(points: &[DiagramPoint<f64>]) -> Vec<(f64, f64)> {
     out
 }
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let args = parse_args()?;
+fn main() -> nonsmooth::Result<()> {
+    let args = parse_args().unwrap_or_else(|e| {
+        eprintln!("{e}");
+        std::process::exit(2)
+    });
     let n = ((args.to - args.from) / args.step).round() as usize + 1;
     // The grid from the index, never accumulated.
     let omegas: Vec<f64> = (0..n).map(|i| args.from + i as f64 * args.step).collect();

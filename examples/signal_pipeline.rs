@@ -28,7 +28,7 @@ impl SplitMix64 {
     }
 }
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
+fn main() -> nonsmooth::Result<()> {
     let dir = std::env::args()
         .nth(1)
         .map_or_else(|| PathBuf::from("out/signal_pipeline"), PathBuf::from);

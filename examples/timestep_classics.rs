@@ -26,7 +26,7 @@ use nonsmooth::timestep::{
     StepRecord,
 };
 
-type Res<T> = Result<T, Box<dyn std::error::Error>>;
+type Res<T> = nonsmooth::Result<T>;
 
 /// Bodies, contacts and initial positions of a column.
 type Column = (PlanarBodies<f64>, Vec<PlanarContact<f64>>, Vec<f64>);

@@ -18,7 +18,7 @@ use nonsmooth::output::csv::{Cell, write_table_path};
 use nonsmooth::systems::BouncingBallTable;
 use nonsmooth::timestep::{ImpactLog, MoreauJean, RidingLog};
 
-type Res<T> = Result<T, Box<dyn std::error::Error>>;
+type Res<T> = nonsmooth::Result<T>;
 
 struct EdImpacts(Vec<f64>);
 

@@ -48,7 +48,7 @@ use nonsmooth::drive::Control;
 use nonsmooth::systems::Woodpecker;
 use nonsmooth::timestep::{MoreauJean, StepObserver, StepRecord};
 
-type Res<T> = Result<T, Box<dyn std::error::Error>>;
+type Res<T> = nonsmooth::Result<T>;
 
 /// The impacts of Siconos' `Woodpecker.ref` (θ = ½, h = 2·10⁻⁵): the end time of the step
 /// with the velocity jump and the contact (0: beak, 1 and 2: sleeve edges `g₂`, `g₃`),

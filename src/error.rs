@@ -52,9 +52,32 @@ pub enum Error {
     /// Parameter identification failed.
     #[error(transparent)]
     Identify(crate::identify::IdentifyError),
+    /// A Filippov run (sliding on switching surfaces) or its monodromy failed.
+    #[error(transparent)]
+    Filippov(#[from] crate::filippov::FilippovError),
+    /// A time-stepping run (Moreau–Jean) failed.
+    #[error(transparent)]
+    TimeStep(#[from] crate::timestep::TimeStepError),
+    /// A complementarity problem was not solved.
+    #[error(transparent)]
+    Lcp(#[from] crate::timestep::lcp::LcpError),
     /// Writing output failed.
     #[error("output error: {0}")]
     Output(String),
+}
+
+impl From<std::io::Error> for Error {
+    /// Reading or writing a file or stream: [`Error::Output`] with the system's message.
+    fn from(e: std::io::Error) -> Self {
+        Error::Output(format!("input/output: {e}"))
+    }
+}
+
+impl From<csv::Error> for Error {
+    /// Reading or writing CSV: [`Error::Output`] with the reader's or writer's message.
+    fn from(e: csv::Error) -> Self {
+        Error::Output(format!("CSV: {e}"))
+    }
 }
 
 impl From<crate::drive::RunError> for Error {

@@ -423,7 +423,9 @@ fn gather_bits(mask: u32, from: &[usize]) -> u32 {
 /// The lanes and their scalar bookkeeping.
 ///
 /// `I` is the instruction set the lane loop is compiled for, `V` the lanes of this engine
-/// and `H` those its tail compacts into (`H = V`: no further compaction).
+/// and `H` those its tail compacts into (`H = V`: no further compaction); the compacted
+/// engine steps with `I`'s [`Tail`](Isa::Tail), whose lane loops are a codegen unit of
+/// their own.
 struct Engine<'a, I: Isa, V: Lanes, H: Lanes, E, D: LaneDynamics<M>, const M: usize> {
     cfg: &'a Ensemble<E, M>,
     jobs: &'a [MemberRun<D, M>],
@@ -679,15 +681,11 @@ impl<'a, I: Isa, V: Lanes, H: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, co
                 self.compact().drive(observers, out);
                 return;
             }
-            super::kernel::step::<I, V, D, M>(&mut self.st, &self.consts, &mut step);
+            I::step::<V, D, M>(&mut self.st, &self.consts, &mut step);
             step.events = false;
             if want_events && step.accepted != 0 {
                 let st = &mut *self.st;
-                super::kernel::event_ends::<I, V, E, M>(
-                    &self.cfg.events,
-                    (&mut st.ends, st.accepted),
-                    &mut step,
-                );
+                I::event_ends::<V, E, M>(&self.cfg.events, (&mut st.ends, st.accepted), &mut step);
             }
             if step.too_small != 0 {
                 for i in lanes_of(step.too_small) {
@@ -727,7 +725,7 @@ impl<'a, I: Isa, V: Lanes, H: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, co
     /// The busy lanes moved, in order, to an engine of the narrow width `H` (the queue is
     /// empty; at most `H::LANES` lanes are busy). Idle lanes there step from the first
     /// busy lane's state, never used.
-    fn compact(&mut self) -> Engine<'a, I, H, H, E, D, M> {
+    fn compact(&mut self) -> Engine<'a, I::Tail, H, H, E, D, M> {
         let busy: Vec<usize> = lanes_of(self.st.active.bits()).collect();
         let st = &self.st;
         let first = busy[0];

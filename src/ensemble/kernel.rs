@@ -20,65 +20,184 @@ use crate::lanes::{F64x8, F64x16};
 
 /// An instruction set the lane loop is compiled for, with its lane width: a run takes
 /// [`Wide`](Self::Wide) lanes and moves its last trajectories to [`Narrow`](Self::Narrow)
-/// ones (the engine's compaction). Each (instruction set, model, event set) compiles the
-/// lane loop for these two widths only.
+/// ones (the engine's compaction), stepped by [`Tail`](Self::Tail). Each (instruction set,
+/// model, event set) compiles the lane loop for these two widths only.
+///
+/// The entry points [`step`](Self::step) and [`event_ends`](Self::event_ends) are methods
+/// of the marker: the compiler places a generic method's code with its `Self` type, and
+/// each marker is declared in a module of its own (below), so each instruction set's and
+/// tail's lane loops (every model and event set) form a codegen unit of their own, which an
+/// optimized build compiles in parallel with the others. As free functions of this module
+/// they were all one unit (11 of the 15 minutes of `cargo build --release --all-features`).
 pub(crate) trait Isa: Copy + Send + Sync + 'static {
     /// The lanes of a run (sixteen with AVX2 or AVX-512: the fastest width measured for the
     /// catalogue's models, `docs/performance.md`).
     type Wide: Lanes;
     /// The lanes the tail of a run compacts into (half of `Wide`).
     type Narrow: Lanes;
+    /// The marker that steps the tail's `Narrow` lanes (the same instruction set; itself
+    /// for a tail, which compacts no further).
+    type Tail: Isa;
     /// Runs `f` compiled with this instruction set's target features.
     fn vectorize<F: pulp::WithSimd>(f: F) -> F::Output;
-}
 
-/// The build's target features (SSE2 on a default x86-64 build): four lanes (two registers
-/// per value), two in the tail.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct Baseline;
+    /// One pass of the lane loop, compiled for this instruction set.
+    #[inline(never)]
+    fn step<V: Lanes, D: LaneDynamics<M>, const M: usize>(
+        st: &mut LaneState<V, D, M>,
+        k: &StepConsts<M>,
+        out: &mut StepOut,
+    ) {
+        Self::vectorize(Pass { st, k, out })
+    }
 
-impl Isa for Baseline {
-    type Wide = F64x4;
-    type Narrow = crate::lanes::F64x2;
-    #[inline(always)]
-    fn vectorize<F: pulp::WithSimd>(f: F) -> F::Output {
-        pulp::Simd::vectorize(pulp::Scalar::new(), f)
+    /// Every event's value and rate at both ends of the accepted steps of a pass (from the
+    /// rows `T0, T1, X0, X1, F0, F1` of `out`; at the start from `cache` where the lane is
+    /// not fresh), from its lane form, and what they say about a quiet step
+    /// ([`QuietEnds::lanes`], into `out.quiet`); `out.events` tells whether every event has
+    /// a lane form. The accepted lanes' ends become their cached starts. Compiled, like
+    /// [`step`](Self::step), for this instruction set (and apart from it, so that the step
+    /// is not compiled again for each event set).
+    #[inline(never)]
+    fn event_ends<V: Lanes, E: EventSet<f64, M>, const M: usize>(
+        events: &E,
+        (cache, accepted): (&mut EndsCache<V>, V),
+        out: &mut StepOut,
+    ) {
+        Self::vectorize(Ends::<V, E, M> {
+            events,
+            cache,
+            accepted,
+            out,
+        })
     }
 }
 
-/// AVX2 and FMA: sixteen lanes (four registers of four per value), eight in the tail.
-#[cfg(all(target_arch = "x86_64", not(debug_assertions)))]
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct Avx2;
+pub(crate) use baseline::Baseline;
 
-#[cfg(all(target_arch = "x86_64", not(debug_assertions)))]
-impl Isa for Avx2 {
-    type Wide = F64x16;
-    type Narrow = F64x8;
-    #[inline(always)]
-    fn vectorize<F: pulp::WithSimd>(f: F) -> F::Output {
-        match pulp::x86::V3::try_new() {
-            Some(v3) => pulp::Simd::vectorize(v3, f),
-            None => pulp::Simd::vectorize(pulp::Scalar::new(), f),
+/// The build's target features (SSE2 on a default x86-64 build).
+mod baseline {
+    use super::{F64x4, Isa};
+    use crate::lanes::F64x2;
+
+    /// The build's target features: four lanes (two SSE2 registers per value), two in the
+    /// tail.
+    #[derive(Debug, Clone, Copy)]
+    pub(crate) struct Baseline;
+
+    impl Isa for Baseline {
+        type Wide = F64x4;
+        type Narrow = F64x2;
+        type Tail = tail::BaselineTail;
+        #[inline(always)]
+        fn vectorize<F: pulp::WithSimd>(f: F) -> F::Output {
+            pulp::Simd::vectorize(pulp::Scalar::new(), f)
+        }
+    }
+
+    mod tail {
+        use super::{F64x2, Isa};
+
+        /// The baseline's tail: two lanes.
+        #[derive(Debug, Clone, Copy)]
+        pub(crate) struct BaselineTail;
+
+        impl Isa for BaselineTail {
+            type Wide = F64x2;
+            type Narrow = F64x2;
+            type Tail = Self;
+            #[inline(always)]
+            fn vectorize<F: pulp::WithSimd>(f: F) -> F::Output {
+                super::Baseline::vectorize(f)
+            }
         }
     }
 }
 
-/// AVX-512F with AVX2 and FMA: sixteen lanes (two registers of eight per value), eight in
-/// the tail.
 #[cfg(all(target_arch = "x86_64", not(debug_assertions)))]
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct Avx512;
+pub(crate) use avx2::Avx2;
+#[cfg(all(target_arch = "x86_64", not(debug_assertions)))]
+pub(crate) use avx512::Avx512;
 
+/// AVX2 and FMA.
 #[cfg(all(target_arch = "x86_64", not(debug_assertions)))]
-impl Isa for Avx512 {
-    type Wide = F64x16;
-    type Narrow = F64x8;
-    #[inline(always)]
-    fn vectorize<F: pulp::WithSimd>(f: F) -> F::Output {
-        match pulp::x86::V4::try_new() {
-            Some(v4) => pulp::Simd::vectorize(v4, f),
-            None => Avx2::vectorize(f),
+mod avx2 {
+    use super::{F64x8, F64x16, Isa};
+
+    /// AVX2 and FMA: sixteen lanes (four registers of four per value), eight in the tail.
+    #[derive(Debug, Clone, Copy)]
+    pub(crate) struct Avx2;
+
+    impl Isa for Avx2 {
+        type Wide = F64x16;
+        type Narrow = F64x8;
+        type Tail = tail::Avx2Tail;
+        #[inline(always)]
+        fn vectorize<F: pulp::WithSimd>(f: F) -> F::Output {
+            match pulp::x86::V3::try_new() {
+                Some(v3) => pulp::Simd::vectorize(v3, f),
+                None => pulp::Simd::vectorize(pulp::Scalar::new(), f),
+            }
+        }
+    }
+
+    mod tail {
+        use super::{F64x8, Isa};
+
+        /// AVX2's tail: eight lanes.
+        #[derive(Debug, Clone, Copy)]
+        pub(crate) struct Avx2Tail;
+
+        impl Isa for Avx2Tail {
+            type Wide = F64x8;
+            type Narrow = F64x8;
+            type Tail = Self;
+            #[inline(always)]
+            fn vectorize<F: pulp::WithSimd>(f: F) -> F::Output {
+                super::Avx2::vectorize(f)
+            }
+        }
+    }
+}
+
+/// AVX-512F with AVX2 and FMA.
+#[cfg(all(target_arch = "x86_64", not(debug_assertions)))]
+mod avx512 {
+    use super::{F64x8, F64x16, Isa};
+
+    /// AVX-512F with AVX2 and FMA: sixteen lanes (two registers of eight per value), eight
+    /// in the tail.
+    #[derive(Debug, Clone, Copy)]
+    pub(crate) struct Avx512;
+
+    impl Isa for Avx512 {
+        type Wide = F64x16;
+        type Narrow = F64x8;
+        type Tail = tail::Avx512Tail;
+        #[inline(always)]
+        fn vectorize<F: pulp::WithSimd>(f: F) -> F::Output {
+            match pulp::x86::V4::try_new() {
+                Some(v4) => pulp::Simd::vectorize(v4, f),
+                None => super::Avx2::vectorize(f),
+            }
+        }
+    }
+
+    mod tail {
+        use super::{F64x8, Isa};
+
+        /// AVX-512's tail: eight lanes.
+        #[derive(Debug, Clone, Copy)]
+        pub(crate) struct Avx512Tail;
+
+        impl Isa for Avx512Tail {
+            type Wide = F64x8;
+            type Narrow = F64x8;
+            type Tail = Self;
+            #[inline(always)]
+            fn vectorize<F: pulp::WithSimd>(f: F) -> F::Output {
+                super::Avx512::vectorize(f)
+            }
         }
     }
 }
@@ -282,16 +401,6 @@ impl StepOut {
             buf: vec![[0.0; 16]; row::count(m)],
         }
     }
-}
-
-/// One pass of the lane loop, compiled for the instruction set `I`.
-#[inline(never)]
-pub(crate) fn step<I: Isa, V: Lanes, D: LaneDynamics<M>, const M: usize>(
-    st: &mut LaneState<V, D, M>,
-    k: &StepConsts<M>,
-    out: &mut StepOut,
-) {
-    I::vectorize(Pass { st, k, out })
 }
 
 /// One pass, handed to `pulp` to be compiled with the instruction set's target features.
@@ -553,27 +662,6 @@ fn body<V: Lanes, D: LaneDynamics<M>, const M: usize>(
             w.store(&mut out.buf[row::vector(q, M) + c]);
         }
     }
-}
-
-/// Every event's value and rate at both ends of the accepted steps of a pass (from the
-/// rows `T0, T1, X0, X1, F0, F1` of `out`; at the start from `cache` where the lane is not
-/// fresh), from its lane form, and what they say about a quiet step
-/// ([`QuietEnds::lanes`], into `out.quiet`); `out.events` tells whether every event has a
-/// lane form. The accepted lanes' ends become their cached starts. Compiled, like
-/// [`step`], for the instruction set `simd` (and apart from it, so that the step is not
-/// compiled again for each event set).
-#[inline(never)]
-pub(crate) fn event_ends<I: Isa, V: Lanes, E: EventSet<f64, M>, const M: usize>(
-    events: &E,
-    (cache, accepted): (&mut EndsCache<V>, V),
-    out: &mut StepOut,
-) {
-    I::vectorize(Ends::<V, E, M> {
-        events,
-        cache,
-        accepted,
-        out,
-    })
 }
 
 /// The events' ends, handed to `pulp` like [`Pass`].
