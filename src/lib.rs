@@ -60,6 +60,7 @@ pub mod excite;
 mod fastmath;
 pub mod filippov;
 pub mod force;
+pub mod guide;
 pub mod identify;
 pub mod integrate;
 pub mod lanes;
