@@ -20,7 +20,7 @@
 //!
 //! The same approach for the contact law's `exp`/`ln` pair (fdlibm-style `ln` with a
 //! division, Taylor `exp`) was slower than glibc's table-driven functions and is not used
-//! (`comparisons/`, `rhs-bench`; the figures are in the README).
+//! (`comparisons/`, `rhs-bench`; the figures are in `docs/performance.md`).
 //!
 //! Both functions are generic over [`Real`]: the kernels are taken only when `T` *is* `f64`
 //! (a `TypeId` test the compiler folds away); `f32` and user scalar types (dual numbers,

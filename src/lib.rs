@@ -25,7 +25,8 @@
 //! | measured data | time series, filter, threshold impacts, synthetic records, identification (the paper's configuration in [`systems::paper`]) | [`signal`], [`identify`] |
 //!
 //! `use nonsmooth::prelude::*` imports the types to build, run and record a system
-//! ([`prelude`]).
+//! ([`prelude`]). The [`guide`] walks through the crate chapter by chapter, from the first
+//! impact oscillator to studies on a cluster, with code that runs as doctests.
 //!
 //! ## Quick start
 //! ```
@@ -60,6 +61,7 @@ pub mod excite;
 mod fastmath;
 pub mod filippov;
 pub mod force;
+pub mod guide;
 pub mod identify;
 pub mod integrate;
 pub mod lanes;

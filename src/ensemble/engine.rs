@@ -443,9 +443,8 @@ struct Engine<'a, I: Isa, V: Lanes, H: Lanes, E, D: LaneDynamics<M>, const M: us
     /// The lanes whose observer [wants steps](Observer::wants_steps).
     watch: u32,
     /// On the heap, like the step's output: on the stack, the speed of the vector step
-    /// depended on where the stack began (the program's path and environment) by up to
-    /// 30 % (measured with AVX2, 16 lanes: 0.38–0.50 s for the same binary); boxed, it
-    /// stays at the fast end.
+    /// depended on where the stack began (the program's path and environment; measured in
+    /// `docs/performance.md`); boxed, it stays at the fast end.
     st: Box<LaneState<V, D, M>>,
     consts: StepConsts<M>,
     isa: core::marker::PhantomData<(I, H)>,

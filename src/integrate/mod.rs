@@ -303,7 +303,7 @@ pub struct StepOptions<T> {
     /// It saves rejected steps and evaluations next to non-smooth points, but at equal
     /// *accuracy* it gains little, and it scatters the Poincaré points of periodic orbits
     /// more (the steps it accepts next to non-smooth points carry errors the embedded
-    /// estimate underrates; the README gives the figures). Hence off by default.
+    /// estimate underrates; `docs/performance.md` gives the figures). Hence off by default.
     pub predictive: bool,
 }
 

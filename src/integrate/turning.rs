@@ -4,8 +4,9 @@
 //! A force term `∝ sgn(ẋ)|ẋ|^q` with `0 < q < 1` (a Hertz contact's damping, `q = n3`) has
 //! an infinite slope at `ẋ = 0`. Where the trajectory turns round with an
 //! acceleration `a ≠ 0`, `ẋ ≈ a·τ`, so the velocity has a `|τ|^{1+q}` term: a method that
-//! steps in time must shrink its steps to ~10⁻⁸ s there and grow them back (≈ 40 attempts per
-//! turning point at rtol 10⁻⁸ in `examples/turning_points.rs`). A regularized friction
+//! steps in time must shrink its steps to ~10⁻⁸ s there and grow them back (the attempts per
+//! turning point are counted by `examples/turning_points.rs`; figures in
+//! `docs/performance.md`). A regularized friction
 //! `T·ẋ/√(ẋ² + ε²)` adds a layer of width `ε/|a|` in time at every `ẋ = 0`.
 //!
 //! # How
@@ -23,8 +24,7 @@
 //! segment's right-hand side has `p − 1` more continuous derivatives than the cusp (`p = 6`
 //! for `q ≈ 0.19`: enough for a fifth-order method), and the friction layer is
 //! stretched from `ε` to `≈ ε^{1/p}`. An integer `p` keeps the map `u ↦ ẋ` to a few
-//! multiplications: `p = 1/q` itself took 6 % fewer steps per segment in
-//! `examples/turning_points.rs` (14.7 against 15.6 at rtol 10⁻⁸) but a `powf` per evaluation, and more time per period.
+//! multiplications; `p = 1/q` itself would cost a `powf` per evaluation.
 //!
 //! The state of a *segment* is `(θ, x)`: the time since the segment began in units of its
 //! natural duration, `θ = τ·|a₀|/V*` (`a₀` the acceleration at entry; a segment lasts
@@ -53,14 +53,10 @@
 //! from `w = 0` (the crossing of the stop, located on the time step's dense output) to
 //! `w = δ*^{1/m}` entering, and back from `δ = δ*` to exactly `δ = 0` leaving. It needs
 //! `ẋ ≠ 0` across the band; a contact shallower than `δ*` (the body turns round inside
-//! it) abandons the segment and is stepped in time. Measured with
-//! `examples/turning_points.rs -- --onset 1e-5`, this does not pay: time stepping spends
-//! about 7 attempts per crossing of `[0, 10⁻⁵ m]` at rtol 10⁻⁸, a segment 6.7 plus two
-//! restarts, after which the time stepper regrows its step inside the contact (80 → 88
-//! accepted steps per period there). On the attractor it costs 9 % more evaluations than
-//! the velocity segments alone at about the same error; on the stable period-2 orbit the
-//! work–precision gain over time stepping is 0.95–1.69× (median 1.33×) against 1.02–1.47×
-//! (median 1.28×) without it. It is off by default.
+//! it) abandons the segment and is stepped in time. It is off by default: on the paper's
+//! model the time stepper crosses the first micrometres of a contact in a few attempts, and
+//! the segment's restarts cost as much (`examples/turning_points.rs -- --onset 1e-5`;
+//! figures in `docs/performance.md`).
 //!
 //! # Which systems declare
 //! The one-degree-of-freedom models declare what their force laws declare
@@ -91,12 +87,9 @@
 //! A segment's accuracy is set by the segment stepper's tolerances on `(θ, x)`. The error
 //! in `θ` is a phase error: `δτ = δθ·V*/|a₀|` shifts the state by `(ẋ, ẍ)·δτ` at the exit.
 //! [`TurningPoints::dopri5`] uses `rtol` for both, an absolute tolerance of `100·rtol` on
-//! `θ` and the time stepper's on `x`, chosen by work–precision measurements
-//! (`examples/turning_points.rs`): on a stable period-2 orbit (ω = 19 rad/s, where
-//! errors do not grow from period to period), time stepping needs 1.0–1.5× (median 1.3×)
-//! the evaluations to reach the segments' error at rtol 10⁻⁶…10⁻¹²; `θ` to `rtol` gains
-//! nothing (0.85–1.13×: the segment then takes as many steps as time stepping spent), and
-//! to `1000·rtol` 0.94–1.35×.
+//! `θ` and the time stepper's on `x`, chosen by work–precision measurements on a stable
+//! periodic orbit, where errors do not grow from period to period
+//! (`examples/turning_points.rs`; figures in `docs/performance.md`).
 
 use nalgebra::{SVector, Vector2};
 

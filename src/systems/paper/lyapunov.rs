@@ -41,9 +41,9 @@
 //! agree within their spreads; on the periodic orbit they agree to `3·10⁻⁴` at tight
 //! tolerances and to 1 % at the paper-grade tolerances, where the two-trajectory estimate
 //! carries the integration error of the difference (see [`D0`]). The QR method costs
-//! about 2.5 times as much per period (15 ms against 5.8 ms for 50 periods at ω = 20.465,
-//! `benches/lyapunov.rs`) and gives the second exponent too; the two-trajectory method is
-//! the one that needs no derivatives and also works for the exact law (`η = 0`).
+//! more per period (`benches/lyapunov.rs`; figures in `docs/performance.md`) and gives the
+//! second exponent too; the two-trajectory method is the one that needs no derivatives and
+//! also works for the exact law (`η = 0`).
 //!
 //!
 //! The paper's exponent-versus-ω diagram (Fig. 5) uses [`diagram_settings`] with [`norm`]
