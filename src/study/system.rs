@@ -50,6 +50,11 @@ impl ParameterPoint {
         self.values.get(name).copied().unwrap_or(f64::NAN)
     }
 
+    /// Every parameter's name and value, by name.
+    pub fn iter(&self) -> impl Iterator<Item = (&str, f64)> {
+        self.values.iter().map(|(k, &v)| (k.as_str(), v))
+    }
+
     /// Sets parameter `name`.
     ///
     /// # Errors

@@ -21,9 +21,10 @@ pub(crate) const MAX_LANE_ELEMENTS: usize = 16;
 /// The most loads a described system runs in lanes with.
 pub(crate) const MAX_LANE_LOADS: usize = 8;
 
-/// A [`Law`]'s parameters in lanes: the law's own packed form, by kind.
+/// A [`Law`]'s parameters in lanes: the law's own packed form, by kind (public only as
+/// the packed form of [`DescribedElements`](super::DescribedElements)).
 #[derive(Debug, Clone, Copy)]
-pub(crate) enum LawLanes<V: Lanes> {
+pub enum LawLanes<V: Lanes> {
     Linear(<LinearSpring<f64> as LaneLaw>::Packed<V>),
     Damper(<ViscousDamper<f64> as LaneLaw>::Packed<V>),
     Cubic(<CubicSpring<f64> as LaneLaw>::Packed<V>),
