@@ -41,12 +41,14 @@ from ._nonsmooth import (
     paper,
     relay_feedback,
     two_dof_impact,
+    woodpecker,
 )
 from . import _nonsmooth as _ext
 from ._results import (
     Bifurcation,
     Branch,
     BranchPoint,
+    EnsembleResult,
     EntropyIndex,
     Impacts,
     LyapunovEstimate,
@@ -58,16 +60,17 @@ from ._results import (
     SweepResult,
     SweepTransition,
     Trajectory,
+    TimeStepRun,
     Transition,
 )
 
 __all__ = [
     "System", "paper", "duffing_ueda", "two_dof_impact", "bouncing_ball", "relay_feedback",
     "describe", "load", "simulate", "impacts", "poincare", "sweep", "lyapunov", "tsallis_q",
-    "periodic_orbit", "continuation", "study",
+    "periodic_orbit", "continuation", "ensemble", "timestep", "study", "woodpecker",
     "Trajectory", "Impacts", "Section", "SweepResult", "SweepBranch", "SweepTransition",
     "LyapunovEstimate", "EntropyIndex", "PeriodicOrbit", "Branch", "BranchPoint",
-    "Bifurcation", "Stats", "ModeChange", "Transition",
+    "Bifurcation", "Stats", "ModeChange", "Transition", "EnsembleResult", "TimeStepRun",
     "NonsmoothError", "ZenoError", "WorkLimitError", "ConvergenceError", "IntegrationError",
     "StudyError", "__version__",
 ]
@@ -465,3 +468,89 @@ def continuation(
         _c.number("t0", t0), r, a, g, bool(contact_changes),
     )
     return Branch._from(d)
+
+
+def ensemble(
+    system: System,
+    y0: Optional[npt.ArrayLike] = None,
+    *,
+    parameter: Optional[str] = None,
+    values: Optional[npt.ArrayLike] = None,
+    transient: int = 100,
+    record: int = 50,
+    surface: int = 0,
+    rtol: float = 1e-8,
+    atol: Union[None, float, npt.ArrayLike] = None,
+    period_tol: float = 1e-4,
+    max_period: int = 16,
+    max_steps: int = 10_000_000,
+) -> EnsembleResult:
+    """Many starts of one smooth system at once, in the SIMD lanes of the crate's ensemble
+    integrator (DOPRI5 with every lane's own step, error control and events), on every
+    core: ``y0`` is one initial state or an ``(n, dim)`` array of them; with
+    ``parameter`` each start ``j`` runs at ``values[j]``. Each start runs ``transient``
+    then ``record`` forcing periods from ``t = 0`` and gives the record :func:`poincare`
+    gives for it, to the bit. A failed start does not stop the others.
+    """
+    n_dim = system.dimension
+    if y0 is None:
+        y0s = [[float(x) for x in system.rest_state]]
+    else:
+        a = np.asarray(y0, dtype=np.float64)
+        if a.ndim == 1:
+            y0s = [_c.vector("y0", a, n_dim)]
+        elif a.ndim == 2:
+            if a.shape[0] > _c.MAX_OUTPUT:
+                raise ValueError(f"{a.shape[0]} initial states; at most {_c.MAX_OUTPUT}")
+            y0s = [_c.vector(f"y0[{j}]", row, n_dim) for j, row in enumerate(a)]
+        else:
+            raise ValueError(f"y0 must be one state or an (n, {n_dim}) array (got shape {a.shape})")
+    if (parameter is None) != (values is None):
+        raise ValueError("give parameter and values together")
+    if parameter is not None and not isinstance(parameter, str):
+        raise TypeError("parameter must be a name (str)")
+    v = np.zeros(0) if values is None else _c.array("values", values, 10_000_000)
+    if parameter is not None and len(y0s) != 1 and len(y0s) != v.size:
+        raise ValueError(f"{len(y0s)} initial states for {v.size} values")
+    r, a_tol = _c.tolerances(rtol, atol, n_dim)
+    d = _ext.ensemble(
+        system, parameter, v, y0s, _c.integer("transient", transient),
+        _c.integer("record", record, 1), _c.integer("surface", surface, 0, 3), r, a_tol,
+        _c.positive("period_tol", period_tol), _c.integer("max_period", max_period, 1),
+        _c.integer("max_steps", max_steps, 1, 2**63 - 1),
+    )
+    return EnsembleResult._from(d)
+
+
+def timestep(
+    system: System,
+    t_span: tuple[float, float],
+    h: float,
+    *,
+    q0: Optional[npt.ArrayLike] = None,
+    v0: Optional[npt.ArrayLike] = None,
+    theta: float = 0.5,
+    every: int = 1,
+    max_records: int = 10_000_000,
+    impact_speed: float = 1e-6,
+) -> TimeStepRun:
+    """Moreau–Jean time-stepping of a rigid-contact system (:func:`bouncing_ball`,
+    :func:`woodpecker`) over ``t_span`` with the fixed step ``h`` (s): on ``t_k = t0 + kh``
+    the free velocity ``v_free = v_k + h M⁻¹((1−θ)f_k + θ f_{k+1})``, one complementarity
+    problem for the impulses of the active contacts (Newton's impact law, Coulomb friction
+    where the contact has it), ``v_{k+1} = v_free + M⁻¹Hᵀp``, ``q_{k+1} = q_k +
+    h((1−θ)v_k + θv_{k+1})``. Impacts accumulate (Zeno) without stalling the scheme.
+    """
+    t0, t1 = _span(t_span)
+    hh = _c.positive("h", h)
+    if (t1 - t0) / hh > 1e10:
+        raise ValueError(f"{(t1 - t0) / hh:.3g} steps of h = {hh}; at most 1e10")
+    th = _c.number("theta", theta)
+    q = None if q0 is None else _c.vector("q0", q0)
+    vv = None if v0 is None else _c.vector("v0", v0)
+    d = _ext.timestep(
+        system, t0, t1, hh, th, q, vv, _c.integer("every", every, 1, 2**63 - 1),
+        _c.integer("max_records", max_records, 1, _c.MAX_OUTPUT),
+        _c.positive("impact_speed", impact_speed),
+    )
+    return TimeStepRun._from(d)

@@ -351,3 +351,82 @@ class Branch:
             end=str(d["end"]),
             end_p=None if d["end_p"] is None else float(d["end_p"]),
         )
+
+
+@dataclass(frozen=True)
+class EnsembleResult:
+    """Many starts of one system run together in SIMD lanes: per start its record (as
+    :func:`poincare` gives it, to the bit) or the message of the error that stopped it."""
+
+    sections: list[Optional[Section]]
+    errors: list[Optional[str]]
+
+    @property
+    def end_states(self) -> F64:
+        """The end state of each start (phase 0; NaN rows for failed starts)."""
+        rows = [s.end_state if s is not None else None for s in self.sections]
+        n = next((len(r) for r in rows if r is not None), 0)
+        return np.array([r if r is not None else np.full(n, np.nan) for r in rows])
+
+    @property
+    def periods(self) -> npt.NDArray[np.int64]:
+        """The detected period of each start (0: none; −1: failed)."""
+        return np.array([s.period if s is not None else -1 for s in self.sections],
+                        dtype=np.int64)
+
+    @property
+    def impacts_per_period(self) -> F64:
+        """Impacts per forcing period of each start (NaN: failed)."""
+        return np.array([s.impacts_per_period if s is not None else np.nan
+                         for s in self.sections])
+
+    @staticmethod
+    def _from(d: dict[str, Any]) -> "EnsembleResult":
+        sections: list[Optional[Section]] = []
+        errors: list[Optional[str]] = []
+        for r in d["starts"]:
+            if r["status"] == "ok":
+                sections.append(Section._from(r))
+                errors.append(None)
+            else:
+                sections.append(None)
+                errors.append(str(r["status"]))
+        return EnsembleResult(sections, errors)
+
+
+@dataclass(frozen=True)
+class TimeStepRun:
+    """A Moreau–Jean run: every ``every``-th step's time ``t`` (s), generalized positions
+    ``q`` and velocities ``v``, energies ``(kinetic, potential, work of the impulses)``
+    (J; NaN at the start); every active contact of every step as rows ``(t, contact, gap,
+    ġ⁻, ġ⁺, normal impulse, tangential impulse)``; the impacts (a normal impulse with an
+    approach speed above ``impact_speed``): step end time, contact, velocities before and
+    after, impulse; and the run's summary."""
+
+    t: F64
+    q: F64
+    v: F64
+    energy: F64
+    contacts: F64
+    impact_t: F64
+    impact_contact: npt.NDArray[np.int64]
+    impact_pre: F64
+    impact_post: F64
+    impact_impulse: F64
+    steps: int
+    t_final: float
+    max_residual: float
+    max_active: int
+    q_final: F64
+    v_final: F64
+
+    @staticmethod
+    def _from(d: dict[str, Any]) -> "TimeStepRun":
+        return TimeStepRun(
+            t=d["t"], q=d["q"], v=d["v"], energy=d["energy"], contacts=d["contacts"],
+            impact_t=d["impact_t"], impact_contact=d["impact_contact"].astype(np.int64),
+            impact_pre=d["impact_pre"], impact_post=d["impact_post"],
+            impact_impulse=d["impact_impulse"], steps=int(d["steps"]),
+            t_final=float(d["t_final"]), max_residual=float(d["max_residual"]),
+            max_active=int(d["max_active"]), q_final=d["q_final"], v_final=d["v_final"],
+        )

@@ -1,7 +1,6 @@
 //! The instruments over runs: Poincaré sections, sweeps, Lyapunov exponents, periodic
 //! orbits and their continuation, the entropy index.
 
-use nonsmooth::Dynamics;
 use nonsmooth::event::{Direction, Event, EventSet};
 use nonsmooth::integrate::Dopri5;
 use nonsmooth::lyapunov::{
@@ -16,6 +15,7 @@ use nonsmooth::sweep::{
     RunFailure, SweepConfig, SweepDirection, SweepPoint, SweepSystem, hysteresis, run_point, sweep,
     transitions,
 };
+use nonsmooth::{Dynamics, LaneDynamics};
 
 use crate::errors::{Fail, Result, value};
 use crate::family::{Family, Visit, visit};
@@ -36,7 +36,7 @@ fn regime(r: Regime) -> i64 {
     r.period().map_or(0, |p| p as i64)
 }
 
-fn point_rec<const M: usize>(p: &SweepPoint<M>) -> Rec {
+pub fn point_rec<const M: usize>(p: &SweepPoint<M>) -> Rec {
     Rec::new()
         .f("param", p.param)
         .rows("poincare", &p.poincare)
@@ -65,7 +65,7 @@ impl Visit for Poincare {
         f: Family<S, E, G>,
     ) -> Result<Rec>
     where
-        S: Dynamics<f64, M> + Clone + Send + Sync + 'static,
+        S: Dynamics<f64, M> + LaneDynamics<M> + Clone + Send + Sync + 'static,
         E: EventSet<f64, M> + Clone + Send + Sync + 'static,
         G: Surface<f64, M> + Clone + Send + Sync + 'static,
         Dims<M>: TangentDimension<M, MT>,
@@ -147,7 +147,7 @@ impl Visit for Sweep {
         f: Family<S, E, G>,
     ) -> Result<Rec>
     where
-        S: Dynamics<f64, M> + Clone + Send + Sync + 'static,
+        S: Dynamics<f64, M> + LaneDynamics<M> + Clone + Send + Sync + 'static,
         E: EventSet<f64, M> + Clone + Send + Sync + 'static,
         G: Surface<f64, M> + Clone + Send + Sync + 'static,
         Dims<M>: TangentDimension<M, MT>,
@@ -269,7 +269,7 @@ impl Visit for Lyapunov {
         f: Family<S, E, G>,
     ) -> Result<Rec>
     where
-        S: Dynamics<f64, M> + Clone + Send + Sync + 'static,
+        S: Dynamics<f64, M> + LaneDynamics<M> + Clone + Send + Sync + 'static,
         E: EventSet<f64, M> + Clone + Send + Sync + 'static,
         G: Surface<f64, M> + Clone + Send + Sync + 'static,
         Dims<M>: TangentDimension<M, MT>,
@@ -422,7 +422,7 @@ impl Visit for Orbit {
         f: Family<S, E, G>,
     ) -> Result<Rec>
     where
-        S: Dynamics<f64, M> + Clone + Send + Sync + 'static,
+        S: Dynamics<f64, M> + LaneDynamics<M> + Clone + Send + Sync + 'static,
         E: EventSet<f64, M> + Clone + Send + Sync + 'static,
         G: Surface<f64, M> + Clone + Send + Sync + 'static,
         Dims<M>: TangentDimension<M, MT>,
@@ -506,7 +506,7 @@ impl Visit for Continue {
         f: Family<S, E, G>,
     ) -> Result<Rec>
     where
-        S: Dynamics<f64, M> + Clone + Send + Sync + 'static,
+        S: Dynamics<f64, M> + LaneDynamics<M> + Clone + Send + Sync + 'static,
         E: EventSet<f64, M> + Clone + Send + Sync + 'static,
         G: Surface<f64, M> + Clone + Send + Sync + 'static,
         Dims<M>: TangentDimension<M, MT>,

@@ -3,7 +3,6 @@
 //! (the paper's cart, Duffing–Ueda, the 2-DOF impact oscillator, described systems of one
 //! to four degrees of freedom).
 
-use nonsmooth::Dynamics;
 use nonsmooth::event::{Direction, Event, EventSet, Gap, Stop};
 use nonsmooth::integrate::Tolerances;
 use nonsmooth::lyapunov::{Dims, Norm, TangentDimension};
@@ -12,6 +11,7 @@ use nonsmooth::study::{DescribedModel, SurfaceEvents};
 use nonsmooth::systems::duffing_ueda::DuffingUedaModel;
 use nonsmooth::systems::paper::PaperOscillator;
 use nonsmooth::systems::two_dof::TwoDofImpactModel;
+use nonsmooth::{Dynamics, LaneDynamics};
 
 use crate::errors::{Result, value};
 use crate::system::Kind;
@@ -80,7 +80,7 @@ pub trait Visit {
         family: Family<S, E, G>,
     ) -> Result<Self::Out>
     where
-        S: Dynamics<f64, M> + Clone + Send + Sync + 'static,
+        S: Dynamics<f64, M> + LaneDynamics<M> + Clone + Send + Sync + 'static,
         E: EventSet<f64, M> + Clone + Send + Sync + 'static,
         G: Surface<f64, M> + Clone + Send + Sync + 'static,
         Dims<M>: TangentDimension<M, MT>;
@@ -214,7 +214,8 @@ pub fn visit<V: Visit>(kind: &Kind, surface: usize, what: &str, v: V) -> Result<
             kind.name(),
             match kind {
                 Kind::Relay(_) => "a Filippov system: use simulate, lyapunov or periodic_orbit",
-                _ => "rigid impacts: use simulate or lyapunov",
+                Kind::Woodpecker => "time-stepping only: use timestep",
+                _ => "rigid impacts: use simulate, lyapunov or timestep",
             }
         ))),
     }

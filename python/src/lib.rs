@@ -9,8 +9,10 @@ mod analysis;
 mod errors;
 mod family;
 mod interrupt;
+mod lanes;
 mod record;
 mod runs;
+mod stepping;
 mod study;
 mod system;
 
@@ -520,6 +522,138 @@ fn tsallis_q<'py>(
     rec.into_py(py)
 }
 
+/// Many starts of one system in SIMD lanes.
+#[pyfunction]
+#[pyo3(signature = (system, parameter, values, y0s, transient, record, surface, rtol, atol, period_tol, max_period, max_steps))]
+#[allow(clippy::too_many_arguments)]
+fn ensemble<'py>(
+    py: Python<'py>,
+    system: &PySystem,
+    parameter: Option<String>,
+    values: PyReadonlyArray1<'py, f64>,
+    y0s: Vec<Vec<f64>>,
+    transient: u32,
+    record: u32,
+    surface: usize,
+    rtol: f64,
+    atol: Option<Vec<f64>>,
+    period_tol: f64,
+    max_period: usize,
+    max_steps: usize,
+) -> PyResult<Bound<'py, PyDict>> {
+    let values = values.to_vec()?;
+    finite("values", &values)?;
+    if let Some(name) = &parameter {
+        system.kind.parameter(name)?;
+    }
+    let n = values.len().max(y0s.len());
+    if n == 0 || n > nonsmooth::sweep::MAX_VALUES {
+        return Err(value(format!(
+            "{n} starts; between 1 and {}",
+            nonsmooth::sweep::MAX_VALUES
+        ))
+        .into());
+    }
+    if parameter.is_some() && values.len() != n {
+        return Err(value(format!("{} values for {n} starts", values.len())).into());
+    }
+    if y0s.len() != 1 && y0s.len() != n {
+        return Err(value(format!("{} initial states for {n} starts", y0s.len())).into());
+    }
+    for (j, y) in y0s.iter().enumerate() {
+        check_state(&format!("y0[{j}]"), y, system.kind.dimension())?;
+    }
+    if record == 0 {
+        return Err(value("record must be >= 1").into());
+    }
+    check_rtol(rtol)?;
+    check_atol(system, &atol)?;
+    let d = detect(period_tol, max_period, max_steps)?;
+    let kind = system.kind.clone();
+    let rec = interrupt::run(py, move |cancel: &Cancel| {
+        lanes::ensemble(
+            &kind,
+            surface,
+            lanes::EnsembleSpec {
+                parameter,
+                values,
+                y0s,
+                transient,
+                record,
+                rtol,
+                atol,
+                detect: d,
+                cancel: cancel.clone(),
+            },
+        )
+    })?;
+    rec.into_py(py)
+}
+
+/// Moreau–Jean time-stepping.
+#[pyfunction]
+#[pyo3(signature = (system, t0, t_end, h, theta, q0, v0, every, max_records, impact_speed))]
+#[allow(clippy::too_many_arguments)]
+fn timestep<'py>(
+    py: Python<'py>,
+    system: &PySystem,
+    t0: f64,
+    t_end: f64,
+    h: f64,
+    theta: f64,
+    q0: Option<Vec<f64>>,
+    v0: Option<Vec<f64>>,
+    every: usize,
+    max_records: usize,
+    impact_speed: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    if !(t0.is_finite() && t_end.is_finite() && t_end > t0) {
+        return Err(value(format!(
+            "the time span must be finite with t_end > t0 (got t0 = {t0}, t_end = {t_end})"
+        ))
+        .into());
+    }
+    positive("h", h)?;
+    if (t_end - t0) / h > 1e10 {
+        return Err(value(format!(
+            "{} steps of h = {h}; at most 1e10",
+            (t_end - t0) / h
+        ))
+        .into());
+    }
+    positive("impact_speed", impact_speed)?;
+    if every == 0 || max_records == 0 || max_records > MAX_OUTPUT {
+        return Err(value(format!(
+            "every must be >= 1 and max_records in [1, {MAX_OUTPUT}]"
+        ))
+        .into());
+    }
+    for (what, x) in [("q0", &q0), ("v0", &v0)] {
+        if let Some(x) = x {
+            finite(what, x)?;
+        }
+    }
+    let kind = system.kind.clone();
+    let rec = interrupt::run(py, move |cancel: &Cancel| {
+        stepping::timestep(
+            &kind,
+            stepping::StepSpec {
+                t0,
+                t_end,
+                h,
+                theta,
+                q0,
+                v0,
+                every,
+                max_records,
+                impact_speed,
+                cancel: cancel.clone(),
+            },
+        )
+    })?;
+    rec.into_py(py)
+}
+
 /// Runs one shard of a study file into a directory.
 #[pyfunction]
 #[pyo3(signature = (spec, out, shard, count, progress))]
@@ -563,6 +697,7 @@ fn _nonsmooth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(system::two_dof_impact, m)?)?;
     m.add_function(wrap_pyfunction!(system::bouncing_ball, m)?)?;
     m.add_function(wrap_pyfunction!(system::relay_feedback, m)?)?;
+    m.add_function(wrap_pyfunction!(system::woodpecker, m)?)?;
     m.add_function(wrap_pyfunction!(system::describe_json, m)?)?;
     m.add_function(wrap_pyfunction!(system::describe_toml, m)?)?;
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
@@ -573,6 +708,8 @@ fn _nonsmooth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(periodic_orbit, m)?)?;
     m.add_function(wrap_pyfunction!(continuation, m)?)?;
     m.add_function(wrap_pyfunction!(tsallis_q, m)?)?;
+    m.add_function(wrap_pyfunction!(ensemble, m)?)?;
+    m.add_function(wrap_pyfunction!(timestep, m)?)?;
     m.add_function(wrap_pyfunction!(study_run, m)?)?;
     m.add_function(wrap_pyfunction!(study_merge, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

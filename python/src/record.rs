@@ -63,6 +63,11 @@ impl Rec {
         self.0.insert(k, Val::A(v, vec![n]));
         self
     }
+    /// A row-major array of the given shape.
+    pub fn shaped(mut self, k: &'static str, flat: Vec<f64>, shape: Vec<usize>) -> Self {
+        self.0.insert(k, Val::A(flat, shape));
+        self
+    }
     /// Rows of `M` components as an `n × M` array.
     pub fn rows<const M: usize>(mut self, k: &'static str, rows: &[SVector<f64, M>]) -> Self {
         let flat: Vec<f64> = rows.iter().flat_map(|r| r.iter().copied()).collect();

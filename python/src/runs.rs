@@ -3,7 +3,6 @@
 //! sticking, Filippov systems through sliding).
 
 use nalgebra::SVector;
-use nonsmooth::Dynamics;
 use nonsmooth::drive::{
     Control, EventRecord, Observer, Simulation, StepView, Termination, run_with_sticking,
 };
@@ -14,6 +13,7 @@ use nonsmooth::integrate::{DenseOutput, Dopri5, Tolerances};
 use nonsmooth::lyapunov::{Dims, TangentDimension};
 use nonsmooth::model::{Elements, Loads, Mechanical};
 use nonsmooth::sample::{ImpactSequence, Surface};
+use nonsmooth::{Dynamics, LaneDynamics};
 
 use crate::errors::{Fail, Result, value};
 use crate::family::{Family, Visit, visit};
@@ -132,7 +132,7 @@ impl Visit for Simulate {
         f: Family<S, E, G>,
     ) -> Result<Rec>
     where
-        S: Dynamics<f64, M> + Clone + Send + Sync + 'static,
+        S: Dynamics<f64, M> + LaneDynamics<M> + Clone + Send + Sync + 'static,
         E: EventSet<f64, M> + Clone + Send + Sync + 'static,
         G: Surface<f64, M> + Clone + Send + Sync + 'static,
         Dims<M>: TangentDimension<M, MT>,
@@ -320,7 +320,7 @@ impl Visit for Impacts {
         f: Family<S, E, G>,
     ) -> Result<Rec>
     where
-        S: Dynamics<f64, M> + Clone + Send + Sync + 'static,
+        S: Dynamics<f64, M> + LaneDynamics<M> + Clone + Send + Sync + 'static,
         E: EventSet<f64, M> + Clone + Send + Sync + 'static,
         G: Surface<f64, M> + Clone + Send + Sync + 'static,
         Dims<M>: TangentDimension<M, MT>,

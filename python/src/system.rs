@@ -28,6 +28,8 @@ pub enum Kind {
     Relay(RelayFeedback),
     /// A mechanical system described with the study files' schema.
     Described(DescribedSystem),
+    /// The woodpecker toy (time-stepping only).
+    Woodpecker,
 }
 
 fn paper_fields(p: &mut PaperParameters) -> [(&'static str, &mut f64); 13] {
@@ -114,6 +116,7 @@ impl Kind {
             Kind::Ball(_) => "bouncing_ball",
             Kind::Relay(_) => "relay_feedback",
             Kind::Described(_) => "mechanical",
+            Kind::Woodpecker => "woodpecker",
         }
     }
 
@@ -124,6 +127,7 @@ impl Kind {
             Kind::TwoDof(..) => 4,
             Kind::Relay(_) => 3,
             Kind::Described(d) => 2 * d.dofs(),
+            Kind::Woodpecker => 6,
         }
     }
 
@@ -160,6 +164,7 @@ impl Kind {
                 list(&mut || relay_fields(&mut r).map(|(n, v)| (n, *v)).to_vec())
             }
             Kind::Described(d) => d.parameters(),
+            Kind::Woodpecker => Vec::new(),
         }
     }
 
@@ -219,6 +224,11 @@ impl Kind {
                 Kind::Relay(r)
             }
             Kind::Described(d) => Kind::Described(d.with_parameter(name, v)?),
+            Kind::Woodpecker => {
+                return Err(value(format!(
+                    "unknown parameter {name:?} of woodpecker; it has none"
+                )));
+            }
         };
         k.validate()?;
         Ok(k)
@@ -238,7 +248,7 @@ impl Kind {
             Kind::Relay(r) => {
                 r.system()?;
             }
-            Kind::Described(_) => {}
+            Kind::Described(_) | Kind::Woodpecker => {}
         }
         Ok(())
     }
@@ -252,7 +262,7 @@ impl Kind {
             Kind::Duffing(d) => Some(d.period()),
             Kind::TwoDof(_, omega) => Some(TwoDofImpact::period(*omega)),
             Kind::Ball(b) => Some(b.period()),
-            Kind::Relay(_) => None,
+            Kind::Relay(_) | Kind::Woodpecker => None,
             Kind::Described(d) => Some(d.period()),
         }
     }
@@ -264,6 +274,14 @@ impl Kind {
             Kind::Paper(p, _) => vec![p.static_equilibrium()?, 0.0],
             Kind::Ball(b) => vec![0.0, b.table_motion(0.0).1 + 2.0],
             Kind::Relay(_) => RelayFeedback::X0.to_vec(),
+            Kind::Woodpecker => {
+                use nonsmooth::systems::Woodpecker;
+                Woodpecker::Q0
+                    .iter()
+                    .chain(&Woodpecker::V0)
+                    .copied()
+                    .collect()
+            }
             k => vec![0.0; k.dimension()],
         })
     }
@@ -304,6 +322,9 @@ impl Kind {
         let n = self.dimension();
         match self {
             Kind::Relay(_) => vec!["x1".into(), "x2".into(), "x3".into()],
+            Kind::Woodpecker => ["z", "phi_s", "phi_b", "dz", "dphi_s", "dphi_b"]
+                .map(String::from)
+                .to_vec(),
             _ if n == 2 => vec!["x".into(), "v".into()],
             _ => (1..=n / 2)
                 .map(|k| format!("x{k}"))
@@ -450,6 +471,15 @@ pub fn bouncing_ball(gamma: f64, e: f64) -> PyResult<PySystem> {
 #[pyo3(signature = (zeta = 0.05, omega = 25.0, sigma = 1.0))]
 pub fn relay_feedback(zeta: f64, omega: f64, sigma: f64) -> PyResult<PySystem> {
     PySystem::checked(Kind::Relay(RelayFeedback { zeta, omega, sigma }))
+}
+
+/// The woodpecker toy of the catalogue (a sleeve and a bird on a pole, three frictional
+/// impact contacts): state `(z, φ_S, φ_B)` and their rates; for `timestep` only.
+#[pyfunction]
+pub fn woodpecker() -> PySystem {
+    PySystem {
+        kind: Kind::Woodpecker,
+    }
 }
 
 /// A mechanical system from the JSON text of a study file's `system` table

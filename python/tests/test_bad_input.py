@@ -182,6 +182,24 @@ def test_instruments_reject_bad_settings(x: Any, p: Any, n: Any) -> None:
     raises(lambda: ns.impacts(PAPER, (0.0, 1.0), surface=n))
 
 
+@FAST
+@given(NOT_FINITE, NOT_POSITIVE, NOT_COUNT)
+def test_ensemble_and_timestep_reject_bad_input(x: Any, p: Any, n: Any) -> None:
+    raises(lambda: ns.ensemble(PAPER, [x, 0.0]))
+    raises(lambda: ns.ensemble(PAPER, parameter="omega", values=[20.0, x]))
+    raises(lambda: ns.ensemble(PAPER, parameter="omega", values=[20.0, -1.0]))
+    raises(lambda: ns.ensemble(PAPER, record=n))
+    raises(lambda: ns.ensemble(PAPER, rtol=p))
+    ball = ns.bouncing_ball()
+    raises(lambda: ns.timestep(ball, (0.0, x), 1e-3))
+    raises(lambda: ns.timestep(ball, (0.0, 1.0), p))
+    raises(lambda: ns.timestep(ball, (0.0, 1.0), 1e-3, q0=[x]))
+    raises(lambda: ns.timestep(ball, (0.0, 1.0), 1e-3, q0=[0.0, 1.0]))
+    raises(lambda: ns.timestep(ball, (0.0, 1.0), 1e-3, theta=x))
+    if not isinstance(n, int) or n < 0:
+        raises(lambda: ns.timestep(ball, (0.0, 1.0), 1e-3, every=n))
+
+
 def test_run_failures_are_nonsmooth_errors() -> None:
     # A step cap far below what the run needs.
     with pytest.raises(ns.WorkLimitError, match="maximum number of steps"):
