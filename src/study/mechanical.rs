@@ -64,7 +64,6 @@ use serde::{Deserialize, Serialize};
 
 use super::StudyError;
 use super::scalar::{self, MAX_SURFACES};
-use super::spec::SystemSpec;
 use super::system::{
     ParameterDef, ParameterPoint, PointRun, PointStart, RunSettings, StudySystem, is_initial_name,
 };
@@ -959,24 +958,14 @@ pub struct DescribedSystem {
 }
 
 impl DescribedSystem {
-    /// Checks the description and its parameters (`system.parameters` must give every
-    /// parameter without a default, `omega` among them) and builds it once.
-    ///
-    /// # Errors
-    /// [`StudyError::InvalidSpec`] naming the field: another model than `"mechanical"`, an
-    /// invalid description, an unknown or missing parameter, a value a law rejects.
-    pub fn new(system: &SystemSpec) -> Result<Self, StudyError> {
-        if system.model != "mechanical" {
-            return Err(invalid(
-                "system.model",
-                format!(
-                    "{:?}: a described system has model = \"mechanical\"",
-                    system.model
-                ),
-            ));
-        }
-        let described = Described::new(&system.description())?;
-        let point = described.point(&system.parameters)?;
+    /// The system of description `d` with the parameter values `parameters` (the study's
+    /// `system` table; [`DescribedSystem::new`] reads it from a [`SystemSpec`](super::SystemSpec)).
+    pub(super) fn from_description(
+        d: &Description<'_>,
+        parameters: &BTreeMap<String, f64>,
+    ) -> Result<Self, StudyError> {
+        let described = Described::new(d)?;
+        let point = described.point(parameters)?;
         Self::at(described, point)
     }
 
