@@ -76,7 +76,7 @@ impl LaneLaw for Law {
 }
 
 /// The elements in lanes, in the description's order (the scalar sum's): the first
-/// [`MAX_LANE_ELEMENTS`] slots, `None` past the last element (elements beyond the slots
+/// `MAX_LANE_ELEMENTS` (16) slots, `None` past the last element (elements beyond the slots
 /// are not packed: a description with more runs its points one by one).
 impl<const N: usize> LaneElements<N> for DescribedElements<N> {
     type Packed<V: Lanes> = [Option<LawLanes<V>>; MAX_LANE_ELEMENTS];
@@ -116,7 +116,7 @@ impl<const N: usize> LaneElements<N> for DescribedElements<N> {
     }
 }
 
-/// The loads in lanes, as the elements ([`MAX_LANE_LOADS`] slots).
+/// The loads in lanes, as the elements (`MAX_LANE_LOADS` (8) slots).
 impl<const N: usize> LaneLoads<N> for DescribedLoads<N> {
     type Packed<V: Lanes> = [Option<<Harmonic<f64> as LaneExcitation>::Packed<V>>; MAX_LANE_LOADS];
     fn pack<V: Lanes>(&self) -> Self::Packed<V> {
