@@ -5,7 +5,7 @@ sliding, event-locating integrators, Poincaré sections, sweeps, Lyapunov expone
 Tsallis entropy index, periodic orbits and their continuation, studies) with numpy in and
 out. Every right-hand side runs compiled: systems come from the catalogue
 (:func:`paper`, :func:`duffing_ueda`, :func:`two_dof_impact`, :func:`bouncing_ball`,
-:func:`relay_feedback`) or from a description in the study files' schema
+:func:`relay_feedback`, :func:`belt_friction`, :func:`woodpecker`) or from a description in the study files' schema
 (:func:`describe`, :func:`load`). Long calls release the GIL, use every core where the
 crate does (sweeps, studies) and stop on Ctrl-C with ``KeyboardInterrupt``.
 
@@ -36,6 +36,7 @@ from ._nonsmooth import (
     WorkLimitError,
     ZenoError,
     __version__,
+    belt_friction,
     bouncing_ball,
     duffing_ueda,
     paper,
@@ -65,7 +66,7 @@ from ._results import (
 )
 
 __all__ = [
-    "System", "paper", "duffing_ueda", "two_dof_impact", "bouncing_ball", "relay_feedback",
+    "System", "paper", "duffing_ueda", "two_dof_impact", "bouncing_ball", "relay_feedback", "belt_friction",
     "describe", "load", "simulate", "impacts", "poincare", "sweep", "lyapunov", "tsallis_q",
     "periodic_orbit", "continuation", "ensemble", "timestep", "study", "woodpecker",
     "Trajectory", "Impacts", "Section", "SweepResult", "SweepBranch", "SweepTransition",
@@ -438,6 +439,7 @@ def continuation(
     atol: Union[None, float, npt.ArrayLike] = None,
     grazing: Optional[tuple[int, float, str]] = None,
     contact_changes: bool = False,
+    period: Optional[float] = None,
 ) -> Branch:
     """Follows the periodic orbit through (near) ``y0`` in ``parameter`` within
     ``[lo, hi]`` by pseudo-arclength continuation (first step ``step``), starting at the
@@ -446,6 +448,12 @@ def continuation(
     unit circle) and, with ``grazing = (component, level, "min" | "max")``, grazing: the
     orbit's extremum of that state component touching ``level`` (``contact_changes``:
     any local extremum).
+
+    A Filippov system (:func:`relay_feedback`, :func:`belt_friction`) is followed over the
+    grid ``p₀ + k·step`` by shooting with the monodromy through sliding, and its sliding
+    bifurcations are located: ``grazing_sliding``, ``crossing_sliding``,
+    ``switching_sliding``, ``adding_sliding`` (``period`` guesses an autonomous orbit's
+    period).
     """
     if not isinstance(parameter, str):
         raise TypeError("parameter must be a name (str)")
@@ -466,6 +474,7 @@ def continuation(
         None if max_points is None else _c.integer("max_points", max_points, 1, 10_000_000),
         bool(downward), _c.integer("multiple", multiple, 1, 10_000), _y0(system, y0),
         _c.number("t0", t0), r, a, g, bool(contact_changes),
+        None if period is None else _c.positive("period", period),
     )
     return Branch._from(d)
 

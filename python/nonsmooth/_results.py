@@ -305,8 +305,10 @@ class BranchPoint:
 
 @dataclass(frozen=True)
 class Bifurcation:
-    """A located bifurcation: `fold`, `period_doubling`, `neimark_sacker` or `grazing`,
-    at parameter `p`, with the orbit's state and multipliers there."""
+    """A located bifurcation: `fold`, `period_doubling`, `neimark_sacker` or `grazing`
+    (smooth systems), `grazing_sliding`, `crossing_sliding`, `switching_sliding` or
+    `adding_sliding` (Filippov systems), at parameter `p`, with the orbit's state and (for
+    smooth systems) its multipliers there."""
 
     kind: str
     p: float

@@ -4,8 +4,8 @@
 use nonsmooth::event::{Direction, Event, EventSet};
 use nonsmooth::integrate::Dopri5;
 use nonsmooth::lyapunov::{
-    Dims, FilippovTwoTrajectory, HybridTwoTrajectory, Norm, TangentDimension, TangentSpace,
-    TwoTrajectory, tangent_tolerances,
+    Dims, HybridTwoTrajectory, Norm, TangentDimension, TangentSpace, TwoTrajectory,
+    tangent_tolerances,
 };
 use nonsmooth::orbit::{
     BifurcationKind, BranchEnd, ContinuationSettings, Extremum, Grazing, Shooting, follow,
@@ -250,7 +250,7 @@ pub struct LyapunovSpec {
     pub cancel: Cancel,
 }
 
-fn estimate_rec(e: &nonsmooth::lyapunov::Estimate<f64>) -> Rec {
+pub fn estimate_rec(e: &nonsmooth::lyapunov::Estimate<f64>) -> Rec {
     Rec::new()
         .a1("exponents", vec![e.exponent])
         .a1("spread", vec![e.spread])
@@ -359,31 +359,8 @@ pub fn lyapunov(kind: &Kind, l: LyapunovSpec) -> Result<Rec> {
             l.cancel.check()?;
             Ok(estimate_rec(&e))
         }
-        Kind::Relay(r) => {
-            if l.spectrum {
-                return Err(value(
-                    "method='spectrum' is not available for the relay system; use \
-                     method='two_trajectory'",
-                ));
-            }
-            let tol = tolerances::<3>(kind, l.rtol, l.atol.as_deref())?;
-            let mut est = FilippovTwoTrajectory::new(
-                r.system()?,
-                Dopri5::new(tol),
-                l.d0.unwrap_or(kind.d0()),
-                weights::<3>(kind)?,
-            )?;
-            est.start(l.t0, state::<3>(&l.y0))?;
-            let tau = l
-                .tau
-                .ok_or_else(|| value("tau is required for an autonomous system"))?;
-            if l.transient > 0 {
-                est.transient::<1>(tau, l.transient)?;
-            }
-            l.cancel.check()?;
-            let e = est.estimate::<1>(tau, l.intervals)?;
-            l.cancel.check()?;
-            Ok(estimate_rec(&e))
+        Kind::Relay(_) | Kind::Belt(_) => {
+            crate::filippov::visit(kind, crate::filippov::Lyapunov(l))
         }
         _ => visit(kind, 0, "lyapunov", Lyapunov(l)),
     }
@@ -441,37 +418,7 @@ impl Visit for Orbit {
 /// A periodic orbit by shooting, with its monodromy matrix and Floquet multipliers.
 pub fn periodic_orbit(kind: &Kind, o: OrbitSpec) -> Result<Rec> {
     match kind {
-        Kind::Relay(r) => {
-            let tol = tolerances::<3>(kind, o.rtol, o.atol.as_deref())?;
-            let mut sim =
-                nonsmooth::filippov::FilippovSimulation::new(r.system()?, Dopri5::new(tol));
-            let period = o
-                .period
-                .ok_or_else(|| value("period (a guess) is required for an autonomous system"))?;
-            let tol12 = nonsmooth::integrate::Tolerances::<f64, 12>::new(o.rtol, o.rtol * 1e-2)?;
-            let orbit = sim.find_orbit::<3, 1, 12>(
-                o.t0,
-                state::<3>(&o.y0),
-                period,
-                true,
-                tol12,
-                o.xtol,
-                o.max_iterations,
-            )?;
-            let mus = orbit.monodromy.multipliers();
-            let stable = mus
-                .iter()
-                .filter(|m| (m.re - 1.0).hypot(m.im) > 1e-6)
-                .all(|m| m.norm() < 1.0);
-            Ok(Rec::new()
-                .vec("state", &orbit.state)
-                .f("period", orbit.period)
-                .matrix("monodromy", &orbit.monodromy.matrix)
-                .complex("multipliers", mus)
-                .i("iterations", orbit.iterations as i64)
-                .f("residual", f64::NAN)
-                .b("stable", stable))
-        }
+        Kind::Relay(_) | Kind::Belt(_) => crate::filippov::visit(kind, crate::filippov::Orbit(o)),
         _ => visit(kind, 0, "periodic_orbit", Orbit(o)),
     }
 }
@@ -597,9 +544,16 @@ impl Visit for Continue {
     }
 }
 
-/// A branch of periodic orbits followed in a parameter, with bifurcations located.
-pub fn continuation(kind: &Kind, c: ContinuationSpec) -> Result<Rec> {
-    visit(kind, 0, "continuation", Continue(c))
+/// A branch of periodic orbits followed in a parameter, with bifurcations located (the
+/// sliding bifurcations of a Filippov system; `period`: the guess of an autonomous
+/// orbit's period).
+pub fn continuation(kind: &Kind, c: ContinuationSpec, period: Option<f64>) -> Result<Rec> {
+    match kind {
+        Kind::Relay(_) | Kind::Belt(_) => {
+            crate::filippov::visit(kind, crate::filippov::Continue { spec: c, period })
+        }
+        _ => visit(kind, 0, "continuation", Continue(c)),
+    }
 }
 
 /// The entropy index `q*` of samples (histogram on `[lo, hi)` with bins of `step`).

@@ -213,7 +213,8 @@ pub fn visit<V: Visit>(kind: &Kind, surface: usize, what: &str, v: V) -> Result<
             "{what} is not available for the {} system ({})",
             kind.name(),
             match kind {
-                Kind::Relay(_) => "a Filippov system: use simulate, lyapunov or periodic_orbit",
+                Kind::Relay(_) | Kind::Belt(_) =>
+                    "a Filippov system: use simulate, lyapunov, periodic_orbit or continuation",
                 Kind::Woodpecker => "time-stepping only: use timestep",
                 _ => "rigid impacts: use simulate, lyapunov or timestep",
             }

@@ -8,6 +8,7 @@
 mod analysis;
 mod errors;
 mod family;
+mod filippov;
 mod interrupt;
 mod lanes;
 mod record;
@@ -440,7 +441,7 @@ fn periodic_orbit<'py>(
 
 /// A branch of periodic orbits followed in a parameter.
 #[pyfunction]
-#[pyo3(signature = (system, parameter, lo, hi, step, max_step, max_points, downward, multiple, y0, t0, rtol, atol, grazing, contact_changes))]
+#[pyo3(signature = (system, parameter, lo, hi, step, max_step, max_points, downward, multiple, y0, t0, rtol, atol, grazing, contact_changes, period))]
 #[allow(clippy::too_many_arguments)]
 fn continuation<'py>(
     py: Python<'py>,
@@ -459,8 +460,12 @@ fn continuation<'py>(
     atol: Option<Vec<f64>>,
     grazing: Option<(usize, f64, bool)>,
     contact_changes: bool,
+    period: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     system.kind.parameter(&parameter)?;
+    if let Some(p) = period {
+        positive("period", p)?;
+    }
     if !t0.is_finite() {
         return Err(value(format!("t0 must be finite (got {t0})")).into());
     }
@@ -499,6 +504,7 @@ fn continuation<'py>(
                 grazing,
                 contact_changes,
             },
+            period,
         )
     })?;
     rec.into_py(py)
@@ -698,6 +704,7 @@ fn _nonsmooth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(system::bouncing_ball, m)?)?;
     m.add_function(wrap_pyfunction!(system::relay_feedback, m)?)?;
     m.add_function(wrap_pyfunction!(system::woodpecker, m)?)?;
+    m.add_function(wrap_pyfunction!(system::belt_friction, m)?)?;
     m.add_function(wrap_pyfunction!(system::describe_json, m)?)?;
     m.add_function(wrap_pyfunction!(system::describe_toml, m)?)?;
     m.add_function(wrap_pyfunction!(simulate, m)?)?;

@@ -8,7 +8,6 @@ use nonsmooth::drive::{
 };
 use nonsmooth::event::{EventSet, NewtonImpact};
 use nonsmooth::excite::Excitation;
-use nonsmooth::filippov::{FilippovSimulation, Plain, TransitionKind};
 use nonsmooth::integrate::{DenseOutput, Dopri5, Tolerances};
 use nonsmooth::lyapunov::{Dims, TangentDimension};
 use nonsmooth::model::{Elements, Loads, Mechanical};
@@ -32,6 +31,14 @@ impl<const M: usize> Samples<M> {
     pub fn new(t: Vec<f64>) -> Self {
         let y = Vec::with_capacity(t.len());
         Self { t, next: 0, y }
+    }
+    /// The number of samples taken.
+    pub fn len(&self) -> usize {
+        self.y.len()
+    }
+    /// The samples taken.
+    pub fn rows(&self) -> &[SVector<f64, M>] {
+        &self.y
     }
 }
 
@@ -60,13 +67,13 @@ pub struct EventLog<const M: usize> {
 }
 
 impl<const M: usize> EventLog<M> {
-    fn new(cap: usize) -> Self {
+    pub fn new(cap: usize) -> Self {
         Self {
             cap,
             ..Default::default()
         }
     }
-    fn rec(self) -> Rec {
+    pub fn rec(self) -> Rec {
         let modes = self
             .modes
             .iter()
@@ -217,61 +224,6 @@ pub fn tolerances<const M: usize>(
     Ok(Tolerances::per_component(rtol, arr)?)
 }
 
-fn relay(r: RunSpec, kind: &Kind) -> Result<Rec> {
-    let Kind::Relay(relay) = kind else {
-        unreachable!()
-    };
-    let tol = tolerances::<3>(kind, r.rtol, r.atol.as_deref())?;
-    let mut sim = FilippovSimulation::new(relay.system()?, Dopri5::new(tol));
-    let mut samples = Samples::<3>::new(r.t_eval.clone());
-    let mut log = EventLog::<3>::new(r.max_events);
-    let mut watch = Watch(r.cancel.clone());
-    let mut obs = Plain((&mut samples, &mut log, &mut watch));
-    let run = sim.run::<3, 1, _>(r.t0, state::<3>(&r.y0), r.t_end, &mut obs)?;
-    if run.stopped && r.cancel.is_set() {
-        return Err(Fail::Interrupted);
-    }
-    let transitions = run
-        .transitions
-        .iter()
-        .map(|tr| {
-            Rec::new()
-                .f("t", tr.t)
-                .i("surface", tr.surface as i64)
-                .s(
-                    "kind",
-                    match tr.kind {
-                        TransitionKind::Crossing => "crossing",
-                        TransitionKind::SlidingEntry => "sliding_entry",
-                        TransitionKind::SlidingExit => "sliding_exit",
-                        TransitionKind::Graze => "graze",
-                    },
-                )
-                .s("from", tr.from.name())
-                .s("to", tr.to.name())
-                .vec("x", &tr.x)
-        })
-        .collect();
-    let n = samples.y.len();
-    Ok(log
-        .rec()
-        .a1("t", r.t_eval[..n].to_vec())
-        .rows("y", &samples.y)
-        .vec("y_final", &run.x)
-        .list("transitions", transitions)
-        .f("max_drift", run.max_drift)
-        .stats(&run.stats)
-        .f("t_final", run.t)
-        .s(
-            "termination",
-            if run.stopped {
-                "stopped"
-            } else {
-                "reached_end"
-            },
-        ))
-}
-
 fn described_rigid<const N: usize, const M: usize>(
     r: RunSpec,
     kind: &Kind,
@@ -295,7 +247,7 @@ pub fn simulate(kind: &Kind, r: RunSpec) -> Result<Rec> {
             let tol = tolerances::<2>(kind, r.rtol, r.atol.as_deref())?;
             rigid::<1, 2, _, _, _>(r, &b.model::<f64>()?, &b.impact::<f64>()?, tol)
         }
-        Kind::Relay(_) => relay(r, kind),
+        Kind::Relay(_) | Kind::Belt(_) => crate::filippov::visit(kind, crate::filippov::Run(r)),
         Kind::Described(d) if d.is_rigid() => match d.dofs() {
             1 => described_rigid::<1, 2>(r, kind, d),
             2 => described_rigid::<2, 4>(r, kind, d),

@@ -12,6 +12,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::errors::{Fail, Result, value};
+use crate::filippov::Belt;
 
 /// A system of the catalogue or a described one, with its parameter values.
 #[derive(Debug, Clone)]
@@ -30,6 +31,8 @@ pub enum Kind {
     Described(DescribedSystem),
     /// The woodpecker toy (time-stepping only).
     Woodpecker,
+    /// The belt oscillator (Filippov, sticking as sliding).
+    Belt(Belt),
 }
 
 fn paper_fields(p: &mut PaperParameters) -> [(&'static str, &mut f64); 13] {
@@ -82,6 +85,15 @@ fn relay_fields(p: &mut RelayFeedback) -> [(&'static str, &mut f64); 3] {
     ]
 }
 
+fn belt_fields(p: &mut Belt) -> [(&'static str, &mut f64); 4] {
+    [
+        ("f0", &mut p.f0),
+        ("omega", &mut p.omega),
+        ("u", &mut p.u),
+        ("fk", &mut p.fk),
+    ]
+}
+
 fn duffing_fields(p: &mut DuffingUeda) -> [(&'static str, &mut f64); 3] {
     [("k", &mut p.k), ("b", &mut p.b), ("omega", &mut p.omega)]
 }
@@ -117,13 +129,14 @@ impl Kind {
             Kind::Relay(_) => "relay_feedback",
             Kind::Described(_) => "mechanical",
             Kind::Woodpecker => "woodpecker",
+            Kind::Belt(_) => "belt_friction",
         }
     }
 
     /// The state dimension.
     pub fn dimension(&self) -> usize {
         match self {
-            Kind::Paper(..) | Kind::Duffing(_) | Kind::Ball(_) => 2,
+            Kind::Paper(..) | Kind::Duffing(_) | Kind::Ball(_) | Kind::Belt(_) => 2,
             Kind::TwoDof(..) => 4,
             Kind::Relay(_) => 3,
             Kind::Described(d) => 2 * d.dofs(),
@@ -165,6 +178,10 @@ impl Kind {
             }
             Kind::Described(d) => d.parameters(),
             Kind::Woodpecker => Vec::new(),
+            Kind::Belt(b) => {
+                let mut b = *b;
+                list(&mut || belt_fields(&mut b).map(|(n, v)| (n, *v)).to_vec())
+            }
         }
     }
 
@@ -229,6 +246,11 @@ impl Kind {
                     "unknown parameter {name:?} of woodpecker; it has none"
                 )));
             }
+            Kind::Belt(b) => {
+                let mut b = *b;
+                set_field("belt_friction", belt_fields(&mut b), name, v)?;
+                Kind::Belt(b)
+            }
         };
         k.validate()?;
         Ok(k)
@@ -249,6 +271,7 @@ impl Kind {
                 r.system()?;
             }
             Kind::Described(_) | Kind::Woodpecker => {}
+            Kind::Belt(b) => b.validate()?,
         }
         Ok(())
     }
@@ -264,6 +287,7 @@ impl Kind {
             Kind::Ball(b) => Some(b.period()),
             Kind::Relay(_) | Kind::Woodpecker => None,
             Kind::Described(d) => Some(d.period()),
+            Kind::Belt(b) => Some(crate::filippov::belt_period(b)),
         }
     }
 
@@ -471,6 +495,15 @@ pub fn bouncing_ball(gamma: f64, e: f64) -> PyResult<PySystem> {
 #[pyo3(signature = (zeta = 0.05, omega = 25.0, sigma = 1.0))]
 pub fn relay_feedback(zeta: f64, omega: f64, sigma: f64) -> PyResult<PySystem> {
     PySystem::checked(Kind::Relay(RelayFeedback { zeta, omega, sigma }))
+}
+
+/// The belt oscillator `ẍ + x = F₀ cos ωt − F_k sgn(ẋ − u)`: a unit mass on a unit spring
+/// rubbing with Coulomb friction `F_k` on a belt moving at `u` (a Filippov system: sticking
+/// to the belt is sliding on `ẋ = u`).
+#[pyfunction]
+#[pyo3(signature = (f0 = 0.6, omega = 2.0, u = 0.5, fk = 1.0))]
+pub fn belt_friction(f0: f64, omega: f64, u: f64, fk: f64) -> PyResult<PySystem> {
+    PySystem::checked(Kind::Belt(Belt { f0, omega, u, fk }))
 }
 
 /// The woodpecker toy of the catalogue (a sleeve and a bird on a pole, three frictional

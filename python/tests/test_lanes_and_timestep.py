@@ -70,3 +70,17 @@ def test_timestep_woodpecker_hits_with_its_beak() -> None:
         ns.timestep(ns.paper(20.0), (0.0, 1.0), 1e-3)
     with pytest.raises(ValueError):
         ns.timestep(ns.woodpecker(), (0.0, 1.0), 1e-12)
+
+
+def test_belt_sliding_bifurcations_on_a_branch() -> None:
+    # tests/filippov.rs (sliding_bifurcations_on_a_branch_of_the_belt_oscillator): the
+    # orbit of the forcing period followed in F₀ from the pure-slip orbit at 0.6 meets a
+    # grazing-sliding, then a switching-sliding, then a crossing-sliding bifurcation.
+    belt = ns.belt_friction(f0=0.6)
+    y0 = [1.0 + 0.6 / (1.0 - 4.0), 0.0]
+    branch = ns.continuation(belt, "f0", 0.5, 2.2, 0.05, y0=y0, rtol=1e-12)
+    assert branch.end == "parameter_range"
+    kinds = [b.kind for b in branch.bifurcations]
+    assert kinds == ["grazing_sliding", "switching_sliding", "crossing_sliding"], kinds
+    run = ns.simulate(belt.with_parameters(f0=2.0), (0.0, 40.0), rtol=1e-10)
+    assert any(t.kind == "sliding_entry" for t in run.transitions)  # sticking to the belt
