@@ -1,7 +1,8 @@
 //! Ensemble throughput on the paper's model at rtol 1e-8, one thread: 64 forcing
 //! frequencies in [17.5, 25] rad/s, 20 periods each from rest, every impact located, steps
 //! landing on the sections — the scalar path (`Simulation` + `Dopri5`, one trajectory
-//! after the other) against the ensemble in lanes of 4, 8 and 16 (exact and vector math).
+//! after the other) against the ensemble on each instruction set of the machine (its
+//! lanes: four on the baseline, sixteen with AVX2 or AVX-512), exact and vector math.
 //! After the group, the throughput ratio ensemble/scalar of the fastest configuration,
 //! measured in this run, is printed as `throughput ratio ensemble/scalar: R`; the line before
 //! it gives the same ratio with the lane loop capped at AVX2 (`Simd::Avx2`, the `_avx2`
@@ -10,8 +11,8 @@
 //! The group `ensemble_any_64x20_periods` runs models built generically from the parts
 //! (their lane forms): the Duffing–Ueda oscillator (64 amplitudes) and the 2-DOF impact
 //! system of the catalogue (64 frequencies, state of size 4, its stop as an event), each
-//! on the scalar path and in lanes of 8 and 16 (exact math); after it, the ratio
-//! ensemble/scalar of each is printed as `throughput ratio <model> ensemble/scalar: R`.
+//! on the scalar path and in lanes (exact math, the widest instruction set); after it, the
+//! ratio ensemble/scalar of each is printed as `throughput ratio <model> ensemble/scalar: R`.
 
 use std::hint::black_box;
 use std::time::Instant;
@@ -21,7 +22,7 @@ use nalgebra::SVector;
 use nalgebra::Vector2;
 use nonsmooth::LaneDynamics;
 use nonsmooth::drive::Simulation;
-use nonsmooth::ensemble::{Ensemble, F64x4, F64x8, F64x16, LaneMath, Lanes, MemberRun, Simd};
+use nonsmooth::ensemble::{Ensemble, LaneMath, MemberRun, Simd};
 use nonsmooth::event::{Direction, Event, EventSet, Stop};
 use nonsmooth::integrate::{Dopri5, Tolerances};
 use nonsmooth::systems::paper::{Member, PAPER};
@@ -72,11 +73,11 @@ fn scalar(s: &Setup) -> u64 {
     evals
 }
 
-fn lanes<V: Lanes>(s: &Setup, math: LaneMath) -> u64 {
-    lanes_in::<V>(s, math, Simd::Auto)
+fn lanes(s: &Setup, math: LaneMath) -> u64 {
+    lanes_in(s, math, Simd::Auto)
 }
 
-fn lanes_in<V: Lanes>(s: &Setup, math: LaneMath, simd: Simd) -> u64 {
+fn lanes_in(s: &Setup, math: LaneMath, simd: Simd) -> u64 {
     let e = Ensemble::new(s.tol)
         .unwrap()
         .with_event(s.impact)
@@ -84,7 +85,7 @@ fn lanes_in<V: Lanes>(s: &Setup, math: LaneMath, simd: Simd) -> u64 {
         .with_math(math)
         .with_simd(simd);
     let mut obs = vec![(); s.jobs.len()];
-    e.run::<V, _, _>(&s.jobs, &mut obs)
+    e.run(&s.jobs, &mut obs)
         .unwrap()
         .into_iter()
         .map(|o| o.unwrap().stats.rhs_evals)
@@ -93,25 +94,17 @@ fn lanes_in<V: Lanes>(s: &Setup, math: LaneMath, simd: Simd) -> u64 {
 
 type Path = (&'static str, fn(&Setup) -> u64);
 
-const PATHS: [Path; 11] = [
+const PATHS: [Path; 7] = [
     ("scalar", scalar),
-    ("lanes4_exact", |s| lanes::<F64x4>(s, LaneMath::Exact)),
-    ("lanes8_exact", |s| lanes::<F64x8>(s, LaneMath::Exact)),
-    ("lanes4_vector", |s| lanes::<F64x4>(s, LaneMath::Vector)),
-    ("lanes8_vector", |s| lanes::<F64x8>(s, LaneMath::Vector)),
-    ("lanes16_exact", |s| lanes::<F64x16>(s, LaneMath::Exact)),
-    ("lanes16_vector", |s| lanes::<F64x16>(s, LaneMath::Vector)),
-    ("lanes8_exact_avx2", |s| {
-        lanes_in::<F64x8>(s, LaneMath::Exact, Simd::Avx2)
+    ("exact", |s| lanes(s, LaneMath::Exact)),
+    ("vector", |s| lanes(s, LaneMath::Vector)),
+    ("exact_avx2", |s| lanes_in(s, LaneMath::Exact, Simd::Avx2)),
+    ("vector_avx2", |s| lanes_in(s, LaneMath::Vector, Simd::Avx2)),
+    ("exact_baseline", |s| {
+        lanes_in(s, LaneMath::Exact, Simd::Baseline)
     }),
-    ("lanes8_vector_avx2", |s| {
-        lanes_in::<F64x8>(s, LaneMath::Vector, Simd::Avx2)
-    }),
-    ("lanes16_exact_avx2", |s| {
-        lanes_in::<F64x16>(s, LaneMath::Exact, Simd::Avx2)
-    }),
-    ("lanes16_vector_avx2", |s| {
-        lanes_in::<F64x16>(s, LaneMath::Vector, Simd::Avx2)
+    ("vector_baseline", |s| {
+        lanes_in(s, LaneMath::Vector, Simd::Baseline)
     }),
 ];
 
@@ -176,7 +169,7 @@ fn any_scalar<D: LaneDynamics<M>, E: EventSet<f64, M> + Clone, const M: usize>(
         .sum()
 }
 
-fn any_lanes<V: Lanes, D: LaneDynamics<M>, E: EventSet<f64, M> + Clone, const M: usize>(
+fn any_lanes<D: LaneDynamics<M>, E: EventSet<f64, M> + Clone, const M: usize>(
     s: &Any<D, E, M>,
 ) -> u64 {
     let e = Ensemble::new(s.tol)
@@ -184,7 +177,7 @@ fn any_lanes<V: Lanes, D: LaneDynamics<M>, E: EventSet<f64, M> + Clone, const M:
         .with_events(s.events.clone())
         .unwrap();
     let mut obs = vec![(); s.jobs.len()];
-    e.run::<V, _, _>(&s.jobs, &mut obs)
+    e.run(&s.jobs, &mut obs)
         .unwrap()
         .into_iter()
         .map(|o| o.unwrap().stats.rhs_evals)
@@ -233,20 +226,14 @@ fn bench_any(c: &mut Criterion) {
     g.bench_function("duffing_scalar", |b| {
         b.iter(|| black_box(any_scalar(&duffing)))
     });
-    g.bench_function("duffing_lanes8", |b| {
-        b.iter(|| black_box(any_lanes::<F64x8, _, _, 2>(&duffing)))
-    });
-    g.bench_function("duffing_lanes16", |b| {
-        b.iter(|| black_box(any_lanes::<F64x16, _, _, 2>(&duffing)))
+    g.bench_function("duffing_lanes", |b| {
+        b.iter(|| black_box(any_lanes(&duffing)))
     });
     g.bench_function("two_dof_scalar", |b| {
         b.iter(|| black_box(any_scalar(&two_dof)))
     });
-    g.bench_function("two_dof_lanes8", |b| {
-        b.iter(|| black_box(any_lanes::<F64x8, _, _, 4>(&two_dof)))
-    });
-    g.bench_function("two_dof_lanes16", |b| {
-        b.iter(|| black_box(any_lanes::<F64x16, _, _, 4>(&two_dof)))
+    g.bench_function("two_dof_lanes", |b| {
+        b.iter(|| black_box(any_lanes(&two_dof)))
     });
     g.finish();
     let best = |f: &dyn Fn() -> u64| {
@@ -258,13 +245,9 @@ fn bench_any(c: &mut Criterion) {
             })
             .fold(f64::INFINITY, f64::min)
     };
-    let d = best(&|| any_scalar(&duffing))
-        / best(&|| any_lanes::<F64x8, _, _, 2>(&duffing))
-            .min(best(&|| any_lanes::<F64x16, _, _, 2>(&duffing)));
+    let d = best(&|| any_scalar(&duffing)) / best(&|| any_lanes(&duffing));
     println!("throughput ratio duffing_ueda ensemble/scalar: {d:.2}");
-    let t = best(&|| any_scalar(&two_dof))
-        / best(&|| any_lanes::<F64x8, _, _, 4>(&two_dof))
-            .min(best(&|| any_lanes::<F64x16, _, _, 4>(&two_dof)));
+    let t = best(&|| any_scalar(&two_dof)) / best(&|| any_lanes(&two_dof));
     println!("throughput ratio two_dof_impact ensemble/scalar: {t:.2}");
 }
 

@@ -12,7 +12,7 @@
 use std::time::Instant;
 
 use nalgebra::Vector2;
-use nonsmooth::ensemble::{Ensemble, F64x8, F64x16, Simd};
+use nonsmooth::ensemble::{Ensemble, Simd};
 use nonsmooth::event::Stop;
 use nonsmooth::integrate::{Dopri5, Tolerances};
 use nonsmooth::sweep::{
@@ -59,20 +59,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .map(|&w| Member::paper(w).map(|m| m.start(y0)))
         .collect::<Result<_, _>>()?;
     let e = Ensemble::new(tol)?;
-    // Sixteen lanes pay on AVX-512, eight on AVX2 (see the `ensemble` module docs).
-    let wide = Simd::Auto.resolve() == Simd::Avx512;
-    let sweep_lanes = if wide {
-        sweep_independent_parallel::<F64x16, Member, Stop, 2>
-    } else {
-        sweep_independent_parallel::<F64x8, Member, Stop, 2>
-    };
-    let chunk = if wide { 32 } else { 16 };
-    let lanes = sweep_lanes(&e, &settings, &starts, Some(stop()), chunk)?;
+    // Two fills of the sixteen lanes per task.
+    let lanes = sweep_independent_parallel(&e, &settings, &starts, Some(stop()), 32)?;
     let t_lanes = start.elapsed().as_secs_f64();
-    println!(
-        "independent starts, ensemble ({} lanes, exact): {t_lanes:7.2} s",
-        if wide { 16 } else { 8 }
-    );
+    println!("independent starts, ensemble (exact): {t_lanes:7.2} s");
 
     let start = Instant::now();
     let cfg = settings.config(values.clone())?;

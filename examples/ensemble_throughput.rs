@@ -7,7 +7,8 @@
 //! impact located, section points and impacts collected per trajectory — the work of an
 //! independent-start bifurcation sweep. Throughput is trajectory-periods per second on
 //! one core; the last line is the ratio of the fastest ensemble configuration of this
-//! build (lane width and math mode, named on the line before) to the scalar path, both
+//! build (instruction set, with its lanes, and math mode, named on the line before) to the
+//! scalar path, both
 //! measured in this run. The scalar path and the configurations run three times in turn
 //! (once with `--quick`), and each keeps its fastest time: on a shared machine,
 //! interference only adds time.
@@ -26,9 +27,7 @@ use std::time::Instant;
 
 use nalgebra::Vector2;
 use nonsmooth::drive::{Control, EventRecord, Observer, Simulation, StepView};
-use nonsmooth::ensemble::{
-    Ensemble, F64x2, F64x4, F64x8, F64x16, LaneMath, Lanes, MemberRun, Simd,
-};
+use nonsmooth::ensemble::{Ensemble, LaneMath, MemberRun, Simd};
 use nonsmooth::event::{Direction, Event, Stop};
 use nonsmooth::integrate::{DenseOutput, Dopri5, Tolerances};
 use nonsmooth::systems::paper::{Member, PAPER};
@@ -127,54 +126,35 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
         Ok((obs, evals))
     };
-    fn lanes<V: Lanes>(
+    fn lanes(
         e: &Ensemble<Event<Stop<f64>>>,
         jobs: &[MemberRun<Member>],
         obs: &mut [Collect],
     ) -> nonsmooth::Result<()> {
-        for r in e.run::<V, _, _>(jobs, obs)? {
+        for r in e.run(jobs, obs)? {
             r?;
         }
         Ok(())
     }
     type Run<'a> = Box<dyn Fn(&mut [Collect]) -> nonsmooth::Result<()> + 'a>;
-    let ensemble = Ensemble::new(tol)?.with_event(impact)?.with_simd(simd);
-    let exact = ensemble.clone();
-    let vector = ensemble.clone().with_math(LaneMath::Vector);
-    let configs: Vec<(&str, Run)> = vec![
-        (
-            "ensemble 2, exact",
-            Box::new(|o| lanes::<F64x2>(&exact, &jobs, o)),
-        ),
-        (
-            "ensemble 4, exact",
-            Box::new(|o| lanes::<F64x4>(&exact, &jobs, o)),
-        ),
-        (
-            "ensemble 8, exact",
-            Box::new(|o| lanes::<F64x8>(&exact, &jobs, o)),
-        ),
-        (
-            "ensemble 16, exact",
-            Box::new(|o| lanes::<F64x16>(&exact, &jobs, o)),
-        ),
-        (
-            "ensemble 2, vector",
-            Box::new(|o| lanes::<F64x2>(&vector, &jobs, o)),
-        ),
-        (
-            "ensemble 4, vector",
-            Box::new(|o| lanes::<F64x4>(&vector, &jobs, o)),
-        ),
-        (
-            "ensemble 8, vector",
-            Box::new(|o| lanes::<F64x8>(&vector, &jobs, o)),
-        ),
-        (
-            "ensemble 16, vector",
-            Box::new(|o| lanes::<F64x16>(&vector, &jobs, o)),
-        ),
-    ];
+    // Each instruction set of this machine up to the cap, with its lanes, in both math
+    // modes.
+    let mut ensembles = Vec::new();
+    for s in Simd::available() {
+        let e = Ensemble::new(tol)?.with_event(impact)?.with_simd(s);
+        ensembles.push((format!("{s:?}, exact"), e.clone()));
+        ensembles.push((format!("{s:?}, vector"), e.with_math(LaneMath::Vector)));
+        if s == simd.resolve() {
+            break;
+        }
+    }
+    let configs: Vec<(String, Run)> = ensembles
+        .iter()
+        .map(|(name, e)| {
+            let run: Run = Box::new(|o| lanes(e, &jobs, o));
+            (format!("ensemble {name}"), run)
+        })
+        .collect();
     let mut scalar_s = f64::INFINITY;
     let mut best_s = vec![f64::INFINITY; configs.len()];
     let (scalar_obs, evals) = scalar()?;
@@ -198,16 +178,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
     }
     println!(
-        "scalar               {scalar_s:7.3} s  {:9.0} trajectory-periods/s  ({:.1} ns per evaluation)",
+        "scalar                     {scalar_s:7.3} s  {:9.0} trajectory-periods/s  ({:.1} ns per evaluation)",
         work / scalar_s,
         scalar_s * 1e9 / evals as f64
     );
     let mut best = (0.0f64, "");
     for (k, (name, _)) in configs.iter().enumerate() {
+        let name = name.as_str();
         let s = best_s[k];
         let ratio = scalar_s / s;
         println!(
-            "{name:<20} {s:7.3} s  {:9.0} trajectory-periods/s  ratio {ratio:5.2}  ({}/{n} trajectories identical to scalar)",
+            "{name:<26} {s:7.3} s  {:9.0} trajectory-periods/s  ratio {ratio:5.2}  ({}/{n} trajectories identical to scalar)",
             work / s,
             same[k]
         );

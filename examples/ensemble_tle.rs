@@ -13,7 +13,7 @@
 use std::time::Instant;
 
 use nalgebra::Vector2;
-use nonsmooth::ensemble::{Ensemble, F64x8, F64x16, LaneMath, Simd};
+use nonsmooth::ensemble::{Ensemble, LaneMath, Simd};
 use nonsmooth::integrate::{Dopri5, Tolerances};
 use nonsmooth::lyapunov::{
     DiagramSettings, IntervalRule, TwoTrajectory, pair_tolerances, tle_independent_parallel,
@@ -49,20 +49,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .collect::<Result<_, _>>()?;
     let start = Instant::now();
     // The lane pair is not the scalar pair to the bit anyway (each copy has its own step),
-    // so the vector math costs nothing in agreement; sixteen lanes pay on AVX-512.
+    // so the vector math costs nothing in agreement.
     let e = Ensemble::new(tol)?.with_math(LaneMath::Vector);
-    let wide = Simd::Auto.resolve() == Simd::Avx512;
-    let tle = if wide {
-        tle_independent_parallel::<F64x16, Member, 2>
-    } else {
-        tle_independent_parallel::<F64x8, Member, 2>
-    };
-    let lanes = tle(&e, &members, y0, PAPER_D0, paper_norm(), &settings, 64)?;
+    let lanes = tle_independent_parallel(&e, &members, y0, PAPER_D0, paper_norm(), &settings, 64)?;
     let t_lanes = start.elapsed().as_secs_f64();
-    println!(
-        "independent starts, ensemble ({} lanes, vector math): {t_lanes:7.2} s",
-        if wide { 16 } else { 8 }
-    );
+    println!("independent starts, ensemble (vector math): {t_lanes:7.2} s");
 
     let pair_tol = pair_tolerances(&tol)?;
     let sub: Vec<usize> = (0..n).step_by(every.max(1)).collect();

@@ -18,6 +18,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$PWD
 WORK=${WORK:-$(mktemp -d /tmp/nonsmooth-build.XXXXXX)}
+mkdir -p "$WORK"
 JOBS=${JOBS:-$(nproc)}
 export CARGO_INCREMENTAL=0
 

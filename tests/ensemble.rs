@@ -5,9 +5,7 @@
 
 use nalgebra::Vector2;
 use nonsmooth::drive::{Control, EventRecord, Observer, Simulation};
-#[cfg(feature = "heavy-tests")]
-use nonsmooth::ensemble::F64x16;
-use nonsmooth::ensemble::{Ensemble, F64x2, F64x4, F64x8, LaneMath, Lanes, MemberRun};
+use nonsmooth::ensemble::{Ensemble, F64x4, F64x8, LaneMath, Lanes, MemberRun, Simd};
 use nonsmooth::event::{Direction, Event, Level, Stop};
 use nonsmooth::integrate::{Dopri5, Stats, Tolerances};
 use nonsmooth::lanes::math;
@@ -92,11 +90,12 @@ fn scalar(
     (rec, out.stats, out.y)
 }
 
-/// The ensemble path in lanes of `V`.
-fn lanes<V: Lanes>(
+/// The ensemble path on the instruction set `simd` (and its width).
+fn lanes(
     jobs: &[MemberRun<Member>],
     tol: Tolerances<f64, 2>,
     math: LaneMath,
+    simd: Simd,
 ) -> Vec<(Record, Stats, Vector2<f64>)> {
     let mut recs: Vec<Record> = jobs
         .iter()
@@ -106,8 +105,9 @@ fn lanes<V: Lanes>(
         .unwrap()
         .with_event(impact())
         .unwrap()
-        .with_math(math);
-    let out = ens.run::<V, _, _>(jobs, &mut recs).unwrap();
+        .with_math(math)
+        .with_simd(simd);
+    let out = ens.run(jobs, &mut recs).unwrap();
     recs.into_iter()
         .zip(out)
         .map(|(r, o)| {
@@ -130,7 +130,7 @@ fn lanes_reproduce_the_scalar_paper_model_to_the_bit() {
     let omegas = [13.0, 14.5, 17.0, 18.0, 19.0, 20.465, 22.0, 25.0, 15.7];
     let jobs = paper_jobs(&omegas, 40.0);
     let tol = tol(1e-8);
-    let ens = lanes::<F64x4>(&jobs, tol, LaneMath::Exact);
+    let ens = lanes(&jobs, tol, LaneMath::Exact, Simd::Auto);
     let mut impacts = 0;
     for (job, (rec, stats, y)) in jobs.iter().zip(&ens) {
         let (srec, sstats, sy) = scalar(job, tol, true);
@@ -145,12 +145,15 @@ fn lanes_reproduce_the_scalar_paper_model_to_the_bit() {
 }
 
 /// The tail compaction: with the queue empty and at most half the lanes busy, the busy
-/// lanes move to a vector of half the width (4 → 2 here, 16 → 8 → 4 → 2 with the feature
-/// `heavy-tests`, as trajectories of 3 to 9 periods end one after another). Each
-/// trajectory is still the scalar one to the bit with exact math, and the same as on two
-/// lanes with vector math.
-fn tail_compaction_keeps_every_trajectory<V: Lanes>() {
-    let omegas = [17.0, 18.0, 19.0, 20.465, 22.0, 25.0, 15.7];
+/// lanes move to a vector of half the width (16 → 8 with AVX2 or AVX-512, 4 → 2 on the
+/// baseline), as trajectories of 3 to 9 periods end one after another. Each trajectory is
+/// still the scalar one to the bit with exact math, and with vector math the same on every
+/// instruction set.
+#[test]
+fn tail_compaction_keeps_every_trajectory() {
+    let omegas = [
+        17.0, 18.0, 19.0, 20.465, 22.0, 25.0, 15.7, 13.0, 14.5, 21.0, 23.0,
+    ];
     let jobs: Vec<MemberRun<Member>> = omegas
         .iter()
         .enumerate()
@@ -159,31 +162,22 @@ fn tail_compaction_keeps_every_trajectory<V: Lanes>() {
         })
         .collect();
     let tol = tol(1e-8);
-    let wide = lanes::<V>(&jobs, tol, LaneMath::Exact);
-    for (job, (rec, stats, y)) in jobs.iter().zip(&wide) {
-        let (srec, sstats, sy) = scalar(job, tol, true);
-        assert_eq!(*stats, sstats, "ω = {}", job.member.omega());
-        assert_eq!(*y, sy);
-        assert_eq!(rec.sections(), srec.sections());
-        assert_eq!(rec.events, srec.events);
+    let vector = summary(&lanes(&jobs, tol, LaneMath::Vector, Simd::Baseline));
+    for simd in Simd::available() {
+        let wide = lanes(&jobs, tol, LaneMath::Exact, simd);
+        for (job, (rec, stats, y)) in jobs.iter().zip(&wide) {
+            let (srec, sstats, sy) = scalar(job, tol, true);
+            assert_eq!(*stats, sstats, "{simd:?}, ω = {}", job.member.omega());
+            assert_eq!(*y, sy);
+            assert_eq!(rec.sections(), srec.sections());
+            assert_eq!(rec.events, srec.events);
+        }
+        assert_eq!(
+            summary(&lanes(&jobs, tol, LaneMath::Vector, simd)),
+            vector,
+            "{simd:?}"
+        );
     }
-    assert_eq!(
-        summary(&lanes::<V>(&jobs, tol, LaneMath::Vector)),
-        summary(&lanes::<F64x2>(&jobs, tol, LaneMath::Vector))
-    );
-}
-
-#[test]
-fn tail_compaction_from_four_lanes_keeps_every_trajectory() {
-    tail_compaction_keeps_every_trajectory::<F64x4>();
-}
-
-/// Sixteen lanes and their chain of compactions: the lane step at every width (minutes of
-/// build, hence behind `heavy-tests`; CI runs it).
-#[cfg(feature = "heavy-tests")]
-#[test]
-fn tail_compaction_from_sixteen_lanes_keeps_every_trajectory() {
-    tail_compaction_keeps_every_trajectory::<F64x16>();
 }
 
 /// The largest distance between the section points of two runs relative to the points'
@@ -217,7 +211,7 @@ fn vector_math_lanes_agree_with_scalar_within_the_tolerance() {
     // scalar path itself between rtol 1e-8 and 1e-9 as the yardstick.
     let omegas = [14.5, 16.0, 17.0, 19.0, 20.2, 24.0];
     let jobs = paper_jobs(&omegas, 150.0);
-    let ens = lanes::<F64x4>(&jobs, tol(1e-8), LaneMath::Vector);
+    let ens = lanes(&jobs, tol(1e-8), LaneMath::Vector, Simd::Auto);
     for (job, (rec, stats, _)) in jobs.iter().zip(&ens) {
         let (srec, sstats, _) = scalar(job, tol(1e-8), true);
         let (frec, _, _) = scalar(job, tol(1e-9), true);
@@ -300,7 +294,7 @@ fn smooth_reference_closed_form() {
         .collect();
     let tol = Tolerances::per_component(1e-9, [1e-13, 1e-11]).unwrap();
     for math in [LaneMath::Exact, LaneMath::Vector] {
-        let ens = lanes::<F64x4>(&jobs, tol, math);
+        let ens = lanes(&jobs, tol, math, Simd::Auto);
         for (job, (rec, _, _)) in jobs.iter().zip(&ens) {
             let lin = Linear::new(job.member.omega());
             let (srec, _, _) = scalar(job, tol, true);
@@ -357,7 +351,7 @@ fn events_in_lanes_are_located_like_the_scalar_ones() {
             .with_event(ev)
             .unwrap()
             .with_math(math);
-        ens.run::<F64x4, _, _>(&jobs, &mut recs).unwrap();
+        ens.run(&jobs, &mut recs).unwrap();
         let mut n = 0;
         for (job, rec) in jobs.iter().zip(&recs) {
             let lin = Linear::new(job.member.omega());
@@ -415,18 +409,14 @@ fn results_do_not_depend_on_lanes_order_or_threads() {
     let jobs = paper_jobs(&omegas, 12.0);
     let tol = tol(1e-8);
     for math in [LaneMath::Exact, LaneMath::Vector] {
-        let base = summary(&lanes::<F64x4>(&jobs, tol, math));
-        assert_eq!(summary(&lanes::<F64x2>(&jobs, tol, math)), base);
-        // Eight and sixteen lanes compile the lane step twice more per instruction set
-        // (minutes of build): behind `heavy-tests`, which CI runs.
-        #[cfg(feature = "heavy-tests")]
-        {
-            assert_eq!(summary(&lanes::<F64x8>(&jobs, tol, math)), base);
-            assert_eq!(summary(&lanes::<F64x16>(&jobs, tol, math)), base);
+        let base = summary(&lanes(&jobs, tol, math, Simd::Auto));
+        // Every instruction set (and its width) gives the same bits.
+        for simd in Simd::available() {
+            assert_eq!(summary(&lanes(&jobs, tol, math, simd)), base, "{simd:?}");
         }
         // Reversed batch: the same per trajectory.
         let rev: Vec<MemberRun<Member>> = jobs.iter().rev().copied().collect();
-        let mut r = summary(&lanes::<F64x4>(&rev, tol, math));
+        let mut r = summary(&lanes(&rev, tol, math, Simd::Auto));
         r.reverse();
         assert_eq!(r, base);
         // Threads and chunks.
@@ -445,7 +435,7 @@ fn results_do_not_depend_on_lanes_order_or_threads() {
                 .map(|j| Record::new(j.member.period()))
                 .collect();
             let out = pool
-                .install(|| ens.run_parallel::<F64x4, _, _>(&jobs, &mut recs, chunk))
+                .install(|| ens.run_parallel(&jobs, &mut recs, chunk))
                 .unwrap();
             let got: Vec<_> = recs
                 .into_iter()
@@ -662,7 +652,7 @@ fn invalid_input_is_an_error() {
     );
     let jobs = paper_jobs(&[20.0, 21.0], 2.0);
     let mut one = vec![()];
-    assert!(ens.run::<F64x4, _, _>(&jobs, &mut one).is_err());
+    assert!(ens.run(&jobs, &mut one).is_err());
     let mut bad = impact();
     bad.function.position = 5;
     assert!(Ensemble::new(tol).unwrap().with_event(bad).is_err());
@@ -671,9 +661,9 @@ fn invalid_input_is_an_error() {
     let capped = ens.max_steps(50).unwrap();
     let short = [MemberRun::new(m, 0.0, rest(), 2e-5).unwrap(), jobs[0]];
     let mut obs = vec![(); 2];
-    let out = capped.run::<F64x4, _, _>(&jobs, &mut obs).unwrap();
+    let out = capped.run(&jobs, &mut obs).unwrap();
     assert!(out.iter().all(|o| o.is_err()));
-    let out = capped.run::<F64x4, _, _>(&short, &mut obs).unwrap();
+    let out = capped.run(&short, &mut obs).unwrap();
     assert!(out[0].is_ok() && out[1].is_err(), "{out:?}");
 }
 
@@ -700,7 +690,7 @@ fn run_records(jobs: Vec<MemberRun<Member>>) -> Vec<Result<Summary, String>> {
             .unwrap()
             .with_event(impact())
             .unwrap();
-        let out = ens.run::<F64x4, _, _>(&jobs, &mut recs).unwrap();
+        let out = ens.run(&jobs, &mut recs).unwrap();
         recs.into_iter()
             .zip(out)
             .map(|(r, o)| {
@@ -776,7 +766,7 @@ fn terminal_and_restarting_events_match_the_driver() {
         ev.restart = restart;
         let ens = Ensemble::new(tol).unwrap().with_event(ev).unwrap();
         let mut obs = vec![(); jobs.len()];
-        let out = ens.run::<F64x4, _, _>(&jobs, &mut obs).unwrap();
+        let out = ens.run(&jobs, &mut obs).unwrap();
         for (j, o) in jobs.iter().zip(&out) {
             let o = o.as_ref().unwrap();
             let want = Simulation::new(*j.member.scalar(), Dopri5::new(tol))
@@ -846,24 +836,29 @@ impl<const M: usize> Observer<f64, M> for StepsAndEvents<M> {
 
 /// The ensemble against the driver, with an observer that does not want steps and with
 /// one that does (running to the end, and stopping at a step): outcomes, statistics,
-/// every step view and every event record equal to the bit; in lanes of `V`.
-fn same_as_driver<V, D, E, const M: usize>(jobs: &[MemberRun<D, M>], tol: Tolerances<f64, M>, ev: E)
-where
-    V: Lanes,
+/// every step view and every event record equal to the bit; on the instruction set `simd`.
+fn same_as_driver<D, E, const M: usize>(
+    jobs: &[MemberRun<D, M>],
+    tol: Tolerances<f64, M>,
+    ev: E,
+    simd: Simd,
+) where
     D: nonsmooth::LaneDynamics<M>,
     E: nonsmooth::event::EventSet<f64, M> + Clone,
 {
     let n = jobs.len();
     let (events, _) =
-        same_as_driver_with::<V, _, _, _, M>(jobs, tol, ev.clone(), |_| EventsOnly::default());
+        same_as_driver_with::<_, _, _, M>(jobs, tol, (ev.clone(), simd), |_| EventsOnly::default());
     assert!(events > 10 * n, "{events} events");
-    let (events, _) =
-        same_as_driver_with::<V, _, _, _, M>(jobs, tol, ev.clone(), |_| StepsAndEvents::default());
-    assert!(events > 10 * n, "{events} events");
-    let (_, stopped) = same_as_driver_with::<V, _, _, _, M>(jobs, tol, ev, |j| StepsAndEvents {
-        stop_at: Some(40 + 7 * j),
-        ..StepsAndEvents::default()
+    let (events, _) = same_as_driver_with::<_, _, _, M>(jobs, tol, (ev.clone(), simd), |_| {
+        StepsAndEvents::default()
     });
+    assert!(events > 10 * n, "{events} events");
+    let (_, stopped) =
+        same_as_driver_with::<_, _, _, M>(jobs, tol, (ev, simd), |j| StepsAndEvents {
+            stop_at: Some(40 + 7 * j),
+            ..StepsAndEvents::default()
+        });
     assert!(
         stopped > n / 2,
         "{stopped} of {n} runs stopped by their observer"
@@ -872,22 +867,25 @@ where
 
 /// [`same_as_driver`] with one observer kind; returns the number of events recorded and
 /// of runs that their observer stopped.
-fn same_as_driver_with<V, D, E, O, const M: usize>(
+fn same_as_driver_with<D, E, O, const M: usize>(
     jobs: &[MemberRun<D, M>],
     tol: Tolerances<f64, M>,
-    ev: E,
+    (ev, simd): (E, Simd),
     observer: impl Fn(usize) -> O,
 ) -> (usize, usize)
 where
-    V: Lanes,
     D: nonsmooth::LaneDynamics<M>,
     E: nonsmooth::event::EventSet<f64, M> + Clone,
     O: Observer<f64, M> + PartialEq + core::fmt::Debug + EventCount,
 {
     use nonsmooth::drive::Termination;
-    let ens = Ensemble::new(tol).unwrap().with_events(ev.clone()).unwrap();
+    let ens = Ensemble::new(tol)
+        .unwrap()
+        .with_events(ev.clone())
+        .unwrap()
+        .with_simd(simd);
     let mut lanes: Vec<O> = (0..jobs.len()).map(&observer).collect();
-    let out = ens.run::<V, _, _>(jobs, &mut lanes).unwrap();
+    let out = ens.run(jobs, &mut lanes).unwrap();
     let (mut events, mut stopped) = (0, 0);
     for (k, ((j, o), rec)) in jobs.iter().zip(&out).zip(&lanes).enumerate() {
         let mut want_rec = observer(k);
@@ -961,7 +959,12 @@ fn quiet_steps_skipped_in_lanes_keep_every_event() {
         .with_reset(base.impact::<f64>().unwrap());
     // In two lanes (the model's lane step is compiled once per width and instruction set:
     // the widths are checked on the paper's model and on the 2-DOF system below).
-    same_as_driver::<F64x2, _, _, 2>(&jobs, Tolerances::new(1e-10, 1e-12).unwrap(), impact);
+    same_as_driver(
+        &jobs,
+        Tolerances::new(1e-10, 1e-12).unwrap(),
+        impact,
+        Simd::Baseline,
+    );
     // The 2-DOF impact system: its stop on the relative coordinate, with a level crossing
     // of the first mass in both directions (two events, one of them grazing often).
     let p = TwoDofImpact::default();
@@ -981,7 +984,12 @@ fn quiet_steps_skipped_in_lanes_keep_every_event() {
         Event::new(p.stop::<f64>().unwrap(), Direction::Rising),
         Event::new(Level::new(0, 0.0).unwrap(), Direction::Either),
     );
-    same_as_driver::<F64x4, _, _, 4>(&jobs, Tolerances::new(1e-8, 1e-10).unwrap(), events);
+    same_as_driver(
+        &jobs,
+        Tolerances::new(1e-8, 1e-10).unwrap(),
+        events,
+        Simd::Auto,
+    );
     // Grazing pairs: x = cos ωt against the level 0.9999, crossed twice within
     // 2·acos(0.9999)/ω ≈ 0.028/ω of every maximum, inside one step at this tolerance (the
     // rates at the step's ends show the pair).
@@ -993,7 +1001,12 @@ fn quiet_steps_skipped_in_lanes_keep_every_event() {
         })
         .collect();
     let graze = Event::new(Level::new(0, 0.9999).unwrap(), Direction::Either);
-    same_as_driver::<F64x2, _, _, 2>(&jobs, Tolerances::new(1e-6, 1e-8).unwrap(), graze);
+    same_as_driver(
+        &jobs,
+        Tolerances::new(1e-6, 1e-8).unwrap(),
+        graze,
+        Simd::Baseline,
+    );
 }
 
 #[test]
@@ -1088,7 +1101,8 @@ impl nonsmooth::Dynamics<f64, 2> for Blowup {
 /// (same error, or same end, state and statistics), whatever runs in the other lanes: a
 /// right-hand side that is NaN after the start (21 non-finite trial steps in a row), one
 /// that turns NaN later (the step falls below the minimum), the step cap, the end time,
-/// with and without a landing grid, in 4 lanes (and 2 after compaction) and 2.
+/// with and without a landing grid, on the widest instruction set of the machine (sixteen
+/// lanes, eight after compaction) and on the baseline (four, then two).
 #[test]
 fn failures_and_caps_counted_in_lanes_match_the_driver() {
     let tol = tol(1e-8);
@@ -1107,13 +1121,9 @@ fn failures_and_caps_counted_in_lanes_match_the_driver() {
     for cap in [100_000_000, 150] {
         let ens = Ensemble::new(tol).unwrap().max_steps(cap).unwrap();
         let mut kinds = std::collections::BTreeSet::new();
-        for lanes in [4, 2] {
+        for simd in [Simd::Auto, Simd::Baseline] {
             let mut obs = vec![(); jobs.len()];
-            let out = match lanes {
-                4 => ens.run::<F64x4, _, _>(&jobs, &mut obs),
-                _ => ens.run::<F64x2, _, _>(&jobs, &mut obs),
-            }
-            .unwrap();
+            let out = ens.clone().with_simd(simd).run(&jobs, &mut obs).unwrap();
             for (k, (j, o)) in jobs.iter().zip(&out).enumerate() {
                 let want = Simulation::new(j.member.0, Dopri5::new(tol))
                     .max_steps(cap)
@@ -1181,7 +1191,7 @@ fn a_time_scale_declared_later_bounds_the_lanes_steps() {
         })
         .collect();
     let mut obs = vec![(); jobs.len()];
-    let out = ens.run::<F64x4, _, _>(&jobs, &mut obs).unwrap();
+    let out = ens.run(&jobs, &mut obs).unwrap();
     for (j, o) in jobs.iter().zip(&out) {
         let o = o.as_ref().unwrap();
         let want = Simulation::new(j.member.0, Dopri5::new(tol))

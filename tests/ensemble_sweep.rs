@@ -3,9 +3,7 @@
 //! same bits on every instruction set).
 
 use nalgebra::Vector2;
-#[cfg(feature = "heavy-tests")]
-use nonsmooth::ensemble::F64x8;
-use nonsmooth::ensemble::{Ensemble, F64x2, F64x4, LaneMath, MemberRun, Simd};
+use nonsmooth::ensemble::{Ensemble, LaneMath, MemberRun, Simd};
 use nonsmooth::event::{Direction, Event, Stop};
 use nonsmooth::integrate::{Dopri5, Tolerances};
 use nonsmooth::sweep::{
@@ -64,20 +62,9 @@ fn independent_sweep_in_lanes_is_the_scalar_sweep_to_the_bit() {
     assert!(want.iter().any(|p| p.impacts > 0) && want.iter().any(|p| p.impacts == 0));
     let e = Ensemble::new(tol()).unwrap();
     let m = members();
-    let got4 =
-        sweep_independent::<F64x4, _, _, 2>(&e, &settings, &starts(&m, rest()), Some(stop()))
-            .unwrap();
+    let got4 = sweep_independent(&e, &settings, &starts(&m, rest()), Some(stop())).unwrap();
     assert_eq!(got4, want);
-    // Eight lanes compile the lane step once more per instruction set (a minute of
-    // build): behind `heavy-tests`, which CI runs.
-    #[cfg(feature = "heavy-tests")]
-    {
-        let got8 =
-            sweep_independent::<F64x8, _, _, 2>(&e, &settings, &starts(&m, rest()), Some(stop()))
-                .unwrap();
-        assert_eq!(got8, want);
-    }
-    let got2 = sweep_independent::<F64x2, _, _, 2>(
+    let got2 = sweep_independent(
         &e.clone().with_simd(Simd::Baseline),
         &settings,
         &starts(&m, rest()),
@@ -87,7 +74,7 @@ fn independent_sweep_in_lanes_is_the_scalar_sweep_to_the_bit() {
     assert_eq!(got2, want);
     #[cfg(feature = "parallel")]
     {
-        let gotp = nonsmooth::sweep::sweep_independent_parallel::<F64x4, _, _, 2>(
+        let gotp = nonsmooth::sweep::sweep_independent_parallel(
             &e,
             &settings,
             &starts(&m, rest()),
@@ -104,13 +91,7 @@ fn independent_sweep_vector_math_agrees_in_regime_and_impacts() {
     let settings = IndependentSweep::new(40, 20).unwrap();
     let want = scalar(&settings);
     let e = Ensemble::new(tol()).unwrap().with_math(LaneMath::Vector);
-    let got = sweep_independent::<F64x4, _, _, 2>(
-        &e,
-        &settings,
-        &starts(&members(), rest()),
-        Some(stop()),
-    )
-    .unwrap();
+    let got = sweep_independent(&e, &settings, &starts(&members(), rest()), Some(stop())).unwrap();
     // Rounding differences grow on chaotic attractors and after only 40 transient periods
     // a slowly converging orbit may still look longer: most values agree in regime, and
     // where they do, in impacts per period.
@@ -135,9 +116,7 @@ fn independent_sweep_vector_math_agrees_in_regime_and_impacts() {
 fn independent_sweep_errors() {
     let e = Ensemble::new(tol()).unwrap();
     let s = IndependentSweep::new(10, 5).unwrap();
-    assert!(
-        sweep_independent::<F64x4, _, _, 2>(&e, &s, &starts(&[], rest()), Some(stop())).is_err()
-    );
+    assert!(sweep_independent(&e, &s, &starts(&[], rest()), Some(stop())).is_err());
     assert!(IndependentSweep::new(10, 0).is_err());
     assert!(s.period_detection(f64::NAN, 4).is_err());
     assert!(s.period_detection(1e-4, 0).is_err());
@@ -145,15 +124,9 @@ fn independent_sweep_errors() {
         position: 5,
         ..stop()
     };
-    assert!(
-        sweep_independent::<F64x4, _, _, 2>(&e, &s, &starts(&members()[..2], rest()), Some(bad))
-            .is_err()
-    );
+    assert!(sweep_independent(&e, &s, &starts(&members()[..2], rest()), Some(bad)).is_err());
     let nan = Vector2::new(f64::NAN, 0.0);
-    assert!(
-        sweep_independent::<F64x4, _, _, 2>(&e, &s, &starts(&members()[..2], nan), Some(stop()))
-            .is_err()
-    );
+    assert!(sweep_independent(&e, &s, &starts(&members()[..2], nan), Some(stop())).is_err());
 }
 
 #[test]
@@ -177,19 +150,14 @@ fn every_instruction_set_gives_the_same_bits() {
             assert_eq!(e.simd(), simd);
             let mut obs = vec![(); jobs.len()];
             let a: Vec<_> = e
-                .run::<F64x4, _, _>(&jobs, &mut obs)
+                .run(&jobs, &mut obs)
                 .unwrap()
                 .into_iter()
                 .map(|o| o.unwrap())
                 .collect();
-            // Eight lanes are one register under AVX-512 (with `heavy-tests`; two lanes
-            // otherwise, one SSE2 register).
-            #[cfg(feature = "heavy-tests")]
-            type Wide = F64x8;
-            #[cfg(not(feature = "heavy-tests"))]
-            type Wide = F64x2;
+            // The first jobs alone: fewer than half the lanes, the tail from the start.
             let b: Vec<_> = e
-                .run::<Wide, _, _>(&jobs, &mut obs)
+                .run(&jobs[..3], &mut obs[..3])
                 .unwrap()
                 .into_iter()
                 .map(|o| o.unwrap())
@@ -237,8 +205,7 @@ fn lane_tle_agrees_with_the_scalar_estimator_within_its_spread() {
         .map(|&w| (w, Member::paper(w).unwrap()))
         .collect();
     let e = Ensemble::new(tol()).unwrap();
-    let lanes =
-        tle_independent::<F64x4, _, 2>(&e, &m, rest(), PAPER_D0, paper_norm(), &settings).unwrap();
+    let lanes = tle_independent(&e, &m, rest(), PAPER_D0, paper_norm(), &settings).unwrap();
     for (p, &w) in lanes.iter().zip(&omegas) {
         let (l, se) = scalar_tle(w, transient, intervals);
         assert_eq!(p.parameter, w);
@@ -260,17 +227,20 @@ fn lane_tle_agrees_with_the_scalar_estimator_within_its_spread() {
         );
         assert_eq!(p.exponent > 0.0, l > 0.0, "ω = {w}: sign");
     }
-    // The same bits on any lane count and thread count.
-    #[cfg(feature = "heavy-tests")]
-    {
-        let lanes8 =
-            tle_independent::<F64x8, _, 2>(&e, &m, rest(), PAPER_D0, paper_norm(), &settings)
-                .unwrap();
-        assert_eq!(lanes8, lanes);
-    }
+    // The same bits on any instruction set (and its width) and thread count.
+    let baseline = tle_independent(
+        &e.clone().with_simd(Simd::Baseline),
+        &m,
+        rest(),
+        PAPER_D0,
+        paper_norm(),
+        &settings,
+    )
+    .unwrap();
+    assert_eq!(baseline, lanes);
     #[cfg(feature = "parallel")]
     {
-        let par = nonsmooth::lyapunov::tle_independent_parallel::<F64x2, _, 2>(
+        let par = nonsmooth::lyapunov::tle_independent_parallel(
             &e,
             &m,
             rest(),
@@ -284,8 +254,7 @@ fn lane_tle_agrees_with_the_scalar_estimator_within_its_spread() {
     }
     // Bad input.
     assert!(
-        tle_independent::<F64x4, Member, 2>(&e, &[], rest(), PAPER_D0, paper_norm(), &settings)
-            .is_err()
+        tle_independent::<Member, 2>(&e, &[], rest(), PAPER_D0, paper_norm(), &settings).is_err()
     );
-    assert!(tle_independent::<F64x4, _, 2>(&e, &m, rest(), 0.0, paper_norm(), &settings).is_err());
+    assert!(tle_independent(&e, &m, rest(), 0.0, paper_norm(), &settings).is_err());
 }

@@ -1410,3 +1410,155 @@ fn every_example_spec_reads_plans_and_the_small_ones_run() {
     }
     assert!(ran >= 5, "{ran} small examples ran");
 }
+
+/// Issue 49: `study merge` checked the spec embedded in a manifest against its hash for the
+/// first shard only, so a shard whose manifest had another spec under the same hash
+/// (`periods.transient`, a mass) merged with exit status 0. Every shard's spec must hash to
+/// its manifest's hash and be the first shard's; the error names the shard file and the field
+/// that differs. The data files a manifest lists must be its shard's own, in its directory.
+#[test]
+fn a_shard_whose_manifest_was_edited_is_refused() {
+    let study = Study::from_toml(TINY).unwrap();
+    let d = scratch("edited-manifest");
+    run_in_shards(&study, &d, 3);
+    let good = merged_bytes(&d);
+    let j = d.join("shard-00002-of-00003.json");
+    let orig = fs::read_to_string(&j).unwrap();
+    let edited = |edit: &dyn Fn(&mut serde_json::Value)| -> String {
+        let mut v: serde_json::Value = serde_json::from_str(&orig).unwrap();
+        edit(&mut v);
+        fs::write(&j, serde_json::to_string_pretty(&v).unwrap()).unwrap();
+        v.to_string()
+    };
+    let refused = |what: &str| -> String {
+        let r = Merged::from_dir(&d);
+        fs::write(&j, &orig).unwrap();
+        match r {
+            Err(StudyError::Corrupt(m)) => {
+                assert!(m.contains("shard-00002-of-00003.json"), "{what}: {m}");
+                m
+            }
+            Ok(_) => panic!("{what}: the edited shard was merged"),
+            Err(e) => panic!("{what}: expected a corrupt shard, got {e:?}"),
+        }
+    };
+    edited(&|v| v["spec"]["periods"]["transient"] = 11.into());
+    let m = refused("periods.transient");
+    assert!(m.contains("periods.transient"), "{m}");
+    edited(&|v| v["spec"]["system"]["parameters"]["m"] = 1.5.into());
+    let m = refused("a mass");
+    assert!(m.contains("system.parameters.m"), "{m}");
+    // A points or sections file elsewhere: a copy of the shard's own, the same bytes.
+    let elsewhere = scratch("edited-manifest-elsewhere");
+    for (key, file) in [
+        ("points_file", "shard-00002-of-00003.csv"),
+        ("sections_file", "shard-00002-of-00003.sections.csv"),
+    ] {
+        let copy = elsewhere.join(file);
+        fs::copy(d.join(file), &copy).unwrap();
+        edited(&|v| v[key] = copy.to_str().unwrap().into());
+        let m = refused(key);
+        assert!(m.contains(key), "{m}");
+    }
+    // The first shard edited: the others' spec is the reference.
+    let j1 = d.join("shard-00001-of-00003.json");
+    let orig1 = fs::read_to_string(&j1).unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(&orig1).unwrap();
+    v["spec"]["grid"]["x"]["end"] = 23.0.into();
+    fs::write(&j1, serde_json::to_string_pretty(&v).unwrap()).unwrap();
+    let r = Merged::from_dir(&d);
+    fs::write(&j1, &orig1).unwrap();
+    match r {
+        Err(StudyError::Corrupt(m)) => assert!(
+            m.contains("shard-00001-of-00003.json") && m.contains("grid.x.end"),
+            "{m}"
+        ),
+        Ok(_) => panic!("the edited first shard was merged"),
+        Err(e) => panic!("expected a corrupt first shard, got {e:?}"),
+    }
+    assert_eq!(merged_bytes(&d), good);
+    // The command line exits non-zero, naming the shard and the field.
+    edited(&|v| v["spec"]["periods"]["transient"] = 11.into());
+    let (ok, _, err) = run_cli(&[os("study"), os("merge"), d.as_os_str()], 120);
+    fs::write(&j, &orig).unwrap();
+    assert!(!ok, "{err}");
+    assert!(
+        err.contains("shard-00002-of-00003.json") && err.contains("periods.transient"),
+        "{err}"
+    );
+}
+
+/// Issue 49: in a described system, `between = [0, 1, 1]` passed `study check` with the
+/// third index dropped (`between = [0]` was refused). A `between` of any length other than
+/// 2 is an error naming the field and the length, on an element and on a surface.
+#[test]
+fn a_between_of_another_length_than_two_is_refused() {
+    let element = "law = \"hertz\"\nbetween = [1, 0]";
+    let surface = "[[system.surfaces]]\nbetween = [1, 0]";
+    for (from, to, field, len) in [
+        (
+            element,
+            "law = \"hertz\"\nbetween = [1, 0, 1]",
+            "system.elements[2].between",
+            3,
+        ),
+        (
+            element,
+            "law = \"hertz\"\nbetween = [1]",
+            "system.elements[2].between",
+            1,
+        ),
+        (
+            element,
+            "law = \"hertz\"\nbetween = []",
+            "system.elements[2].between",
+            0,
+        ),
+        (
+            surface,
+            "[[system.surfaces]]\nbetween = [1, 0, 0, 1]",
+            "system.surfaces[0].between",
+            4,
+        ),
+    ] {
+        let text = DAMPER.replacen(from, to, 1);
+        assert_ne!(text, DAMPER, "{to}");
+        match Study::from_toml(&text) {
+            Err(StudyError::InvalidSpec { field: f, message }) => {
+                assert_eq!(f, field, "{message}");
+                assert!(message.contains(&format!("length {len}")), "{message}");
+            }
+            Ok(_) => panic!("{to}: accepted, expected an error naming {field}"),
+            Err(e) => panic!("{to}: expected an error naming {field}, got {e:?}"),
+        }
+    }
+}
+
+/// Issue 49: `study check` of a spec with 10⁷ points on one axis took 30 s (a map of the
+/// parameters cloned and searched by name at every axis value). Checking is still a check
+/// of every axis value: an invalid value far along a long axis is reported, naming the axis
+/// and the value.
+#[test]
+fn an_invalid_value_far_along_a_long_axis_is_reported() {
+    let text = r#"
+name = "long"
+[system]
+model = "bouncing_ball"
+[grid]
+x = { parameter = "e", start = 0.5, end = 1.5, points = 1000001 }
+[periods]
+transient = 10
+record = 10
+"#;
+    match Study::from_toml(text) {
+        Err(StudyError::InvalidSpec { field, message }) => {
+            assert_eq!(field, "grid.x", "{message}");
+            // The first value above 1 (restitution in [0, 1]): 0.5 + 500001·10⁻⁶.
+            assert!(message.contains("(e = 1.00000"), "{message}");
+        }
+        Ok(_) => panic!("accepted, expected an error naming grid.x"),
+        Err(e) => panic!("expected an error naming grid.x, got {e:?}"),
+    }
+    let valid = text.replace("end = 1.5", "end = 1.0");
+    assert_eq!(Study::from_toml(&valid).unwrap().points(), 1_000_001);
+}

@@ -2,7 +2,7 @@
 //! SIMD lanes of the crate's ensemble integrator, each start's record the one
 //! `poincare` gives for it, to the bit (`sweep::sweep_starts`, exact lane math).
 
-use nonsmooth::ensemble::{Ensemble, F64x4};
+use nonsmooth::ensemble::Ensemble;
 use nonsmooth::event::EventSet;
 use nonsmooth::lyapunov::{Dims, TangentDimension};
 use nonsmooth::sample::Surface;
@@ -88,8 +88,7 @@ impl Visit for Lanes {
             .par_chunks(CHUNK)
             .map(|chunk| {
                 s.cancel.check()?;
-                let out =
-                    sweep_starts::<F64x4, S, G, M>(&ensemble, &settings, chunk, surface.clone())?;
+                let out = sweep_starts::<S, G, M>(&ensemble, &settings, chunk, surface.clone())?;
                 Ok(out
                     .iter()
                     .map(|r| match r {

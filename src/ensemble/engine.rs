@@ -11,6 +11,10 @@ use crate::integrate::{
     DenseOutput, Dopri5Dense, HermiteDense, IntegrateError, Stats, StepOptions, Tolerances,
 };
 use crate::lanes::{LaneMath, Lanes, Simd, TRUE};
+
+#[cfg(all(target_arch = "x86_64", not(debug_assertions)))]
+use super::kernel::{Avx2, Avx512};
+use super::kernel::{Baseline, Isa};
 use crate::validate::ParameterError;
 
 /// `Result` with the driver's [`RunError`]: the ensemble's runs fail as the scalar
@@ -240,10 +244,13 @@ impl<E: EventSet<f64, M>, const M: usize> Ensemble<E, M> {
         self.math
     }
 
-    /// Integrates every trajectory in lanes of `V`, streaming trajectory `j` to
-    /// `observers[j]`, on the calling thread. A lane whose trajectory ends (or fails) takes
-    /// the next one in order; the result of each trajectory does not depend on `V`, on the
-    /// order of the slice or on what runs in the other lanes.
+    /// Integrates every trajectory in SIMD lanes, streaming trajectory `j` to
+    /// `observers[j]`, on the calling thread. The instruction set is chosen at run time
+    /// ([`with_simd`](Self::with_simd), default the widest the CPU has), and with it the
+    /// lanes: sixteen with AVX2 or AVX-512, four on the baseline, half that for the last
+    /// trajectories of a run. A lane whose trajectory ends (or fails) takes the next one
+    /// in order; the result of each trajectory does not depend on the instruction set or
+    /// the width, on the order of the slice or on what runs in the other lanes.
     ///
     /// Every trajectory is checked ([`MemberRun::check`]) before the lanes start: an
     /// invalid one (fields set directly to a reversed time span, a non-finite state, a
@@ -256,7 +263,7 @@ impl<E: EventSet<f64, M>, const M: usize> Ensemble<E, M> {
     /// length. Each trajectory's own result is an element of the vector: its
     /// [`Outcome`], or the error that stopped it (the scalar driver's errors, or that of
     /// [`MemberRun::check`]).
-    pub fn run<V: Lanes, D: LaneDynamics<M>, O: Observer<f64, M>>(
+    pub fn run<D: LaneDynamics<M>, O: Observer<f64, M>>(
         &self,
         trajectories: &[MemberRun<D, M>],
         observers: &mut [O],
@@ -294,13 +301,36 @@ impl<E: EventSet<f64, M>, const M: usize> Ensemble<E, M> {
             }
         }
         if let Some(&first) = queue.first() {
-            Engine::<V, E, D, M>::new(self, trajectories, &queue, &trajectories[first])
-                .run(observers, &mut out);
+            let first = &trajectories[first];
+            match self.simd.resolve() {
+                #[cfg(all(target_arch = "x86_64", not(debug_assertions)))]
+                Simd::Avx512 => {
+                    self.lanes::<Avx512, _, _>(trajectories, &queue, first, observers, &mut out)
+                }
+                #[cfg(all(target_arch = "x86_64", not(debug_assertions)))]
+                Simd::Avx2 => {
+                    self.lanes::<Avx2, _, _>(trajectories, &queue, first, observers, &mut out)
+                }
+                _ => self.lanes::<Baseline, _, _>(trajectories, &queue, first, observers, &mut out),
+            }
         }
         Ok(out
             .into_iter()
             .map(|r| r.unwrap_or_else(|| Err(IntegrateError::NotInitialized.into())))
             .collect())
+    }
+
+    /// The lanes of the instruction set `I` over the valid trajectories `queue`.
+    fn lanes<I: Isa, D: LaneDynamics<M>, O: Observer<f64, M>>(
+        &self,
+        trajectories: &[MemberRun<D, M>],
+        queue: &[usize],
+        first: &MemberRun<D, M>,
+        observers: &mut [O],
+        out: &mut [Option<Result<Outcome<f64, M>>>],
+    ) {
+        Engine::<I, I::Wide, I::Narrow, E, D, M>::new(self, trajectories, queue, first)
+            .run(observers, out);
     }
 
     /// [`run`](Self::run) over the threads of the current rayon pool, `chunk` trajectories
@@ -310,7 +340,7 @@ impl<E: EventSet<f64, M>, const M: usize> Ensemble<E, M> {
     /// # Errors
     /// As [`run`](Self::run); [`ParameterError`] if `chunk == 0`.
     #[cfg(feature = "parallel")]
-    pub fn run_parallel<V: Lanes, D: LaneDynamics<M> + Sync, O: Observer<f64, M> + Send>(
+    pub fn run_parallel<D: LaneDynamics<M> + Sync, O: Observer<f64, M> + Send>(
         &self,
         trajectories: &[MemberRun<D, M>],
         observers: &mut [O],
@@ -334,7 +364,7 @@ impl<E: EventSet<f64, M>, const M: usize> Ensemble<E, M> {
         let parts: Vec<Vec<Result<Outcome<f64, M>>>> = trajectories
             .par_chunks(chunk)
             .zip(observers.par_chunks_mut(chunk))
-            .map(|(t, o)| self.run::<V, D, O>(t, o))
+            .map(|(t, o)| self.run::<D, O>(t, o))
             .collect::<Result<_>>()?;
         Ok(parts.into_iter().flatten().collect())
     }
@@ -391,7 +421,10 @@ fn gather_bits(mask: u32, from: &[usize]) -> u32 {
 }
 
 /// The lanes and their scalar bookkeeping.
-struct Engine<'a, V: Lanes, E, D: LaneDynamics<M>, const M: usize> {
+///
+/// `I` is the instruction set the lane loop is compiled for, `V` the lanes of this engine
+/// and `H` those its tail compacts into (`H = V`: no further compaction).
+struct Engine<'a, I: Isa, V: Lanes, H: Lanes, E, D: LaneDynamics<M>, const M: usize> {
     cfg: &'a Ensemble<E, M>,
     jobs: &'a [MemberRun<D, M>],
     /// The indices of the valid trajectories, in order ([`MemberRun::check`]).
@@ -413,6 +446,7 @@ struct Engine<'a, V: Lanes, E, D: LaneDynamics<M>, const M: usize> {
     /// stays at the fast end.
     st: Box<LaneState<V, D, M>>,
     consts: StepConsts<M>,
+    isa: core::marker::PhantomData<(I, H)>,
 }
 
 /// The lanes whose bit is set in `mask`, in increasing order.
@@ -427,7 +461,9 @@ fn lanes_of(mut mask: u32) -> impl Iterator<Item = usize> {
     })
 }
 
-impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engine<'a, V, E, D, M> {
+impl<'a, I: Isa, V: Lanes, H: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize>
+    Engine<'a, I, V, H, E, D, M>
+{
     fn new(
         cfg: &'a Ensemble<E, M>,
         jobs: &'a [MemberRun<D, M>],
@@ -469,7 +505,8 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
                 counts: Counts::zero(),
                 ends: EndsCache::new(),
             }),
-            consts: StepConsts::new(&cfg.tol, &cfg.opts, (cfg.max_steps, cfg.math, cfg.simd)),
+            consts: StepConsts::new(&cfg.tol, &cfg.opts, (cfg.max_steps, cfg.math)),
+            isa: core::marker::PhantomData,
         }
     }
 
@@ -636,19 +673,18 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
         let want_events = E::LEN > 0;
         while self.st.active.bits() != 0 {
             if self.next >= self.queue.len()
-                && <V::Half as Lanes>::LANES < V::LANES
-                && self.st.active.bits().count_ones() as usize <= <V::Half as Lanes>::LANES
+                && H::LANES < V::LANES
+                && self.st.active.bits().count_ones() as usize <= H::LANES
             {
                 self.compact().drive(observers, out);
                 return;
             }
-            super::kernel::step(&mut self.st, &self.consts, &mut step);
+            super::kernel::step::<I, V, D, M>(&mut self.st, &self.consts, &mut step);
             step.events = false;
             if want_events && step.accepted != 0 {
                 let st = &mut *self.st;
-                super::kernel::event_ends::<V, E, M>(
+                super::kernel::event_ends::<I, V, E, M>(
                     &self.cfg.events,
-                    self.consts.simd(),
                     (&mut st.ends, st.accepted),
                     &mut step,
                 );
@@ -688,20 +724,20 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
         }
     }
 
-    /// The busy lanes moved, in order, to an engine with half the lanes (the queue is
-    /// empty). Idle lanes there step from the first busy lane's state, never used.
-    fn compact(&mut self) -> Engine<'a, V::Half, E, D, M> {
-        type H<V> = <V as Lanes>::Half;
+    /// The busy lanes moved, in order, to an engine of the narrow width `H` (the queue is
+    /// empty; at most `H::LANES` lanes are busy). Idle lanes there step from the first
+    /// busy lane's state, never used.
+    fn compact(&mut self) -> Engine<'a, I, H, H, E, D, M> {
         let busy: Vec<usize> = lanes_of(self.st.active.bits()).collect();
         let st = &self.st;
         let first = busy[0];
-        let splat = |x: V| <H<V> as Lanes>::splat(x.lane(first));
+        let splat = |x: V| H::splat(x.lane(first));
         let member = self.slots[first]
             .member
             .as_ref()
             .unwrap_or(&self.jobs[self.queue[0]].member);
         let mut half = Box::new(LaneState {
-            packed: member.pack::<H<V>>(),
+            packed: member.pack::<H>(),
             t: splat(st.t),
             origin: splat(st.origin),
             tau: splat(st.tau),
@@ -715,15 +751,15 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
             t_end: splat(st.t_end),
             ln_err_old: splat(st.ln_err_old),
             rej_last: splat(st.rej_last),
-            active: <H<V> as Lanes>::splat(0.0),
-            kk: [[<H<V> as Lanes>::splat(0.0); M]; 7],
-            accepted: <H<V> as Lanes>::splat(0.0),
+            active: H::splat(0.0),
+            kk: [[H::splat(0.0); M]; 7],
+            accepted: H::splat(0.0),
             counts: Counts::zero(),
             ends: EndsCache::new(),
         });
-        let mut slots: Vec<Slot<D>> = (0..<H<V> as Lanes>::LANES).map(|_| Slot::idle()).collect();
+        let mut slots: Vec<Slot<D>> = (0..H::LANES).map(|_| Slot::idle()).collect();
         for (k, &i) in busy.iter().enumerate() {
-            let mv = |dst: H<V>, src: V| dst.with_lane(k, src.lane(i));
+            let mv = |dst: H, src: V| dst.with_lane(k, src.lane(i));
             half.t = mv(half.t, st.t);
             half.origin = mv(half.origin, st.origin);
             half.tau = mv(half.tau, st.tau);
@@ -760,6 +796,7 @@ impl<'a, V: Lanes, E: EventSet<f64, M>, D: LaneDynamics<M>, const M: usize> Engi
             watch: gather_bits(self.watch, &busy),
             st: half,
             consts: self.consts,
+            isa: core::marker::PhantomData,
         }
     }
 

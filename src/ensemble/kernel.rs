@@ -5,7 +5,7 @@
 //! [`Tolerances::error_norm`], the PI controller), written over the components of a state
 //! of any size `M` and evaluated with the model's lane form
 //! ([`LaneDynamics`](crate::LaneDynamics)). It is compiled for the instruction set chosen at
-//! run time ([`Simd`]): the body is handed to `pulp`, which runs it under the AVX2 or
+//! run time ([`Simd`](crate::lanes::Simd)): the body is handed to `pulp`, which runs it under the AVX2 or
 //! AVX-512 target features where the CPU has them.
 
 use crate::LaneDynamics;
@@ -14,7 +14,74 @@ use crate::event::{EventSet, MAX_EVENTS};
 use crate::integrate::dopri5::tableau;
 use crate::integrate::{StepOptions, Tolerances};
 use crate::lanes::math::{exp, ln};
-use crate::lanes::{LaneMath, Lanes, Simd, TRUE};
+use crate::lanes::{F64x4, LaneMath, Lanes, TRUE};
+#[cfg(all(target_arch = "x86_64", not(debug_assertions)))]
+use crate::lanes::{F64x8, F64x16};
+
+/// An instruction set the lane loop is compiled for, with its lane width: a run takes
+/// [`Wide`](Self::Wide) lanes and moves its last trajectories to [`Narrow`](Self::Narrow)
+/// ones (the engine's compaction). Each (instruction set, model, event set) compiles the
+/// lane loop for these two widths only.
+pub(crate) trait Isa: Copy + Send + Sync + 'static {
+    /// The lanes of a run (sixteen with AVX2 or AVX-512: the fastest width measured for the
+    /// catalogue's models, `docs/performance.md`).
+    type Wide: Lanes;
+    /// The lanes the tail of a run compacts into (half of `Wide`).
+    type Narrow: Lanes;
+    /// Runs `f` compiled with this instruction set's target features.
+    fn vectorize<F: pulp::WithSimd>(f: F) -> F::Output;
+}
+
+/// The build's target features (SSE2 on a default x86-64 build): four lanes (two registers
+/// per value), two in the tail.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Baseline;
+
+impl Isa for Baseline {
+    type Wide = F64x4;
+    type Narrow = crate::lanes::F64x2;
+    #[inline(always)]
+    fn vectorize<F: pulp::WithSimd>(f: F) -> F::Output {
+        pulp::Simd::vectorize(pulp::Scalar::new(), f)
+    }
+}
+
+/// AVX2 and FMA: sixteen lanes (four registers of four per value), eight in the tail.
+#[cfg(all(target_arch = "x86_64", not(debug_assertions)))]
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Avx2;
+
+#[cfg(all(target_arch = "x86_64", not(debug_assertions)))]
+impl Isa for Avx2 {
+    type Wide = F64x16;
+    type Narrow = F64x8;
+    #[inline(always)]
+    fn vectorize<F: pulp::WithSimd>(f: F) -> F::Output {
+        match pulp::x86::V3::try_new() {
+            Some(v3) => pulp::Simd::vectorize(v3, f),
+            None => pulp::Simd::vectorize(pulp::Scalar::new(), f),
+        }
+    }
+}
+
+/// AVX-512F with AVX2 and FMA: sixteen lanes (two registers of eight per value), eight in
+/// the tail.
+#[cfg(all(target_arch = "x86_64", not(debug_assertions)))]
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Avx512;
+
+#[cfg(all(target_arch = "x86_64", not(debug_assertions)))]
+impl Isa for Avx512 {
+    type Wide = F64x16;
+    type Narrow = F64x8;
+    #[inline(always)]
+    fn vectorize<F: pulp::WithSimd>(f: F) -> F::Output {
+        match pulp::x86::V4::try_new() {
+            Some(v4) => pulp::Simd::vectorize(v4, f),
+            None => Avx2::vectorize(f),
+        }
+    }
+}
 
 /// The vector state of all lanes.
 #[derive(Debug, Clone)]
@@ -109,8 +176,7 @@ impl<V: Lanes> Counts<V> {
     }
 }
 
-/// The scalar settings of a step: tolerances, controller constants, math mode and the
-/// instruction set (already resolved for this CPU).
+/// The scalar settings of a step: tolerances, controller constants and the math mode.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct StepConsts<const M: usize> {
     atol: [f64; M],
@@ -124,14 +190,13 @@ pub(crate) struct StepConsts<const M: usize> {
     h_min: f64,
     max_steps: f64,
     math: LaneMath,
-    simd: Simd,
 }
 
 impl<const M: usize> StepConsts<M> {
     pub(crate) fn new(
         tol: &Tolerances<f64, M>,
         opts: &StepOptions<f64>,
-        (max_steps, math, simd): (usize, LaneMath, Simd),
+        (max_steps, math): (usize, LaneMath),
     ) -> Self {
         Self {
             atol: core::array::from_fn(|i| tol.atol[i]),
@@ -145,13 +210,7 @@ impl<const M: usize> StepConsts<M> {
             h_min: opts.h_min,
             max_steps: max_steps as f64,
             math,
-            simd: simd.resolve(),
         }
-    }
-
-    /// The instruction set of the run (already resolved for this CPU).
-    pub(crate) fn simd(&self) -> Simd {
-        self.simd
     }
 }
 
@@ -225,39 +284,23 @@ impl StepOut {
     }
 }
 
-/// One pass of the lane loop in the instruction set `k.simd`.
+/// One pass of the lane loop, compiled for the instruction set `I`.
 #[inline(never)]
-pub(crate) fn step<V: Lanes, D: LaneDynamics<M>, const M: usize>(
+pub(crate) fn step<I: Isa, V: Lanes, D: LaneDynamics<M>, const M: usize>(
     st: &mut LaneState<V, D, M>,
     k: &StepConsts<M>,
     out: &mut StepOut,
 ) {
-    #[cfg(target_arch = "x86_64")]
-    match k.simd {
-        Simd::Avx512 => {
-            if let Some(v4) = pulp::x86::V4::try_new() {
-                return pulp::Simd::vectorize(v4, Pass { st, k, out });
-            }
-        }
-        Simd::Avx2 => {
-            if let Some(v3) = pulp::x86::V3::try_new() {
-                return pulp::Simd::vectorize(v3, Pass { st, k, out });
-            }
-        }
-        _ => {}
-    }
-    body(st, k, out)
+    I::vectorize(Pass { st, k, out })
 }
 
 /// One pass, handed to `pulp` to be compiled with the instruction set's target features.
-#[cfg(target_arch = "x86_64")]
 struct Pass<'a, V: Lanes, D: LaneDynamics<M>, const M: usize> {
     st: &'a mut LaneState<V, D, M>,
     k: &'a StepConsts<M>,
     out: &'a mut StepOut,
 }
 
-#[cfg(target_arch = "x86_64")]
 impl<V: Lanes, D: LaneDynamics<M>, const M: usize> pulp::WithSimd for Pass<'_, V, D, M> {
     type Output = ();
 
@@ -520,35 +563,20 @@ fn body<V: Lanes, D: LaneDynamics<M>, const M: usize>(
 /// [`step`], for the instruction set `simd` (and apart from it, so that the step is not
 /// compiled again for each event set).
 #[inline(never)]
-pub(crate) fn event_ends<V: Lanes, E: EventSet<f64, M>, const M: usize>(
+pub(crate) fn event_ends<I: Isa, V: Lanes, E: EventSet<f64, M>, const M: usize>(
     events: &E,
-    simd: Simd,
     (cache, accepted): (&mut EndsCache<V>, V),
     out: &mut StepOut,
 ) {
-    #[cfg(target_arch = "x86_64")]
-    match simd {
-        Simd::Avx512 => {
-            if let Some(v4) = pulp::x86::V4::try_new() {
-                let ends = Ends::<V, E, M>::new(events, (cache, accepted), out);
-                return pulp::Simd::vectorize(v4, ends);
-            }
-        }
-        Simd::Avx2 => {
-            if let Some(v3) = pulp::x86::V3::try_new() {
-                let ends = Ends::<V, E, M>::new(events, (cache, accepted), out);
-                return pulp::Simd::vectorize(v3, ends);
-            }
-        }
-        _ => {}
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = simd;
-    ends_body::<V, E, M>(events, (cache, accepted), out)
+    I::vectorize(Ends::<V, E, M> {
+        events,
+        cache,
+        accepted,
+        out,
+    })
 }
 
 /// The events' ends, handed to `pulp` like [`Pass`].
-#[cfg(target_arch = "x86_64")]
 struct Ends<'a, V, E, const M: usize> {
     events: &'a E,
     cache: &'a mut EndsCache<V>,
@@ -556,23 +584,6 @@ struct Ends<'a, V, E, const M: usize> {
     out: &'a mut StepOut,
 }
 
-#[cfg(target_arch = "x86_64")]
-impl<'a, V, E, const M: usize> Ends<'a, V, E, M> {
-    fn new(
-        events: &'a E,
-        (cache, accepted): (&'a mut EndsCache<V>, V),
-        out: &'a mut StepOut,
-    ) -> Self {
-        Self {
-            events,
-            cache,
-            accepted,
-            out,
-        }
-    }
-}
-
-#[cfg(target_arch = "x86_64")]
 impl<V: Lanes, E: EventSet<f64, M>, const M: usize> pulp::WithSimd for Ends<'_, V, E, M> {
     type Output = ();
 

@@ -3,8 +3,8 @@
 //!
 //! A bifurcation sweep, a TLE diagram or a parameter plane integrates thousands of
 //! independent trajectories of the same model. [`Ensemble::run`] puts `L` of them in the
-//! lanes of a [`Lanes`] vector ([`F64x2`], [`F64x4`], [`F64x8`], [`F64x16`]) and steps them
-//! together with DOPRI5.
+//! lanes of a [`Lanes`] vector and steps them together with DOPRI5: `L = 16` with AVX2 or
+//! AVX-512, 4 on the baseline instruction set (see [below](#instruction-sets-and-widths)).
 //!
 //! # Which models
 //! Any model with a lane form ([`LaneDynamics`](crate::LaneDynamics)), of any state size
@@ -72,21 +72,22 @@
 //! position in the batch, on the other lanes or on the number of threads
 //! ([`Ensemble::run_parallel`]).
 //!
-//! # Instruction sets
+//! # Instruction sets and widths
 //! The lane types ([`F64x2`], [`F64x4`], [`F64x8`], [`F64x16`]) are arrays whose
 //! operations are lane-wise loops; the lane step is compiled in this crate for the build's
 //! target, for AVX2+FMA and for AVX-512F, and [`Simd`] picks the widest the CPU has when a
-//! run starts, so a default build (x86-64 baseline) runs on AVX2 or AVX-512 registers
-//! without `-C target-cpu`. The variants execute the same IEEE operations in the same order
-//! (no fused multiply-add is introduced): results are bit-identical across them (tested).
-//!
-//! # Which width
-//! The step is a chain of dependent operations (the polynomials of `sin`, `exp`, `ln`, the
-//! stages), so more lanes than one register holds still pay: the extra registers are
-//! independent work that fills the pipeline while a chain waits: the widest types are
-//! usually the fastest (the README gives the measured ratios per model and width,
-//! `examples/ensemble_throughput` and `examples/ensemble_any` measure them on a machine).
-//! With few trajectories per thread, wide types leave lanes idle at the end of the queue.
+//! run starts ([`Ensemble::with_simd`] caps it), so a default build (x86-64 baseline) runs on
+//! AVX2 or AVX-512 registers without `-C target-cpu`. Each instruction set has one width:
+//! sixteen lanes with AVX2 (four registers per value) and AVX-512 (two), four on the
+//! baseline (two SSE2 registers); once the queue is empty and at most half the lanes are
+//! busy, the last trajectories move to half the width (eight, or two). The step is a chain
+//! of dependent operations (the polynomials of `sin`, `exp`, `ln`, the stages), so more
+//! lanes than one register holds pay: the extra registers are independent work that fills
+//! the pipeline while a chain waits (the measured ratios per model and width are in
+//! `docs/performance.md`). One width per instruction set keeps what a model compiles to
+//! six lane loops (two widths, three instruction sets). The variants execute the same
+//! IEEE operations in the same order (no fused multiply-add is introduced): results are
+//! bit-identical across instruction sets and widths (tested).
 //!
 //! # Where ensembles are used
 //! The instruments built on the ensemble live with their scalar forms, for any model with a
@@ -120,13 +121,13 @@
 //! ```
 //! use nalgebra::Vector2;
 //! use nonsmooth::drive::Simulation;
-//! use nonsmooth::ensemble::{Ensemble, F64x4, MemberRun};
+//! use nonsmooth::ensemble::{Ensemble, MemberRun};
 //! use nonsmooth::integrate::{Dopri5, Tolerances};
 //! use nonsmooth::systems::DuffingUeda;
 //!
 //! let tol = Tolerances::new(1e-8, 1e-10)?;
 //! let y0 = Vector2::new(1.0, 0.0);
-//! // The Duffing–Ueda oscillator at eight forcing amplitudes, 5 periods each, in lanes of four.
+//! // The Duffing–Ueda oscillator at eight forcing amplitudes, 5 periods each, in lanes.
 //! let jobs = (0..8)
 //!     .map(|i| {
 //!         let p = DuffingUeda { b: 5.0 + i as f64, ..DuffingUeda::default() };
@@ -134,7 +135,7 @@
 //!     })
 //!     .collect::<nonsmooth::Result<Vec<_>>>()?;
 //! let mut observers = vec![(); jobs.len()];
-//! let out = Ensemble::new(tol)?.run::<F64x4, _, _>(&jobs, &mut observers)?;
+//! let out = Ensemble::new(tol)?.run(&jobs, &mut observers)?;
 //! // The same as the scalar path, to the bit.
 //! let j = &jobs[3];
 //! let scalar = Simulation::new(j.member, Dopri5::new(tol))

@@ -3,8 +3,9 @@
 /// Which instruction set the ensemble's lane loop is compiled for.
 ///
 /// The lane loop (the six stages, the error norm, the controller and the masked updates)
-/// is compiled three times: for the build's target (the x86-64 baseline, SSE2, unless
-/// `RUSTFLAGS` says otherwise), with AVX2 and FMA enabled, and with AVX-512F enabled (the
+/// is compiled three times (in an optimized build, below): for the build's target (the
+/// x86-64 baseline, SSE2, unless `RUSTFLAGS` says otherwise) in four lanes, with AVX2 and
+/// FMA enabled and with AVX-512F enabled in sixteen lanes each (the
 /// `pulp` crate's `V3` and `V4` tokens, created only where the CPU has the features, run
 /// the inlined loop under those target features without `unsafe` in this crate). At
 /// the start of every [`Ensemble::run`](crate::ensemble::Ensemble::run) the variant is picked by
@@ -12,6 +13,15 @@
 /// reports (`is_x86_feature_detected!`); on other architectures there is only the
 /// baseline. The default build therefore gets the AVX2 or AVX-512 code without
 /// `-C target-cpu`.
+///
+/// # Which builds have which variants
+/// The AVX2 and AVX-512 variants are compiled in builds without debug assertions (the
+/// `release` profile, `cargo run --release`, `cargo bench`): there their speed matters. A
+/// build with debug assertions (the `dev` and `test` profiles: `cargo build`, `cargo test`)
+/// compiles the baseline alone, so that a test build does not compile the lane loop three
+/// times for every model; [`resolve`](Self::resolve) and [`available`](Self::available)
+/// then report the baseline. The results are the same bits either way (below); CI runs the
+/// ensemble's tests in both profiles.
 ///
 /// # Same answers on every path
 /// The variants differ in instruction selection only: every variant executes the same
@@ -64,8 +74,9 @@ impl Simd {
     }
 }
 
-/// `(avx2 and fma, avx512f and avx2 and fma)` on this CPU.
-#[cfg(target_arch = "x86_64")]
+/// `(avx2 and fma, avx512f and avx2 and fma)` on this CPU, in a build that compiles those
+/// variants (without debug assertions).
+#[cfg(all(target_arch = "x86_64", not(debug_assertions)))]
 fn detected() -> (bool, bool) {
     let avx2 = std::arch::is_x86_feature_detected!("avx")
         && std::arch::is_x86_feature_detected!("avx2")
@@ -73,7 +84,7 @@ fn detected() -> (bool, bool) {
     (avx2, avx2 && std::arch::is_x86_feature_detected!("avx512f"))
 }
 
-#[cfg(not(target_arch = "x86_64"))]
+#[cfg(not(all(target_arch = "x86_64", not(debug_assertions))))]
 fn detected() -> (bool, bool) {
     (false, false)
 }

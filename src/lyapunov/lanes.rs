@@ -6,7 +6,7 @@ use nalgebra::SVector;
 use super::{DiagramPoint, DiagramSettings, LyapunovError, Norm, block_standard_error, grid_time};
 use crate::LaneDynamics;
 use crate::drive::{Outcome, RunError};
-use crate::ensemble::{Ensemble, Lanes, MemberRun};
+use crate::ensemble::{Ensemble, MemberRun};
 use crate::integrate::Stats;
 
 /// `Result` with [`LyapunovError`].
@@ -48,7 +48,7 @@ type Outcomes<const M: usize> =
 /// [`LyapunovError`] for empty `systems`, a bad `d0`, norm, interval or block count, a
 /// separation lost in a recorded interval; the first integration error in the order of
 /// `systems` ([`LyapunovError::Run`]).
-pub fn tle_independent<V: Lanes, D: LaneDynamics<M> + Clone, const M: usize>(
+pub fn tle_independent<D: LaneDynamics<M> + Clone, const M: usize>(
     ensemble: &Ensemble<(), M>,
     systems: &[(f64, D)],
     y0: SVector<f64, M>,
@@ -58,7 +58,7 @@ pub fn tle_independent<V: Lanes, D: LaneDynamics<M> + Clone, const M: usize>(
 ) -> Result<Vec<DiagramPoint<f64>>> {
     estimate(systems, y0, d0, norm, settings, |jobs| {
         let mut obs = vec![(); jobs.len()];
-        ensemble.run::<V, _, _>(jobs, &mut obs)
+        ensemble.run(jobs, &mut obs)
     })
 }
 
@@ -68,7 +68,7 @@ pub fn tle_independent<V: Lanes, D: LaneDynamics<M> + Clone, const M: usize>(
 /// # Errors
 /// As [`tle_independent`]; a parameter error if `chunk == 0`.
 #[cfg(feature = "parallel")]
-pub fn tle_independent_parallel<V: Lanes, D: LaneDynamics<M> + Clone + Sync, const M: usize>(
+pub fn tle_independent_parallel<D: LaneDynamics<M> + Clone + Sync, const M: usize>(
     ensemble: &Ensemble<(), M>,
     systems: &[(f64, D)],
     y0: SVector<f64, M>,
@@ -79,7 +79,7 @@ pub fn tle_independent_parallel<V: Lanes, D: LaneDynamics<M> + Clone + Sync, con
 ) -> Result<Vec<DiagramPoint<f64>>> {
     estimate(systems, y0, d0, norm, settings, |jobs| {
         let mut obs = vec![(); jobs.len()];
-        ensemble.run_parallel::<V, _, _>(jobs, &mut obs, chunk)
+        ensemble.run_parallel(jobs, &mut obs, chunk)
     })
 }
 

@@ -14,7 +14,7 @@ use super::StudyError;
 use super::mechanical::{Described, Description};
 use super::system::{ParameterDef, ParameterPoint, PointRun, PointStart, RunSettings, StudySystem};
 use super::{lanes, scalar};
-use crate::ensemble::{Ensemble, F64x8, F64x16, Simd};
+use crate::ensemble::Ensemble;
 use crate::event::Stop;
 use crate::integrate::{Dopri5, Tolerances};
 use crate::lyapunov::{Norm, TwoTrajectory};
@@ -127,22 +127,40 @@ impl Paper {
 
     /// The parameters at `p` with the factor applied, and `ω`.
     pub(crate) fn at(p: &ParameterPoint) -> (PaperParameters, f64) {
+        // The values in the order of `Paper::new`'s list.
+        let [
+            omega,
+            factor,
+            m,
+            m0e,
+            k,
+            c,
+            t,
+            eps,
+            k_i,
+            b,
+            n1,
+            n2,
+            n3,
+            x_i,
+            eta,
+        ] = p.array();
         let q = PaperParameters {
-            m: p.get("m"),
-            m0e: p.get("m0e") * p.get("amplitude_factor"),
-            k: p.get("k"),
-            c: p.get("c"),
-            t: p.get("t"),
-            eps: p.get("eps"),
-            k_i: p.get("k_i"),
-            b: p.get("b"),
-            n1: p.get("n1"),
-            n2: p.get("n2"),
-            n3: p.get("n3"),
-            x_i: p.get("x_i"),
-            eta: p.get("eta"),
+            m,
+            m0e: m0e * factor,
+            k,
+            c,
+            t,
+            eps,
+            k_i,
+            b,
+            n1,
+            n2,
+            n3,
+            x_i,
+            eta,
         };
-        (q, p.get("omega"))
+        (q, omega)
     }
 
     /// Impacts: rising crossings of `x = x_I`.
@@ -253,19 +271,12 @@ impl Paper {
                     .push((k, LaneStart { param: 0.0, ..st })),
             }
         }
-        // Sixteen lanes pay on AVX-512, eight on AVX2 (the `ensemble` module docs); the
-        // records are the same either way.
-        let run_lanes = if Simd::Auto.resolve() == Simd::Avx512 {
-            sweep_starts::<F64x16, Member, Stop, 2>
-        } else {
-            sweep_starts::<F64x8, Member, Stop, 2>
-        };
         for group in groups.values() {
             let stop = Self::impact_stop(group[0].1.system.params());
             let starts: Vec<LaneStart<Member, 2>> = group.iter().map(|(_, st)| *st).collect();
             let run = Ensemble::new(tol)
                 .map_err(|e| SweepError::failed(0.0, e))
-                .and_then(|e| run_lanes(&e, &settings, &starts, Some(stop)));
+                .and_then(|e| sweep_starts(&e, &settings, &starts, Some(stop)));
             match run {
                 Err(e) => {
                     for (k, _) in group {
@@ -389,10 +400,12 @@ impl Duffing {
     }
 
     fn at(p: &ParameterPoint) -> DuffingUeda {
+        // The values in the order of `Duffing::new`'s list.
+        let [omega, factor, k, b] = p.array();
         DuffingUeda {
-            k: p.get("k"),
-            b: p.get("b") * p.get("amplitude_factor"),
-            omega: p.get("omega"),
+            k,
+            b: b * factor,
+            omega,
         }
     }
 }
@@ -443,7 +456,7 @@ impl StudySystem for Duffing {
             let model = d.model::<f64>().map_err(|e| e.to_string())?;
             Ok((model, Vec::<Stop>::new(), d.period(), y0.clone()))
         });
-        lanes::run_smooth_batch::<2, 4, lanes::ByMachine, _, _>(s, starts.collect())
+        lanes::run_smooth_batch::<2, 4, _, _>(s, starts.collect())
     }
 }
 
@@ -480,20 +493,35 @@ impl TwoDof {
     }
 
     fn at(p: &ParameterPoint) -> (TwoDofImpact, f64) {
+        // The values in the order of `TwoDof::new`'s list.
+        let [
+            omega,
+            factor,
+            m1,
+            m2,
+            k1,
+            k2,
+            c1,
+            c2,
+            force,
+            gap,
+            k_contact,
+            b_contact,
+        ] = p.array();
         (
             TwoDofImpact {
-                m1: p.get("m1"),
-                m2: p.get("m2"),
-                k1: p.get("k1"),
-                k2: p.get("k2"),
-                c1: p.get("c1"),
-                c2: p.get("c2"),
-                force: p.get("force") * p.get("amplitude_factor"),
-                gap: p.get("gap"),
-                k_contact: p.get("k_contact"),
-                b_contact: p.get("b_contact"),
+                m1,
+                m2,
+                k1,
+                k2,
+                c1,
+                c2,
+                force: force * factor,
+                gap,
+                k_contact,
+                b_contact,
             },
-            p.get("omega"),
+            omega,
         )
     }
 }
@@ -548,7 +576,7 @@ impl StudySystem for TwoDof {
             let stop = d.stop::<f64>().map_err(e)?;
             Ok((model, vec![stop], TwoDofImpact::period(omega), y0.clone()))
         });
-        lanes::run_smooth_batch::<4, 8, lanes::ByMachine, _, _>(s, starts.collect())
+        lanes::run_smooth_batch::<4, 8, _, _>(s, starts.collect())
     }
 }
 
@@ -578,12 +606,13 @@ impl Ball {
     }
 
     fn at(p: &ParameterPoint) -> BouncingBallTable {
-        let (omega, g) = (p.get("omega"), p.get("g"));
+        // The values in the order of `Ball::new`'s list.
+        let [omega, factor, gamma, e, g] = p.array();
         BouncingBallTable {
             g,
-            amplitude: p.get("gamma") * g / (omega * omega) * p.get("amplitude_factor"),
+            amplitude: gamma * g / (omega * omega) * factor,
             omega,
-            e: p.get("e"),
+            e,
         }
     }
 }
@@ -625,5 +654,82 @@ impl StudySystem for Ball {
         let model = b.model::<f64>().map_err(e)?;
         let impact = b.impact::<f64>().map_err(e)?;
         scalar::run_rigid::<1, 2, _, _, _>(s, model, impact, b.period(), y0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each parameter set by name to a value of its own (2, 3, 4, … in the system's order):
+    /// the point and the values by name.
+    fn distinct(system: &dyn StudySystem) -> (ParameterPoint, BTreeMap<String, f64>) {
+        let values: BTreeMap<String, f64> = system
+            .parameters()
+            .iter()
+            .enumerate()
+            .map(|(k, d)| (d.name.clone(), 2.0 + k as f64))
+            .collect();
+        (system.point(&values).unwrap(), values)
+    }
+
+    /// The `at` of each system of the catalogue reads every parameter at its index: a point
+    /// whose parameters are set by name gives each field the value of its own name.
+    #[test]
+    fn each_system_reads_its_parameters_by_their_names() {
+        let (p, v) = distinct(&Paper::new());
+        let (q, omega) = Paper::at(&p);
+        assert_eq!(omega, v["omega"]);
+        let fields = [
+            (q.m, "m"),
+            (q.k, "k"),
+            (q.c, "c"),
+            (q.t, "t"),
+            (q.eps, "eps"),
+            (q.k_i, "k_i"),
+            (q.b, "b"),
+            (q.n1, "n1"),
+            (q.n2, "n2"),
+            (q.n3, "n3"),
+            (q.x_i, "x_i"),
+            (q.eta, "eta"),
+        ];
+        for (got, name) in fields {
+            assert_eq!(got, v[name], "{name}");
+        }
+        assert_eq!(q.m0e, v["m0e"] * v["amplitude_factor"]);
+
+        let (p, v) = distinct(&Duffing::new());
+        let d = Duffing::at(&p);
+        assert_eq!([d.k, d.omega], [v["k"], v["omega"]]);
+        assert_eq!(d.b, v["b"] * v["amplitude_factor"]);
+
+        let (p, v) = distinct(&TwoDof::new());
+        let (d, omega) = TwoDof::at(&p);
+        let fields = [
+            (omega, "omega"),
+            (d.m1, "m1"),
+            (d.m2, "m2"),
+            (d.k1, "k1"),
+            (d.k2, "k2"),
+            (d.c1, "c1"),
+            (d.c2, "c2"),
+            (d.gap, "gap"),
+            (d.k_contact, "k_contact"),
+            (d.b_contact, "b_contact"),
+        ];
+        for (got, name) in fields {
+            assert_eq!(got, v[name], "{name}");
+        }
+        assert_eq!(d.force, v["force"] * v["amplitude_factor"]);
+
+        let (p, v) = distinct(&Ball::new());
+        let b = Ball::at(&p);
+        assert_eq!([b.g, b.omega, b.e], [v["g"], v["omega"], v["e"]]);
+        let (omega, g) = (v["omega"], v["g"]);
+        assert_eq!(
+            b.amplitude,
+            v["gamma"] * g / (omega * omega) * v["amplitude_factor"]
+        );
     }
 }

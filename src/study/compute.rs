@@ -2,7 +2,7 @@
 
 use super::record::PointRecord;
 use super::shard::{Shard, shard_indices};
-use super::spec::{Study, apply_axis};
+use super::spec::Study;
 use super::system::{ParameterPoint, PointRun, PointStart, RunSettings, fill};
 use crate::entropy::{Histogram, QRange, entropy_index};
 
@@ -26,24 +26,13 @@ fn try_point(study: &Study, index: usize) -> Result<PointRecord, String> {
 
 /// The parameters and the given initial components (NaN: not given) of point `index`.
 fn point_setup(study: &Study, index: usize) -> Result<(ParameterPoint, Option<Vec<f64>>), String> {
-    let spec = study.spec();
     if index >= study.points() {
         return Err(format!(
             "point {index} outside the grid of {} points",
             study.points()
         ));
     }
-    let system = study.system();
-    let mut point = system
-        .point(&spec.system.parameters)
-        .map_err(|e| e.to_string())?;
-    let mut y0 = spec.initial.state.clone();
-    let (xv, yv) = study.values(index);
-    apply_axis(system, &mut point, &mut y0, &spec.grid.x.parameter, xv);
-    if let Some(y) = &spec.grid.y {
-        apply_axis(system, &mut point, &mut y0, &y.parameter, yv);
-    }
-    Ok((point, y0))
+    Ok(study.point(index))
 }
 
 /// The run settings of every point of `study`.

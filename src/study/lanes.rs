@@ -10,7 +10,7 @@
 
 use super::scalar::{self, MAX_SURFACES, Observers, Recording, SurfaceEvents};
 use super::system::{PointRun, RunSettings};
-use crate::ensemble::{Ensemble, F64x8, F64x16, MemberRun, Simd};
+use crate::ensemble::{Ensemble, MemberRun};
 use crate::event::EventFunction;
 use crate::{Dynamics, LaneDynamics};
 
@@ -28,68 +28,11 @@ struct Ready<S, G, const M: usize> {
     rec: Recording<M>,
 }
 
-/// Each trajectory's outcome of an ensemble run, or why the run could not start.
-type Outcomes<const M: usize> =
-    Result<Vec<Result<crate::drive::Outcome<f64, M>, crate::drive::RunError>>, String>;
-
-/// The lane widths a batch may run in (each width compiles the ensemble's lane loop once
-/// more for the model).
-pub(crate) trait Widths {
-    /// Runs `jobs` in an ensemble of one of the widths.
-    fn run<E, D, const M: usize>(
-        e: &Ensemble<E, M>,
-        jobs: &[MemberRun<D, M>],
-        obs: &mut [Observers<M>],
-    ) -> Outcomes<M>
-    where
-        E: crate::event::EventSet<f64, M>,
-        D: LaneDynamics<M>;
-}
-
-/// Sixteen lanes on AVX-512, eight otherwise (the records are the same either way).
-pub(crate) struct ByMachine;
-
-impl Widths for ByMachine {
-    fn run<E, D, const M: usize>(
-        e: &Ensemble<E, M>,
-        jobs: &[MemberRun<D, M>],
-        obs: &mut [Observers<M>],
-    ) -> Outcomes<M>
-    where
-        E: crate::event::EventSet<f64, M>,
-        D: LaneDynamics<M>,
-    {
-        if Simd::Auto.resolve() == Simd::Avx512 {
-            e.run::<F64x16, _, _>(jobs, obs)
-        } else {
-            e.run::<F64x8, _, _>(jobs, obs)
-        }
-        .map_err(|e| e.to_string())
-    }
-}
-
-/// Eight lanes on every machine: one width to compile (the described systems, built for
-/// each of their sizes).
-pub(crate) struct Eight;
-
-impl Widths for Eight {
-    fn run<E, D, const M: usize>(
-        e: &Ensemble<E, M>,
-        jobs: &[MemberRun<D, M>],
-        obs: &mut [Observers<M>],
-    ) -> Outcomes<M>
-    where
-        E: crate::event::EventSet<f64, M>,
-        D: LaneDynamics<M>,
-    {
-        e.run::<F64x8, _, _>(jobs, obs).map_err(|e| e.to_string())
-    }
-}
-
-/// The points of `points` run in SIMD lanes of the widths `W`: for each, what
+/// The points of `points` run in SIMD lanes (the ensemble's width for the instruction set
+/// of the machine): for each, what
 /// [`scalar::run_smooth`]`::<M, M2, _, _>(s, system, surfaces, period, y0)` returns, to the
 /// bit, failure messages included.
-pub(crate) fn run_smooth_batch<const M: usize, const M2: usize, W: Widths, S, G>(
+pub(crate) fn run_smooth_batch<const M: usize, const M2: usize, S, G>(
     s: &RunSettings,
     points: Vec<SmoothStart<S, G>>,
 ) -> Vec<Result<PointRun, String>>
@@ -113,7 +56,7 @@ where
         }
     }
     for group in groups {
-        run_group::<M, M2, W, S, G>(s, group, &mut out);
+        run_group::<M, M2, S, G>(s, group, &mut out);
     }
     out.into_iter()
         .map(|r| r.unwrap_or_else(|| Err("internal: not computed".into())))
@@ -155,7 +98,7 @@ where
 
 /// Runs one group in one ensemble of the widths `W` and stores each point's record in
 /// `out`.
-fn run_group<const M: usize, const M2: usize, W: Widths, S, G>(
+fn run_group<const M: usize, const M2: usize, S, G>(
     s: &RunSettings,
     group: Vec<Ready<S, G, M>>,
     out: &mut [Option<Result<PointRun, String>>],
@@ -173,7 +116,7 @@ fn run_group<const M: usize, const M2: usize, W: Widths, S, G>(
         .iter()
         .map(|r| (r.job.clone(), r.rec.obs.clone()))
         .unzip();
-    let results = built.and_then(|e| W::run(&e, &jobs, &mut obs));
+    let results = built.and_then(|e| e.run(&jobs, &mut obs).map_err(|e| e.to_string()));
     match results {
         Err(m) => {
             for r in &group {

@@ -100,9 +100,10 @@ pub struct ElementSpec {
     /// The degree of freedom `i` (from 0) the law acts on, or
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub dof: Option<usize>,
-    /// the pair `[i, j]` of the relative coordinate `q_i − q_j`.
+    /// the pair `[i, j]` of the relative coordinate `q_i − q_j` (read as a list: any other
+    /// length is an error of the spec naming the field, not an index dropped or missing).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub between: Option<[usize; 2]>,
+    pub between: Option<Vec<usize>>,
     /// `"upper"` or `"lower"`: the side of a `hertz` stop (default `"upper"`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub side: Option<String>,
@@ -131,9 +132,10 @@ pub struct SurfaceSpec {
     /// The degree of freedom (from 0), or
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub dof: Option<usize>,
-    /// the pair `[i, j]` of the relative coordinate `q_i − q_j`.
+    /// the pair `[i, j]` of the relative coordinate `q_i − q_j` (as on an element: exactly
+    /// two indices).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub between: Option<[usize; 2]>,
+    pub between: Option<Vec<usize>>,
     /// The stop's position on the coordinate.
     pub position: SpecValue,
     /// `"upper"` (the coordinate reaches the stop from below; the default) or `"lower"`.
@@ -172,13 +174,32 @@ impl Description<'_> {
 /// A law's parameters: each name with its default (`None`: required).
 type LawParameters = &'static [(&'static str, Option<f64>)];
 
-/// The laws and their parameters.
-const LAWS: &[(&str, LawParameters)] = &[
-    ("linear_spring", &[("k", None), ("x0", Some(0.0))]),
-    ("viscous_damper", &[("c", None)]),
-    ("cubic_spring", &[("k1", None), ("k3", None)]),
+/// The built-in laws.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum LawKind {
+    Linear,
+    Damper,
+    Cubic,
+    Hertz,
+    Friction,
+}
+
+/// The laws, their kinds and their parameters (in the order [`Described::law`] reads them).
+const LAWS: &[(&str, LawKind, LawParameters)] = &[
+    (
+        "linear_spring",
+        LawKind::Linear,
+        &[("k", None), ("x0", Some(0.0))],
+    ),
+    ("viscous_damper", LawKind::Damper, &[("c", None)]),
+    (
+        "cubic_spring",
+        LawKind::Cubic,
+        &[("k1", None), ("k3", None)],
+    ),
     (
         "hertz",
+        LawKind::Hertz,
         &[
             ("position", None),
             ("k", None),
@@ -188,8 +209,15 @@ const LAWS: &[(&str, LawParameters)] = &[
             ("n3", Some(1.0)),
         ],
     ),
-    ("dry_friction", &[("t", None), ("eps", None)]),
+    (
+        "dry_friction",
+        LawKind::Friction,
+        &[("t", None), ("eps", None)],
+    ),
 ];
+
+/// The most parameters of a law (the Hertz stop's).
+const MAX_LAW_PARAMETERS: usize = 6;
 
 /// The law's parameter named `name` by its constructor, as the spec names it.
 fn spec_name(law: &str, name: &'static str) -> &'static str {
@@ -331,9 +359,87 @@ impl std::fmt::Display for BuildError {
 pub(crate) struct Described {
     masses: Vec<SpecValue>,
     elements: Vec<ElementSpec>,
+    /// The elements' laws, resolved once.
+    laws: Vec<ResolvedLaw>,
     loads: Vec<LoadSpec>,
     surfaces: Vec<SurfaceSpec>,
     params: Vec<ParameterDef>,
+}
+
+/// A number of the description resolved once against the system's parameters: a number,
+/// or the index of a parameter in a point's values (negated: `"-name"`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Resolved {
+    Number(f64),
+    Parameter { index: usize, negated: bool },
+}
+
+impl Resolved {
+    /// `v` against `params` (a name that is not among them: an index beyond a point's
+    /// values, whose value is NaN).
+    fn new(v: &SpecValue, params: &[ParameterDef]) -> Self {
+        match v {
+            SpecValue::Number(x) => Self::Number(*x),
+            SpecValue::Parameter(name) => {
+                let (negated, name) = match name.strip_prefix('-') {
+                    Some(name) => (true, name),
+                    None => (false, name.as_str()),
+                };
+                let index = params
+                    .iter()
+                    .position(|d| d.name == name)
+                    .unwrap_or(usize::MAX);
+                Self::Parameter { index, negated }
+            }
+        }
+    }
+
+    /// The value at `p`.
+    fn at(self, p: &ParameterPoint) -> f64 {
+        match self {
+            Self::Number(x) => x,
+            Self::Parameter {
+                index,
+                negated: false,
+            } => p.value(index),
+            Self::Parameter {
+                index,
+                negated: true,
+            } => -p.value(index),
+        }
+    }
+}
+
+/// An element's law resolved once: its kind, its side (a Hertz stop's) and its parameters
+/// in the order of [`LAWS`] (each the value given, or the default; NaN beyond the law's).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct ResolvedLaw {
+    kind: LawKind,
+    side: Side,
+    values: [Resolved; MAX_LAW_PARAMETERS],
+}
+
+impl ResolvedLaw {
+    /// The law of `e` (checked: a known law; `None` otherwise) against `params`.
+    fn new(e: &ElementSpec, params: &[ParameterDef]) -> Option<Self> {
+        let (_, kind, list) = LAWS.iter().find(|(l, _, _)| *l == e.law)?;
+        let mut values = [Resolved::Number(f64::NAN); MAX_LAW_PARAMETERS];
+        for (slot, (name, default)) in values.iter_mut().zip(list.iter()) {
+            *slot = match e.parameters.get(*name) {
+                Some(v) => Resolved::new(v, params),
+                None => Resolved::Number(default.unwrap_or(f64::NAN)),
+            };
+        }
+        let side = match e.side.as_deref() {
+            Some("lower") => Side::Lower,
+            _ => Side::Upper,
+        };
+        Some(Self {
+            kind: *kind,
+            side,
+            values,
+        })
+    }
 }
 
 impl Described {
@@ -368,12 +474,27 @@ impl Described {
             }
         }
         check_surfaces(d.surfaces, n, &mut names)?;
+        let params = names.definitions();
+        let laws = d
+            .elements
+            .iter()
+            .enumerate()
+            .map(|(i, e)| {
+                ResolvedLaw::new(e, &params).ok_or_else(|| {
+                    invalid(
+                        format!("system.elements[{i}].law"),
+                        format!("unknown law {:?}", e.law),
+                    )
+                })
+            })
+            .collect::<Result<Vec<_>, StudyError>>()?;
         Ok(Self {
             masses: d.masses.to_vec(),
             elements: d.elements.to_vec(),
+            laws,
             loads: d.loads.to_vec(),
             surfaces: d.surfaces.to_vec(),
-            params: names.definitions(),
+            params,
         })
     }
 
@@ -381,29 +502,28 @@ impl Described {
     fn model<const N: usize>(&self, p: &ParameterPoint) -> Result<Model<N>, BuildError> {
         let mut masses = [0.0; N];
         for (k, (m, v)) in masses.iter_mut().zip(&self.masses).enumerate() {
-            let field = format!("system.masses[{k}]");
-            *m = value(p, v);
+            *m = self.value(p, v);
             if !(m.is_finite() && *m > 0.0) {
                 return Err(build_error(
-                    field,
+                    format!("system.masses[{k}]"),
                     v,
                     format!("must be finite and > 0 (got {m})"),
                 ));
             }
         }
         let mut elements = Vec::with_capacity(self.elements.len());
-        for (i, e) in self.elements.iter().enumerate() {
-            let f = format!("system.elements[{i}]");
-            let c = coordinate::<N>(&f, e.dof, e.between)?;
-            elements.push(Element::new(c, self.law(p, &f, e)?));
+        for (i, (e, law)) in self.elements.iter().zip(&self.laws).enumerate() {
+            let f = Item("system.elements", i);
+            let c = coordinate::<N>(f, e.dof, e.between.as_deref())?;
+            elements.push(Element::new(c, self.law(p, f, e, law)?));
         }
-        let omega = p.get("omega");
-        let factor = p.get("amplitude_factor");
+        let omega = p.value(OMEGA);
+        let factor = p.value(AMPLITUDE_FACTOR);
         let mut loads = Vec::with_capacity(self.loads.len());
         for (i, l) in self.loads.iter().enumerate() {
-            let f = format!("system.loads[{i}]");
-            let amplitude = value(p, &l.amplitude) * factor;
-            let phase = l.phase.as_ref().map_or(0.0, |v| value(p, v));
+            let f = Item("system.loads", i);
+            let amplitude = self.value(p, &l.amplitude) * factor;
+            let phase = l.phase.as_ref().map_or(0.0, |v| self.value(p, v));
             let h = Harmonic::new(amplitude, omega, std::f64::consts::FRAC_PI_2 + phase).map_err(
                 |e| {
                     let (name, v) = match e.name {
@@ -439,19 +559,14 @@ impl Described {
             .with_loads(DescribedLoads(loads)))
     }
 
-    /// The law of element `e` (field `f`) at `p`.
-    fn law(&self, p: &ParameterPoint, f: &str, e: &ElementSpec) -> Result<Law, BuildError> {
-        let get = |name: &str| -> f64 {
-            match e.parameters.get(name) {
-                Some(v) => value(p, v),
-                None => LAWS
-                    .iter()
-                    .find(|(l, _)| *l == e.law)
-                    .and_then(|(_, ps)| ps.iter().find(|(n, _)| *n == name))
-                    .and_then(|(_, d)| *d)
-                    .unwrap_or(f64::NAN),
-            }
-        };
+    /// The law of element `e` (field `f`; resolved: `law`) at `p`.
+    fn law(
+        &self,
+        p: &ParameterPoint,
+        f: Item,
+        e: &ElementSpec,
+        law: &ResolvedLaw,
+    ) -> Result<Law, BuildError> {
         let fail = |err: ParameterError| {
             let name = spec_name(&e.law, err.name);
             let message = format!("must be {} (got {})", err.requirement, err.value);
@@ -464,46 +579,49 @@ impl Described {
                 },
             }
         };
-        let law = match e.law.as_str() {
-            "linear_spring" => Law::Linear(
-                LinearSpring::new(get("k"))
-                    .and_then(|l| l.with_rest_position(get("x0")))
-                    .map_err(fail)?,
-            ),
-            "viscous_damper" => Law::Damper(ViscousDamper::new(get("c")).map_err(fail)?),
-            "cubic_spring" => Law::Cubic(CubicSpring::new(get("k1"), get("k3")).map_err(fail)?),
-            "hertz" => {
-                let side = match e.side.as_deref() {
-                    Some("lower") => Side::Lower,
-                    _ => Side::Upper,
-                };
-                Law::Hertz(
-                    HertzContact::new(get("position"), get("k"))
-                        .map(|h| h.with_side(side))
-                        .and_then(|h| h.with_stiffness_exponent(get("n1")))
-                        .and_then(|h| h.with_damping(get("b"), get("n2"), get("n3")))
+        // The values in the order of the law's parameters in `LAWS`.
+        let v = law.values.map(|x| x.at(p));
+        Ok(match law.kind {
+            LawKind::Linear => {
+                let [k, x0, ..] = v;
+                Law::Linear(
+                    LinearSpring::new(k)
+                        .and_then(|l| l.with_rest_position(x0))
                         .map_err(fail)?,
                 )
             }
-            "dry_friction" => Law::Friction(DryFriction::sqrt(get("t"), get("eps")).map_err(fail)?),
-            other => {
-                return Err(BuildError {
-                    field: format!("{f}.law"),
-                    message: format!("unknown law {other:?}"),
-                    parameter: None,
-                });
+            LawKind::Damper => {
+                let [c, ..] = v;
+                Law::Damper(ViscousDamper::new(c).map_err(fail)?)
             }
-        };
-        Ok(law)
+            LawKind::Cubic => {
+                let [k1, k3, ..] = v;
+                Law::Cubic(CubicSpring::new(k1, k3).map_err(fail)?)
+            }
+            LawKind::Hertz => {
+                let [position, k, n1, b, n2, n3] = v;
+                Law::Hertz(
+                    HertzContact::new(position, k)
+                        .map(|h| h.with_side(law.side))
+                        .and_then(|h| h.with_stiffness_exponent(n1))
+                        .and_then(|h| h.with_damping(b, n2, n3))
+                        .map_err(fail)?,
+                )
+            }
+            LawKind::Friction => {
+                let [t, eps, ..] = v;
+                Law::Friction(DryFriction::sqrt(t, eps).map_err(fail)?)
+            }
+        })
     }
 
     /// The surfaces at `p`.
     fn gaps<const N: usize>(&self, p: &ParameterPoint) -> Result<Vec<Gap<f64, N>>, BuildError> {
         let mut gaps = Vec::with_capacity(self.surfaces.len());
         for (i, s) in self.surfaces.iter().enumerate() {
-            let f = format!("system.surfaces[{i}]");
-            let c = coordinate::<N>(&f, s.dof, s.between)?;
-            let position = value(p, &s.position);
+            let f = Item("system.surfaces", i);
+            let c = coordinate::<N>(f, s.dof, s.between.as_deref())?;
+            let position = self.value(p, &s.position);
             let c = c.with_offset(-position).map_err(|_| {
                 build_error(
                     format!("{f}.position"),
@@ -542,7 +660,7 @@ impl Described {
                 message: "internal: no surface".into(),
                 parameter: None,
             })?;
-        let r = value(p, e);
+        let r = self.value(p, e);
         NewtonImpact::new(gap, r, model.mass_matrix())
             .map(Some)
             .map_err(|err| {
@@ -559,7 +677,7 @@ impl Described {
         let model = self.model::<N>(p)?;
         self.gaps::<N>(p)?;
         self.rigid::<N>(p, &model)?;
-        let omega = p.get("omega");
+        let omega = p.value(OMEGA);
         if !(omega.is_finite() && omega > 0.0) {
             return Err(BuildError {
                 field: "system.parameters.omega".into(),
@@ -596,7 +714,7 @@ impl Described {
     {
         let e = |e: BuildError| e.to_string();
         let model = self.model::<N>(p).map_err(e)?;
-        let period = std::f64::consts::TAU / p.get("omega");
+        let period = std::f64::consts::TAU / p.value(OMEGA);
         match self.rigid::<N>(p, &model).map_err(e)? {
             Some(impact) => scalar::run_rigid::<N, M, _, _, _>(s, model, impact, period, y0),
             None => {
@@ -607,14 +725,26 @@ impl Described {
     }
 }
 
-/// The value of `v` at `p` (`"-name"`: the parameter's negative).
-fn value(p: &ParameterPoint, v: &SpecValue) -> f64 {
-    match v {
-        SpecValue::Number(x) => *x,
-        SpecValue::Parameter(name) => match name.strip_prefix('-') {
-            Some(name) => -p.get(name),
-            None => p.get(name),
-        },
+impl Described {
+    /// The value of `v` at `p` (`"-name"`: the parameter's negative).
+    fn value(&self, p: &ParameterPoint, v: &SpecValue) -> f64 {
+        Resolved::new(v, &self.params).at(p)
+    }
+}
+
+/// The index of `omega` in a point's values ([`ParameterNames::definitions`]).
+const OMEGA: usize = 0;
+/// The index of `amplitude_factor` in a point's values.
+const AMPLITUDE_FACTOR: usize = 1;
+
+/// The field of item `index` of a list of the description (`system.elements[2]`), formatted
+/// only where an error names it.
+#[derive(Debug, Clone, Copy)]
+struct Item(&'static str, usize);
+
+impl std::fmt::Display for Item {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}[{}]", self.0, self.1)
     }
 }
 
@@ -651,8 +781,8 @@ impl ParameterNames {
         }
     }
 
-    /// The system's parameters: `omega` (required), `amplitude_factor` (default 1), then
-    /// each name noted (required).
+    /// The system's parameters: `omega` (required; index [`OMEGA`]), `amplitude_factor`
+    /// (default 1; index [`AMPLITUDE_FACTOR`]), then each name noted (required).
     fn definitions(self) -> Vec<ParameterDef> {
         let mut params = vec![
             ParameterDef::required("omega"),
@@ -671,14 +801,14 @@ fn check_element(
     n: usize,
     names: &mut ParameterNames,
 ) -> Result<(), StudyError> {
-    let Some((_, params)) = LAWS.iter().find(|(l, _)| *l == e.law) else {
-        let known: Vec<&str> = LAWS.iter().map(|(l, _)| *l).collect();
+    let Some((_, _, params)) = LAWS.iter().find(|(l, _, _)| *l == e.law) else {
+        let known: Vec<&str> = LAWS.iter().map(|(l, _, _)| *l).collect();
         return Err(invalid(
             format!("{f}.law"),
             format!("unknown law {:?}; known: {}", e.law, known.join(", ")),
         ));
     };
-    check_coordinate(f, e.dof, e.between, n)?;
+    check_coordinate(f, e.dof, e.between.as_deref(), n)?;
     check_side(&format!("{f}.side"), e.side.as_deref())?;
     if e.side.is_some() && e.law != "hertz" {
         return Err(invalid(
@@ -741,7 +871,7 @@ fn check_surfaces(
     }
     for (i, s) in surfaces.iter().enumerate() {
         let f = format!("system.surfaces[{i}]");
-        check_coordinate(&f, s.dof, s.between, n)?;
+        check_coordinate(&f, s.dof, s.between.as_deref(), n)?;
         check_side(&format!("{f}.side"), s.side.as_deref())?;
         names.note(format!("{f}.position"), &s.position)?;
         if let Some(e) = &s.restitution {
@@ -774,11 +904,11 @@ fn build_error(field: String, v: &SpecValue, message: String) -> BuildError {
     }
 }
 
-/// Exactly one of `dof` and `between`, within the `n` degrees of freedom.
+/// Exactly one of `dof` and `between` (a pair), within the `n` degrees of freedom.
 fn check_coordinate(
     f: &str,
     dof: Option<usize>,
-    between: Option<[usize; 2]>,
+    between: Option<&[usize]>,
     n: usize,
 ) -> Result<(), StudyError> {
     match (dof, between) {
@@ -787,11 +917,20 @@ fn check_coordinate(
             format!("{f}.dof"),
             format!("{i} is not a degree of freedom of {n} (0 to {})", n - 1),
         )),
-        (None, Some([i, j])) if i < n && j < n && i != j => Ok(()),
-        (None, Some([i, j])) => Err(invalid(
+        (None, Some(&[i, j])) if i < n && j < n && i != j => Ok(()),
+        (None, Some(&[i, j])) => Err(invalid(
             format!("{f}.between"),
             format!(
                 "[{i}, {j}] must be two different degrees of freedom of {n} (0 to {})",
+                n - 1
+            ),
+        )),
+        (None, Some(other)) => Err(invalid(
+            format!("{f}.between"),
+            format!(
+                "{other:?} has length {}: expected a pair [i, j] of two different degrees of \
+                 freedom of {n} (0 to {})",
+                other.len(),
                 n - 1
             ),
         )),
@@ -819,14 +958,15 @@ fn check_side(field: &str, side: Option<&str>) -> Result<(), StudyError> {
 
 /// The coordinate `dof` or `between` (checked by [`check_coordinate`]).
 fn coordinate<const N: usize>(
-    f: &str,
+    f: Item,
     dof: Option<usize>,
-    between: Option<[usize; 2]>,
+    between: Option<&[usize]>,
 ) -> Result<Coordinate<f64, N>, BuildError> {
     let c = match (dof, between) {
         (Some(i), _) => Coordinate::dof(i),
-        (None, Some([i, j])) => Coordinate::relative(i, j),
-        (None, None) => Coordinate::dof(usize::MAX),
+        (None, Some(&[i, j])) => Coordinate::relative(i, j),
+        // Neither, or not a pair: refused by the check; an index out of range here.
+        (None, _) => Coordinate::dof(usize::MAX),
     };
     c.map_err(|e| BuildError {
         field: format!("{f}.{}", if dof.is_some() { "dof" } else { "between" }),
@@ -924,10 +1064,10 @@ impl Described {
             let e = |e: BuildError| e.to_string();
             let model = self.model::<N>(p).map_err(e)?;
             let gaps = self.gaps::<N>(p).map_err(e)?;
-            let period = std::f64::consts::TAU / p.get("omega");
+            let period = std::f64::consts::TAU / p.value(OMEGA);
             Ok((model, gaps, period, y0.clone()))
         });
-        super::lanes::run_smooth_batch::<M, M2, super::lanes::Eight, _, _>(s, starts.collect())
+        super::lanes::run_smooth_batch::<M, M2, _, _>(s, starts.collect())
     }
 }
 
@@ -973,7 +1113,8 @@ impl DescribedSystem {
         if let Some(d) = described
             .params
             .iter()
-            .find(|d| d.default.is_none() && point.get(&d.name).is_nan())
+            .zip(point.values())
+            .find_map(|(d, v)| (d.default.is_none() && v.is_nan()).then_some(d))
         {
             return Err(invalid(
                 format!("system.parameters.{}", d.name),
@@ -1007,14 +1148,19 @@ impl DescribedSystem {
     /// The value of parameter `name`, if the system has one.
     pub fn parameter(&self, name: &str) -> Option<f64> {
         self.described
-            .has_parameter(name)
-            .then(|| self.point.get(name))
+            .parameter_index(name)
+            .map(|i| self.point.value(i))
     }
 
     /// Every parameter and its value (`omega`, `amplitude_factor`, then the names the
     /// description uses), by name.
     pub fn parameters(&self) -> Vec<(String, f64)> {
-        self.point.iter().map(|(k, v)| (k.to_string(), v)).collect()
+        self.described
+            .params
+            .iter()
+            .zip(self.point.values())
+            .map(|(d, &v)| (d.name.clone(), v))
+            .collect()
     }
 
     /// The system with parameter `name` set to `value`.
@@ -1022,8 +1168,7 @@ impl DescribedSystem {
     /// # Errors
     /// [`StudyError::InvalidSpec`] for an unknown name or a value the model rejects.
     pub fn with_parameter(&self, name: &str, value: f64) -> Result<Self, StudyError> {
-        let mut point = self.point.clone();
-        point.set(name, value).map_err(|_| {
+        let index = self.described.parameter_index(name).ok_or_else(|| {
             invalid(
                 format!("system.parameters.{name}"),
                 format!(
@@ -1032,12 +1177,14 @@ impl DescribedSystem {
                 ),
             )
         })?;
+        let mut point = self.point.clone();
+        point.set(index, value);
         Self::at(self.described.clone(), point)
     }
 
     /// The forcing period `2π/ω`.
     pub fn period(&self) -> f64 {
-        std::f64::consts::TAU / self.point.get("omega")
+        std::f64::consts::TAU / self.point.value(OMEGA)
     }
 
     fn check_dofs<const N: usize>(&self) -> Result<(), StudyError> {
@@ -1098,9 +1245,99 @@ mod tests {
         assert_eq!(spec_name("linear_spring", "k"), "k");
         assert!(check_side("f", Some("sideways")).is_err());
         assert!(check_coordinate("f", Some(2), None, 2).is_err());
-        assert!(check_coordinate("f", None, Some([1, 1]), 2).is_err());
+        assert!(check_coordinate("f", None, Some(&[1, 1]), 2).is_err());
         assert!(check_coordinate("f", None, None, 2).is_err());
-        assert!(check_coordinate("f", None, Some([1, 0]), 2).is_ok());
+        assert!(check_coordinate("f", None, Some(&[1, 0]), 2).is_ok());
+        assert!(check_coordinate("f", None, Some(&[1, 0, 1]), 2).is_err());
+        assert!(check_coordinate("f", None, Some(&[1]), 2).is_err());
+    }
+
+    /// Each law reads its parameters in the order of [`LAWS`]: the laws of a description,
+    /// built at a point, are the laws built directly from the same numbers (the defaults
+    /// and a parameter's negative among them).
+    #[test]
+    fn each_law_reads_its_parameters_by_their_names() {
+        let el = |law: &str, ps: &[(&str, SpecValue)]| ElementSpec {
+            law: law.into(),
+            dof: Some(0),
+            between: None,
+            side: None,
+            parameters: ps.iter().map(|(n, v)| (n.to_string(), v.clone())).collect(),
+        };
+        let num = SpecValue::Number;
+        let elements = vec![
+            el("linear_spring", &[("k", num(3.0)), ("x0", num(0.25))]),
+            el("viscous_damper", &[("c", num(0.5))]),
+            el("cubic_spring", &[("k1", num(2.0)), ("k3", num(7.0))]),
+            ElementSpec {
+                side: Some("lower".into()),
+                ..el(
+                    "hertz",
+                    &[
+                        ("position", num(-0.1)),
+                        ("k", num(1e3)),
+                        ("n1", num(1.25)),
+                        ("b", num(0.3)),
+                        ("n2", num(1.75)),
+                        ("n3", num(0.5)),
+                    ],
+                )
+            },
+            el("dry_friction", &[("t", num(0.2)), ("eps", num(1e-3))]),
+            el(
+                "hertz",
+                &[
+                    ("position", SpecValue::Parameter("-gap".into())),
+                    ("k", num(1e4)),
+                ],
+            ),
+        ];
+        let masses = [num(1.0)];
+        let d = Described::new(&Description {
+            masses: &masses,
+            elements: &elements,
+            loads: &[],
+            surfaces: &[],
+        })
+        .unwrap();
+        let values = BTreeMap::from([("omega".to_string(), 1.0), ("gap".to_string(), 0.2)]);
+        let p = d.point(&values).unwrap();
+        let want = [
+            Law::Linear(
+                LinearSpring::new(3.0)
+                    .unwrap()
+                    .with_rest_position(0.25)
+                    .unwrap(),
+            ),
+            Law::Damper(ViscousDamper::new(0.5).unwrap()),
+            Law::Cubic(CubicSpring::new(2.0, 7.0).unwrap()),
+            Law::Hertz(
+                HertzContact::new(-0.1, 1e3)
+                    .unwrap()
+                    .with_side(Side::Lower)
+                    .with_stiffness_exponent(1.25)
+                    .unwrap()
+                    .with_damping(0.3, 1.75, 0.5)
+                    .unwrap(),
+            ),
+            Law::Friction(DryFriction::sqrt(0.2, 1e-3).unwrap()),
+            Law::Hertz(
+                HertzContact::new(-0.2, 1e4)
+                    .unwrap()
+                    .with_side(Side::Upper)
+                    .with_stiffness_exponent(1.5)
+                    .unwrap()
+                    .with_damping(0.0, 1.5, 1.0)
+                    .unwrap(),
+            ),
+        ];
+        for (i, (e, w)) in elements.iter().zip(want).enumerate() {
+            let got = d
+                .law(&p, Item("system.elements", i), e, &d.laws[i])
+                .unwrap();
+            assert_eq!(got, w, "{}", e.law);
+        }
+        assert!(LAWS.iter().all(|(_, _, ps)| ps.len() <= MAX_LAW_PARAMETERS));
     }
 
     #[test]

@@ -36,8 +36,8 @@
 //! task). A point's record depends only on the spec and `i` — every point starts from its
 //! own initial state, with its own stepper, no shared random state and no accumulation
 //! across points — so it is the same bits on any shard, in any thread. The merge
-//! ([`read_shards`]) refuses anything short of every shard `1..=N` of one spec hash with
-//! every point exactly once, and labels attractors in index order; the merged table is
+//! ([`read_shards`]) refuses anything short of every shard `1..=N` of one spec (each shard's
+//! embedded spec verified against its hash) with every point exactly once, and labels attractors in index order; the merged table is
 //! therefore bit-identical whether the study ran whole, in 3 shards or in 7, with any number
 //! of threads (`tests/study.rs` checks it).
 //!
@@ -150,7 +150,9 @@
 //! (atomic on POSIX file systems), the manifest last: a killed task leaves either no shard
 //! or a complete one, and a re-run of a failed or stale shard replaces it. A manifest whose
 //! CSV files do not hash to the recorded values (a task killed between the renames, a
-//! truncated copy) is reported at merge as corrupt.
+//! truncated copy) is reported at merge as corrupt; so is one whose embedded spec does not
+//! hash to its spec hash or differs from another shard's (the error names the field), and
+//! one that lists other data files than its shard's own.
 //!
 //! [`Merged::write`] writes the merged table (one row per point in index order), the kept
 //! section points, the attractor summary and the PNG figure ([`Merged::figure`]).

@@ -556,15 +556,21 @@ fn attach_sections(
 /// # Errors
 /// [`StudyError::MissingShards`] if no shard, or not every shard `1..=N`, is present
 /// (naming the missing ones); [`StudyError::Mismatch`] for shards of different specs, crate
-/// versions or shard counts; [`StudyError::Corrupt`] for an unreadable manifest, a file
-/// whose content hash differs from its manifest, or a shard whose points are not exactly
-/// its share (every index must appear exactly once).
+/// versions or shard counts; [`StudyError::Corrupt`] for an unreadable manifest, one whose
+/// embedded spec does not hash to its spec hash or differs from another shard's (naming the
+/// field), one that lists data files other than its shard's own, a file whose content hash
+/// differs from its manifest, or a shard whose points are not exactly its share (every index
+/// must appear exactly once).
 pub fn read_shards(dir: &Path) -> Result<(Study, Vec<PointRecord>), StudyError> {
     let ms = read_manifests(dir)?;
     check_consistent(&ms)?;
-    let (p0, m0) = &ms[0];
-    let study = embedded_study(p0, m0)?;
-    let n = m0.shards;
+    let (reference, study) = reference_study(&ms)?;
+    for (p, m) in &ms {
+        if p != reference {
+            check_same_spec(p, m, reference, &study)?;
+        }
+    }
+    let n = ms[0].1.shards;
     let by_index = index_shards(dir, ms, n)?;
     let total = study.points();
     let mut slots: Vec<Option<PointRecord>> = vec![None; total];
@@ -663,6 +669,110 @@ fn embedded_study(p: &Path, m: &ShardManifest) -> Result<Study, StudyError> {
     Ok(study)
 }
 
+/// The study of the first manifest of `ms` whose embedded spec hashes to its spec hash, and
+/// that manifest's path.
+///
+/// # Errors
+/// Where none does, the first manifest's: [`StudyError::Corrupt`] for its hash, or as
+/// [`Study::new`] for its spec.
+fn reference_study(ms: &[(PathBuf, ShardManifest)]) -> Result<(&Path, Study), StudyError> {
+    for (p, m) in ms {
+        if m.spec.hash()? == m.spec_hash {
+            return Ok((p, embedded_study(p, m)?));
+        }
+    }
+    let (p0, m0) = &ms[0];
+    Err(embedded_study(p0, m0)
+        .err()
+        .unwrap_or_else(|| corrupt(p0, "the embedded spec does not hash to its spec hash")))
+}
+
+/// The spec embedded in manifest `m` (at `p`) against `study`, the spec of the manifest at
+/// `p0`: it must hash to its manifest's spec hash and be the same spec.
+///
+/// # Errors
+/// [`StudyError::Corrupt`] naming the file `p`, its hash if it differs from the manifest's,
+/// and the first field where the spec differs.
+fn check_same_spec(
+    p: &Path,
+    m: &ShardManifest,
+    p0: &Path,
+    study: &Study,
+) -> Result<(), StudyError> {
+    if m.spec.canonical()? == study.spec().canonical()? {
+        return Ok(());
+    }
+    let hash = m.spec.hash()?;
+    let hashed = if hash == m.spec_hash {
+        String::new()
+    } else {
+        format!(
+            "the embedded spec hashes to {hash}, the manifest says {}; ",
+            m.spec_hash
+        )
+    };
+    let differs = match spec_difference(&m.spec, study.spec())? {
+        Some((field, here, there)) => format!("`{field}` is {here} here, {there} in"),
+        None => "the embedded spec differs from the one in".to_string(),
+    };
+    Err(corrupt(
+        p,
+        format!(
+            "{hashed}{differs} {} (the manifest was edited, or the shards are of different \
+             studies): re-run shard {}/{}",
+            p0.display(),
+            m.shard,
+            m.shards
+        ),
+    ))
+}
+
+/// The first field where specs `a` and `b` differ (as `grid.x.points`,
+/// `system.masses[1]`), with its value in each (JSON; `absent` where a spec has none).
+///
+/// # Errors
+/// [`StudyError::Io`] if a spec cannot be serialized.
+fn spec_difference(
+    a: &StudySpec,
+    b: &StudySpec,
+) -> Result<Option<(String, String, String)>, StudyError> {
+    let json = |s: &StudySpec| serde_json::to_value(s).map_err(|e| StudyError::Io(e.to_string()));
+    Ok(json_difference(String::new(), &json(a)?, &json(b)?))
+}
+
+/// The first path below `path` where `a` and `b` differ, with the two values there.
+fn json_difference(
+    path: String,
+    a: &serde_json::Value,
+    b: &serde_json::Value,
+) -> Option<(String, String, String)> {
+    use serde_json::Value;
+    let show = |v: Option<&Value>| v.map_or("absent".to_string(), Value::to_string);
+    match (a, b) {
+        (Value::Object(x), Value::Object(y)) => {
+            let keys: std::collections::BTreeSet<&String> = x.keys().chain(y.keys()).collect();
+            keys.into_iter().find_map(|k| {
+                let at = if path.is_empty() {
+                    k.clone()
+                } else {
+                    format!("{path}.{k}")
+                };
+                match (x.get(k), y.get(k)) {
+                    (Some(u), Some(v)) => json_difference(at, u, v),
+                    (u, v) => Some((at, show(u), show(v))),
+                }
+            })
+        }
+        (Value::Array(x), Value::Array(y)) if x.len() == y.len() => x
+            .iter()
+            .zip(y)
+            .enumerate()
+            .find_map(|(k, (u, v))| json_difference(format!("{path}[{k}]"), u, v)),
+        _ if a == b => None,
+        _ => Some((path, a.to_string(), b.to_string())),
+    }
+}
+
 /// The manifests by shard index, each in the file named after its shard; every shard
 /// `1..=n` must be present.
 fn index_shards(
@@ -680,6 +790,7 @@ fn index_shards(
                 format!("describes shard {shard}, file name differs"),
             ));
         }
+        check_listed_files(&p, &m, shard)?;
         by_index.insert(m.shard, (p, m));
     }
     let missing: Vec<String> = (1..=n)
@@ -695,6 +806,34 @@ fn index_shards(
         )));
     }
     Ok(by_index)
+}
+
+/// The data files manifest `m` (at `p`) lists: its shard's own, `STEM.csv` and
+/// `STEM.sections.csv` beside it, as [`write_shard`] names them.
+///
+/// # Errors
+/// [`StudyError::Corrupt`] naming the manifest, the key and the file it lists.
+fn check_listed_files(p: &Path, m: &ShardManifest, shard: Shard) -> Result<(), StudyError> {
+    let stem = shard.stem();
+    for (key, listed, expected) in [
+        ("points_file", &m.points_file, format!("{stem}.csv")),
+        (
+            "sections_file",
+            &m.sections_file,
+            format!("{stem}.sections.csv"),
+        ),
+    ] {
+        if *listed != expected {
+            return Err(corrupt(
+                p,
+                format!(
+                    "{key} is {listed:?}; the files of shard {shard} are {stem}.csv and \
+                     {stem}.sections.csv beside its manifest"
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Reads the points of `shard` (manifest `m` at `p`) into their `slots`, after checking

@@ -392,9 +392,17 @@ impl StudySpec {
     /// wrong type (the message names the key); [`StudyError::InvalidSpec`] naming the field
     /// that fails validation.
     pub fn from_toml(text: &str) -> Result<Self, StudyError> {
-        let spec: StudySpec = toml::from_str(text).map_err(|e| StudyError::Toml(e.to_string()))?;
+        let spec = Self::parse(text)?;
         spec.validate()?;
         Ok(spec)
+    }
+
+    /// Reads a spec from TOML text without validating it.
+    ///
+    /// # Errors
+    /// [`StudyError::Toml`] as [`from_toml`](Self::from_toml).
+    fn parse(text: &str) -> Result<Self, StudyError> {
+        toml::from_str(text).map_err(|e| StudyError::Toml(e.to_string()))
     }
 
     /// Checks every field; the error names the first invalid one.
@@ -409,18 +417,23 @@ impl StudySpec {
     fn checked(&self) -> Result<Arc<dyn StudySystem>, StudyError> {
         self.validate_name()?;
         let system = catalogue::system(&self.system.model, &self.system.description())?;
-        let sys = &*system;
+        self.validate_with(&*system)?;
+        Ok(system)
+    }
+
+    /// Checks every field but the name and the model against `sys`, the spec's system.
+    fn validate_with(&self, sys: &dyn StudySystem) -> Result<(), StudyError> {
         self.validate_system(sys)?;
         let axes = self.axes();
         self.validate_grid(sys, &axes)?;
+        let axes = self.resolve(sys, &axes)?;
         self.validate_fixed(sys, &axes)?;
         self.validate_initial(sys)?;
         self.validate_integration(sys)?;
         self.validate_periods()?;
         self.validate_record()?;
         self.validate_attractors(sys)?;
-        self.validate_axis_models(sys, &axes)?;
-        Ok(system)
+        self.validate_axis_models(sys, &axes)
     }
 
     /// The number of grid points.
@@ -702,21 +715,40 @@ impl StudySpec {
         Ok(())
     }
 
+    /// The axes with their targets, resolved once (the names are known: checked by
+    /// [`validate_grid`](Self::validate_grid)).
+    ///
+    /// # Errors
+    /// As [`AxisTarget::of`].
+    fn resolve<'a>(
+        &self,
+        system: &dyn StudySystem,
+        axes: &[(&'static str, &'a Axis)],
+    ) -> Result<Vec<ResolvedAxis<'a>>, StudyError> {
+        axes.iter()
+            .map(|&(field, axis)| {
+                Ok(ResolvedAxis {
+                    field,
+                    axis,
+                    target: AxisTarget::of(system, field, &axis.parameter)?,
+                    required: self.unset_required(system, &axis.parameter),
+                })
+            })
+            .collect()
+    }
+
     /// The values the spec fixes, at the base point (the fixed parameters, the defaults,
     /// and the axis starts of parameters without a default), naming the field at fault.
     fn validate_fixed(
         &self,
         system: &dyn StudySystem,
-        axes: &[(&str, &Axis)],
+        axes: &[ResolvedAxis<'_>],
     ) -> Result<(), StudyError> {
         let mut p = system.point(&self.system.parameters)?;
-        let mut y0 = self.initial.state.clone();
-        for (_, b) in axes {
-            if self.unset_required(system, &b.parameter) {
-                apply_axis(system, &mut p, &mut y0, &b.parameter, b.start);
-            }
+        for b in axes.iter().filter(|b| b.required) {
+            b.set(&mut p, b.axis.start);
         }
-        system.check_fixed(&p, &|name| axes.iter().any(|(_, a)| a.parameter == name))
+        system.check_fixed(&p, &|name| axes.iter().any(|a| a.axis.parameter == name))
     }
 
     /// The axes of parameters without a default take their start while the other axis is
@@ -725,34 +757,30 @@ impl StudySpec {
     fn blame_axis_start(
         &self,
         system: &dyn StudySystem,
-        axes: &[(&str, &Axis)],
+        axes: &[ResolvedAxis<'_>],
         set: &ParameterPoint,
     ) -> Result<(), StudyError> {
-        let required: Vec<&(&str, &Axis)> = axes
-            .iter()
-            .filter(|(_, b)| self.unset_required(system, &b.parameter))
-            .collect();
         let mut base = set.clone();
-        let mut y0 = self.initial.state.clone();
-        for (_, b) in &required {
-            apply_axis(system, &mut base, &mut y0, &b.parameter, b.start);
+        for b in axes.iter().filter(|b| b.required) {
+            b.set(&mut base, b.axis.start);
         }
         let Err(e) = system.check(&base) else {
             return Ok(());
         };
-        for (field, b) in required {
-            let frees = (1..b.points).any(|k| {
-                let mut p = base.clone();
-                apply_axis(system, &mut p, &mut y0, &b.parameter, b.value(k));
+        for b in axes.iter().filter(|b| b.required) {
+            // Each value of this axis on the base point (one parameter set in turn).
+            let mut p = base.clone();
+            let frees = (1..b.axis.points).any(|k| {
+                b.set(&mut p, b.axis.value(k));
                 system.check(&p).is_ok()
             });
             if frees {
                 return Err(invalid(
-                    field.to_string(),
+                    b.field,
                     format!(
                         "value {v} ({} = {v}) gives an invalid model: {e}",
-                        b.parameter,
-                        v = b.start
+                        b.axis.parameter,
+                        v = b.axis.start
                     ),
                 ));
             }
@@ -763,47 +791,72 @@ impl StudySpec {
     /// Every axis value must give a valid model, with the other axis at the base value
     /// (the fixed parameters or the model's default), so that an error names the axis
     /// at fault; a parameter without a default (the paper's `omega`) takes its axis start.
+    /// The point is built once per axis and each value sets its one parameter; the values
+    /// of an initial-condition axis leave the model as it is, which is checked once.
     fn validate_axis_models(
         &self,
         system: &dyn StudySystem,
-        axes: &[(&str, &Axis)],
+        axes: &[ResolvedAxis<'_>],
     ) -> Result<(), StudyError> {
         let set = system.point(&self.system.parameters)?;
         self.blame_axis_start(system, axes, &set)?;
-        for (field, a) in axes {
-            for k in 0..a.points {
-                let v = a.value(k);
+        for a in axes {
+            let mut p = set.clone();
+            for b in axes {
+                if b.axis.parameter != a.axis.parameter && b.required {
+                    b.set(&mut p, b.axis.start);
+                }
+            }
+            let mut checked = false;
+            let axis = a.axis;
+            for k in 0..axis.points {
+                let v = axis.value(k);
                 if !v.is_finite() {
                     return Err(invalid(
-                        field.to_string(),
+                        a.field,
                         format!(
                             "value {k} of {} ({} from {} to {} in {} points) is {v}: every \
                              axis value must be finite",
-                            a.parameter, a.parameter, a.start, a.end, a.points
+                            axis.parameter, axis.parameter, axis.start, axis.end, axis.points
                         ),
                     ));
                 }
-                let mut p = set.clone();
-                let mut y0 = self.initial.state.clone();
-                for (_, b) in axes {
-                    if b.parameter == a.parameter {
-                        apply_axis(system, &mut p, &mut y0, &b.parameter, v);
-                    } else if self.unset_required(system, &b.parameter) {
-                        apply_axis(system, &mut p, &mut y0, &b.parameter, b.start);
-                    }
+                match a.target {
+                    AxisTarget::Parameter(i) => p.set(i, v),
+                    AxisTarget::Initial(_) if checked => continue,
+                    AxisTarget::Initial(_) => checked = true,
                 }
                 system.check(&p).map_err(|e| {
                     invalid(
-                        field.to_string(),
+                        a.field,
                         format!(
                             "value {v} ({} = {v}) gives an invalid model: {e}",
-                            a.parameter
+                            axis.parameter
                         ),
                     )
                 })?;
             }
         }
         Ok(())
+    }
+}
+
+/// An axis of the grid with its field (`grid.x`), where its values go, and whether it is
+/// the axis of a parameter without a default that the spec does not fix.
+struct ResolvedAxis<'a> {
+    field: &'static str,
+    axis: &'a Axis,
+    target: AxisTarget,
+    required: bool,
+}
+
+impl ResolvedAxis<'_> {
+    /// Sets the axis value `v` in `p` (a value of an initial-condition axis sets no
+    /// parameter).
+    fn set(&self, p: &mut ParameterPoint, v: f64) {
+        if let AxisTarget::Parameter(i) = self.target {
+            p.set(i, v);
+        }
     }
 }
 
@@ -878,24 +931,54 @@ pub(crate) fn fnv1a(bytes: &[u8]) -> u64 {
     h
 }
 
-/// Sets an axis value: a model parameter or an initial-condition component (`y0` holds the
-/// given components, NaN for the others). Names are checked by the spec.
-pub(crate) fn apply_axis(
-    system: &dyn StudySystem,
-    p: &mut ParameterPoint,
-    y0: &mut Option<Vec<f64>>,
-    name: &str,
-    value: f64,
-) {
-    match system.initial_names().iter().position(|n| n == name) {
-        Some(k) => {
-            let s = y0.get_or_insert_with(|| vec![f64::NAN; system.dimension()]);
-            if let Some(c) = s.get_mut(k) {
-                *c = value;
-            }
+/// Where the values of an axis go: a parameter of the system or a component of the initial
+/// state, by index (the axis's name resolved once).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum AxisTarget {
+    /// The parameter of this index in a point's values.
+    Parameter(usize),
+    /// The initial-state component of this index.
+    Initial(usize),
+}
+
+impl AxisTarget {
+    /// The target of the axis `field` over `name`: an initial-condition component of
+    /// `system`, or else its parameter.
+    ///
+    /// # Errors
+    /// [`StudyError::InvalidSpec`] naming `FIELD.parameter` if `name` is neither.
+    fn of(system: &dyn StudySystem, field: &str, name: &str) -> Result<Self, StudyError> {
+        match system.initial_names().iter().position(|n| n == name) {
+            Some(k) => Ok(Self::Initial(k)),
+            None => system
+                .parameter_index(name)
+                .map(Self::Parameter)
+                .ok_or_else(|| {
+                    invalid(
+                        format!("{field}.parameter"),
+                        format!("unknown parameter {name:?} of model {:?}", system.name()),
+                    )
+                }),
         }
-        None => {
-            let _ = p.set(name, value);
+    }
+
+    /// Sets the axis value `value`: in `p`, or in `y0` (the given components of an initial
+    /// state of `dimension` components, NaN for the others).
+    fn apply(
+        self,
+        dimension: usize,
+        p: &mut ParameterPoint,
+        y0: &mut Option<Vec<f64>>,
+        value: f64,
+    ) {
+        match self {
+            Self::Parameter(i) => p.set(i, value),
+            Self::Initial(k) => {
+                let s = y0.get_or_insert_with(|| vec![f64::NAN; dimension]);
+                if let Some(c) = s.get_mut(k) {
+                    *c = value;
+                }
+            }
         }
     }
 }
@@ -906,6 +989,10 @@ pub struct Study {
     spec: StudySpec,
     hash: String,
     system: Arc<dyn StudySystem>,
+    /// The parameters of every point before the axes set theirs.
+    base: ParameterPoint,
+    /// Where the values of the axes go: `x`, then `y` if the grid has it.
+    targets: (AxisTarget, Option<AxisTarget>),
 }
 
 impl PartialEq for Study {
@@ -922,15 +1009,27 @@ impl Study {
     pub fn new(spec: StudySpec) -> Result<Self, StudyError> {
         let system = spec.checked()?;
         let hash = spec.hash()?;
-        Ok(Self { spec, hash, system })
+        let base = system.point(&spec.system.parameters)?;
+        let x = AxisTarget::of(&*system, "grid.x", &spec.grid.x.parameter)?;
+        let y = match &spec.grid.y {
+            Some(a) => Some(AxisTarget::of(&*system, "grid.y", &a.parameter)?),
+            None => None,
+        };
+        Ok(Self {
+            spec,
+            hash,
+            system,
+            base,
+            targets: (x, y),
+        })
     }
 
-    /// Reads a study from TOML text.
+    /// Reads a study from TOML text (validated once, by [`Study::new`]).
     ///
     /// # Errors
     /// As [`StudySpec::from_toml`].
     pub fn from_toml(text: &str) -> Result<Self, StudyError> {
-        Self::new(StudySpec::from_toml(text)?)
+        Self::new(StudySpec::parse(text)?)
     }
 
     /// Reads a study from a TOML file.
@@ -983,6 +1082,21 @@ impl Study {
         (index % nx, index / nx)
     }
 
+    /// The parameters of point `index` and its given initial components (`None`, or NaN
+    /// where not given: the rest state's).
+    pub(crate) fn point(&self, index: usize) -> (ParameterPoint, Option<Vec<f64>>) {
+        let mut p = self.base.clone();
+        let mut y0 = self.spec.initial.state.clone();
+        let (xv, yv) = self.values(index);
+        let dimension = self.system.dimension();
+        let (x, y) = self.targets;
+        x.apply(dimension, &mut p, &mut y0, xv);
+        if let Some(y) = y {
+            y.apply(dimension, &mut p, &mut y0, yv);
+        }
+        (p, y0)
+    }
+
     /// Axis values `(x, y)` of point `index` (`y` is NaN for a one-axis grid).
     pub fn values(&self, index: usize) -> (f64, f64) {
         let (ix, iy) = self.coordinates(index);
@@ -995,6 +1109,9 @@ impl Study {
 
 #[cfg(test)]
 mod tests {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+
+    use super::super::system::{ParameterDef, PointRun, RunSettings, state_names};
     use super::*;
 
     #[test]
@@ -1036,6 +1153,106 @@ mod tests {
         assert!((0..7).all(|k| b.value(k).is_finite()));
         assert!((0..6).all(|k| b.value(k) < b.value(k + 1)));
         assert_eq!((b.value(0), b.value(6)), (-f64::MAX, f64::MAX));
+    }
+
+    /// A system that counts its model checks and the look-ups of its parameter and state
+    /// names, and runs nothing.
+    #[derive(Debug)]
+    struct Counting {
+        params: Vec<ParameterDef>,
+        checks: AtomicUsize,
+        lookups: AtomicUsize,
+    }
+
+    impl Counting {
+        fn new() -> Self {
+            Self {
+                params: vec![ParameterDef::new("omega", 1.0), ParameterDef::new("k", 1.0)],
+                checks: 0.into(),
+                lookups: 0.into(),
+            }
+        }
+        fn count(c: &AtomicUsize) -> usize {
+            c.load(Ordering::Relaxed)
+        }
+        fn add(c: &AtomicUsize) {
+            c.fetch_add(1, Ordering::Relaxed);
+        }
+    }
+
+    impl StudySystem for Counting {
+        fn name(&self) -> &str {
+            "counting"
+        }
+        fn parameters(&self) -> &[ParameterDef] {
+            Self::add(&self.lookups);
+            &self.params
+        }
+        fn dimension(&self) -> usize {
+            2
+        }
+        fn surfaces(&self) -> usize {
+            0
+        }
+        fn scales(&self) -> Vec<f64> {
+            vec![1.0; 2]
+        }
+        fn atol_per_rtol(&self) -> Vec<f64> {
+            vec![1.0; 2]
+        }
+        fn d0(&self) -> f64 {
+            1e-6
+        }
+        fn check(&self, _p: &ParameterPoint) -> Result<(), String> {
+            Self::add(&self.checks);
+            Ok(())
+        }
+        fn rest_state(&self, _p: &ParameterPoint) -> Result<Vec<f64>, String> {
+            Ok(vec![0.0; 2])
+        }
+        fn run(
+            &self,
+            _p: &ParameterPoint,
+            _y0: &[f64],
+            _s: &RunSettings,
+        ) -> Result<PointRun, String> {
+            Err("not run".into())
+        }
+        fn state_names(&self) -> Vec<String> {
+            Self::add(&self.lookups);
+            state_names(2)
+        }
+    }
+
+    /// Issue 49: checking a spec looked up the axes' names, and copied the parameters, at
+    /// every axis value (30 s for 10⁷ points). The names are resolved once per axis: per
+    /// value of a parameter axis there is one model check and no look-up, and an
+    /// initial-condition axis, whose values leave the model as it is, checks it once.
+    #[test]
+    fn checking_a_spec_resolves_the_axes_once() {
+        let n = 10_000;
+        let text = format!(
+            r#"
+name = "count"
+[system]
+model = "counting"
+[grid]
+x = {{ parameter = "k", start = 1.0, end = 2.0, points = {n} }}
+y = {{ parameter = "x0", start = -1.0, end = 1.0, points = {n} }}
+[periods]
+transient = 10
+record = 10
+"#
+        );
+        let spec: StudySpec = toml::from_str(&text).unwrap();
+        let sys = Counting::new();
+        spec.validate_with(&sys).unwrap();
+        let (checks, lookups) = (Counting::count(&sys.checks), Counting::count(&sys.lookups));
+        assert!(
+            (n..n + 10).contains(&checks),
+            "{checks} model checks for {n} values of k and {n} of x0"
+        );
+        assert!(lookups < 100, "{lookups} look-ups of the names");
     }
 
     #[test]

@@ -37,35 +37,37 @@ impl ParameterDef {
     }
 }
 
-/// The values of every parameter of a system at one grid point (NaN for a parameter without
-/// a default that is not given).
+/// The values of every parameter of a system at one grid point, in the order of the
+/// system's [`parameters`](StudySystem::parameters) (NaN for a parameter without a default
+/// that is not given). Names are resolved to indices once
+/// ([`parameter_index`](StudySystem::parameter_index)), not at every point.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct ParameterPoint {
-    values: BTreeMap<String, f64>,
+    values: Vec<f64>,
 }
 
 impl ParameterPoint {
-    /// The value of `name` (NaN if the system has no such parameter).
-    pub fn get(&self, name: &str) -> f64 {
-        self.values.get(name).copied().unwrap_or(f64::NAN)
+    /// The value of parameter `index` (NaN beyond the system's parameters).
+    pub fn value(&self, index: usize) -> f64 {
+        self.values.get(index).copied().unwrap_or(f64::NAN)
     }
 
-    /// Every parameter's name and value, by name.
-    pub fn iter(&self) -> impl Iterator<Item = (&str, f64)> {
-        self.values.iter().map(|(k, &v)| (k.as_str(), v))
+    /// Every parameter's value, in the order of the system's parameters.
+    pub fn values(&self) -> &[f64] {
+        &self.values
     }
 
-    /// Sets parameter `name`.
-    ///
-    /// # Errors
-    /// The message names the parameter if the system has none of that name.
-    pub fn set(&mut self, name: &str, value: f64) -> Result<(), String> {
-        match self.values.get_mut(name) {
-            Some(v) => {
-                *v = value;
-                Ok(())
-            }
-            None => Err(format!("unknown parameter {name:?}")),
+    /// The values of a system of `K` parameters, in order; all NaN for a point of another
+    /// number of parameters (not a point of that system: every check then fails).
+    pub fn array<const K: usize>(&self) -> [f64; K] {
+        debug_assert_eq!(self.values.len(), K, "a point of another system");
+        self.values.as_slice().try_into().unwrap_or([f64::NAN; K])
+    }
+
+    /// Sets parameter `index` (nothing beyond the system's parameters).
+    pub fn set(&mut self, index: usize, value: f64) {
+        if let Some(v) = self.values.get_mut(index) {
+            *v = value;
         }
     }
 }
@@ -231,20 +233,29 @@ pub(crate) trait StudySystem: std::fmt::Debug + Send + Sync {
             values: self
                 .parameters()
                 .iter()
-                .map(|d| (d.name.clone(), d.default.unwrap_or(f64::NAN)))
+                .map(|d| d.default.unwrap_or(f64::NAN))
                 .collect(),
         };
         for (name, &v) in values {
-            p.set(name, v).map_err(|_| StudyError::InvalidSpec {
-                field: format!("system.parameters.{name}"),
-                message: format!(
-                    "unknown parameter of model {:?}; known: {}",
-                    self.name(),
-                    self.parameter_list()
-                ),
-            })?;
+            let index = self
+                .parameter_index(name)
+                .ok_or_else(|| StudyError::InvalidSpec {
+                    field: format!("system.parameters.{name}"),
+                    message: format!(
+                        "unknown parameter of model {:?}; known: {}",
+                        self.name(),
+                        self.parameter_list()
+                    ),
+                })?;
+            p.set(index, v);
         }
         Ok(p)
+    }
+
+    /// The index of parameter `name` in [`parameters`](Self::parameters) and in a point's
+    /// values.
+    fn parameter_index(&self, name: &str) -> Option<usize> {
+        self.parameters().iter().position(|d| d.name == name)
     }
 
     /// The parameter names, comma-separated.
@@ -258,7 +269,7 @@ pub(crate) trait StudySystem: std::fmt::Debug + Send + Sync {
 
     /// Whether `name` is a parameter.
     fn has_parameter(&self, name: &str) -> bool {
-        self.parameters().iter().any(|d| d.name == name)
+        self.parameter_index(name).is_some()
     }
 }
 

@@ -10,7 +10,7 @@ use super::{
 };
 use crate::LaneDynamics;
 use crate::drive::{Outcome, RunError};
-use crate::ensemble::{Ensemble, Lanes, MemberRun};
+use crate::ensemble::{Ensemble, MemberRun};
 use crate::event::{Direction, Event};
 use crate::sample::Surface;
 
@@ -140,14 +140,14 @@ pub struct LaneStart<D, const M: usize> {
 /// # Examples
 /// ```
 /// use nalgebra::SVector;
-/// use nonsmooth::ensemble::{Ensemble, F64x4};
+/// use nonsmooth::ensemble::Ensemble;
 /// use nonsmooth::event::Stop;
 /// use nonsmooth::integrate::Tolerances;
 /// use nonsmooth::sweep::{IndependentSweep, LaneStart, sweep_independent};
 /// use nonsmooth::systems::TwoDofImpact;
 ///
 /// let p = TwoDofImpact::default();
-/// let tol = Tolerances::new(1e-6, 1e-8)?;
+/// let tol = Tolerances::<f64, 4>::new(1e-6, 1e-8)?;
 /// let starts = [0.6, 0.7, 0.8]
 ///     .map(|w| -> nonsmooth::Result<_> {
 ///         Ok(LaneStart { param: w, system: p.model(w)?, period: TwoDofImpact::period(w), y0: SVector::zeros() })
@@ -157,7 +157,7 @@ pub struct LaneStart<D, const M: usize> {
 /// // State (q₁, q₂, q̇₁, q̇₂): impacts of the secondary mass on the stop q₂ = d.
 /// let stop = Stop { position: 1, velocity: 3, level: p.gap };
 /// let settings = IndependentSweep::new(20, 5)?;
-/// let points = sweep_independent::<F64x4, _, _, 4>(&Ensemble::new(tol)?, &settings, &starts, Some(stop))?;
+/// let points = sweep_independent(&Ensemble::new(tol)?, &settings, &starts, Some(stop))?;
 /// assert_eq!(points.len(), 3);
 /// assert_eq!(points[1].param, 0.7);
 /// # Ok::<(), nonsmooth::Error>(())
@@ -166,22 +166,19 @@ pub struct LaneStart<D, const M: usize> {
 /// # Errors
 /// [`SweepError`]: invalid settings or no starts; [`SweepError::Failed`] with the
 /// parameter of the first start (in order) whose run failed.
-pub fn sweep_independent<V, D, G, const M: usize>(
+pub fn sweep_independent<D, G, const M: usize>(
     ensemble: &Ensemble<(), M>,
     settings: &IndependentSweep,
     starts: &[LaneStart<D, M>],
     stop: Option<G>,
 ) -> Result<Vec<SweepPoint<M>>, SweepError>
 where
-    V: Lanes,
     D: LaneDynamics<M> + Clone,
     G: Surface<f64, M> + Clone,
 {
-    run_starts(ensemble, settings, starts, stop, |e, j, o| {
-        e.run::<V, _, _>(j, o)
-    })?
-    .into_iter()
-    .collect()
+    run_starts(ensemble, settings, starts, stop, |e, j, o| e.run(j, o))?
+        .into_iter()
+        .collect()
 }
 
 /// [`sweep_independent`] over the threads of the current rayon pool, `chunk` starts per
@@ -190,7 +187,7 @@ where
 /// # Errors
 /// As [`sweep_independent`]; [`SweepError::Failed`] (a parameter error) if `chunk == 0`.
 #[cfg(feature = "parallel")]
-pub fn sweep_independent_parallel<V, D, G, const M: usize>(
+pub fn sweep_independent_parallel<D, G, const M: usize>(
     ensemble: &Ensemble<(), M>,
     settings: &IndependentSweep,
     starts: &[LaneStart<D, M>],
@@ -198,12 +195,11 @@ pub fn sweep_independent_parallel<V, D, G, const M: usize>(
     chunk: usize,
 ) -> Result<Vec<SweepPoint<M>>, SweepError>
 where
-    V: Lanes,
     D: LaneDynamics<M> + Clone + Sync,
     G: Surface<f64, M> + Clone + Send + Sync,
 {
     run_starts(ensemble, settings, starts, stop, |e, j, o| {
-        e.run_parallel::<V, _, _>(j, o, chunk)
+        e.run_parallel(j, o, chunk)
     })?
     .into_iter()
     .collect()
@@ -218,20 +214,17 @@ where
 ///
 /// # Errors
 /// The outer error: [`SweepError`] for invalid settings or no starts.
-pub fn sweep_starts<V, D, G, const M: usize>(
+pub fn sweep_starts<D, G, const M: usize>(
     ensemble: &Ensemble<(), M>,
     settings: &IndependentSweep,
     starts: &[LaneStart<D, M>],
     stop: Option<G>,
 ) -> Result<Vec<Result<SweepPoint<M>, SweepError>>, SweepError>
 where
-    V: Lanes,
     D: LaneDynamics<M> + Clone,
     G: Surface<f64, M> + Clone,
 {
-    run_starts(ensemble, settings, starts, stop, |e, j, o| {
-        e.run::<V, _, _>(j, o)
-    })
+    run_starts(ensemble, settings, starts, stop, |e, j, o| e.run(j, o))
 }
 
 /// The lane runs of every start, the batch run by `run` (on the calling thread or over
