@@ -63,6 +63,9 @@ def vector(name: str, value: Any, n: Optional[int] = None) -> list[float]:
 
 def array(name: str, value: Any, max_len: int = MAX_OUTPUT) -> npt.NDArray[np.float64]:
     """A contiguous 1-D float array of finite values."""
+    if isinstance(value, np.ndarray) and value.size > max_len:
+        # Refused before the copy: a broadcast view can stand for more memory than exists.
+        raise ValueError(f"{name} has {value.size} values; at most {max_len}")
     try:
         a = np.ascontiguousarray(value, dtype=np.float64)
     except (TypeError, ValueError) as e:

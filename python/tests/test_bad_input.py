@@ -219,3 +219,88 @@ def test_run_failures_are_nonsmooth_errors() -> None:
         ns.study.run("/nonexistent/spec.toml", "/tmp/out")
     with pytest.raises(OSError):
         ns.load("/nonexistent/system.toml")
+
+
+@FAST
+@given(BAD_FLOATS, st.floats(max_value=0.0, allow_nan=False))
+def test_remaining_constructors_reject_bad_values(x: float, neg: float) -> None:
+    raises(lambda: ns.belt_friction(f0=x))
+    raises(lambda: ns.belt_friction(u=x))
+    raises(lambda: ns.belt_friction(omega=neg))
+    raises(lambda: ns.belt_friction(fk=neg))
+    raises(lambda: ns.duffing_ueda(omega=neg))
+    raises(lambda: ns.two_dof_impact(m2=neg))
+    raises(lambda: ns.two_dof_impact(0.7, k1=x))
+    raises(lambda: ns.bouncing_ball(e=x))
+    raises(lambda: ns.bouncing_ball(e=neg - 1.0))
+    raises(lambda: ns.belt_friction().with_parameters(f0=x))
+    raises(lambda: ns.relay_feedback().with_parameters(zeta=x))
+    raises(lambda: ns.paper(20.0, **{"not a parameter": 1.0}))
+    raises(lambda: ns.paper(20.0, m="heavy"))  # type: ignore[arg-type]
+    raises(lambda: ns.woodpecker(1.0))  # type: ignore[call-arg]
+
+
+@FAST
+@given(BAD_FLOATS, st.floats(max_value=0.0, allow_nan=False))
+def test_described_systems_reject_bad_parameters(x: float, neg: float) -> None:
+    base = {"model": "mechanical", "masses": ["m"], "parameters": {"omega": 1.0, "m": 1.0},
+            "elements": [{"law": "linear_spring", "dof": 0, "k": "k"}]}
+    s = ns.describe(base, k=1.0)
+    raises(lambda: s.with_parameters(m=x))
+    raises(lambda: s.with_parameters(m=neg))
+    raises(lambda: s.with_parameters(k=neg - 1.0))
+    raises(lambda: s.with_parameters(omega=neg))
+    raises(lambda: s.with_parameters(unknown=1.0))
+    raises(lambda: ns.describe(base, k=x))
+    raises(lambda: ns.describe(base))  # k has no value
+    raises(lambda: ns.sweep(s, "k", [neg - 1.0, 1.0]))
+    raises(lambda: ns.poincare(s, 5, surface=1))
+
+
+@FAST
+@given(st.text(max_size=40))
+def test_load_rejects_junk_files(text: str) -> None:
+    import os
+    import tempfile
+    fd, path = tempfile.mkstemp(suffix=".toml")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            f.write(text)
+        raises(lambda: ns.load(path))
+        raises(lambda: ns.load(path, omega=math.nan))
+    finally:
+        os.unlink(path)
+
+
+@FAST
+@given(st.text(max_size=30), JUNK)
+def test_study_entry_points_reject_bad_paths_and_shards(name: str, junk: Any) -> None:
+    import tempfile
+    with tempfile.TemporaryDirectory() as d:
+        raises(lambda: ns.study.run(f"{d}/{name}.toml", f"{d}/out"))
+        raises(lambda: ns.study.merge(f"{d}/{name}-missing"))
+        raises(lambda: ns.study.merge(d))  # no shards
+        raises(lambda: ns.study.run(f"{d}/x.toml", f"{d}/out", shard=junk))
+        raises(lambda: ns.study.run(f"{d}/x.toml", f"{d}/out", shard=(0, 1)))
+        raises(lambda: ns.study.run(f"{d}/x.toml", f"{d}/out", progress=junk))
+        spec = f"{d}/bad.toml"
+        with open(spec, "w", encoding="utf-8") as f:
+            f.write(f'name = "x"\n[system]\nmodel = "{name}_model"\n')
+        raises(lambda: ns.study.run(spec, f"{d}/out"))
+
+
+@FAST
+@given(HUGE)
+def test_huge_arrays_and_counts_of_the_other_entry_points(n: int) -> None:
+    raises(lambda: ns.ensemble(PAPER, transient=n))
+    raises(lambda: ns.ensemble(PAPER, max_period=n))
+    raises(lambda: ns.timestep(ns.bouncing_ball(), (0.0, 1.0), 1.0 / n))
+    raises(lambda: ns.timestep(ns.bouncing_ball(), (0.0, 1.0), 1e-3, max_records=n))
+    raises(lambda: ns.lyapunov(PAPER, 10, transient=n))
+    raises(lambda: ns.periodic_orbit(PAPER, max_iterations=n))
+    raises(lambda: ns.poincare(PAPER, 5, max_period=n, transient=n))
+    # An array larger than the limits, as a view (no memory behind it).
+    big = np.broadcast_to(np.float64(20.0), (min(n, 2**40),))
+    raises(lambda: ns.sweep(PAPER, "omega", big))
+    raises(lambda: ns.ensemble(PAPER, parameter="omega", values=big))
+    raises(lambda: ns.tsallis_q(big, 0.0, 1.0, 0.1))
