@@ -282,9 +282,9 @@ impl ForceLaw<f64> for Law {
     }
 }
 
-/// The elements of a described system.
+/// The elements of a described system (built by [`DescribedSystem::model`]).
 #[derive(Debug, Clone, PartialEq)]
-pub(crate) struct DescribedElements<const N: usize>(Vec<Element<f64, N, Law>>);
+pub struct DescribedElements<const N: usize>(Vec<Element<f64, N, Law>>);
 
 impl<const N: usize> Elements<f64, N> for DescribedElements<N> {
     #[inline]
@@ -306,9 +306,9 @@ impl<const N: usize> Elements<f64, N> for DescribedElements<N> {
     }
 }
 
-/// The loads of a described system.
+/// The loads of a described system (built by [`DescribedSystem::model`]).
 #[derive(Debug, Clone, PartialEq)]
-pub(crate) struct DescribedLoads<const N: usize>(Vec<Load<f64, N, Harmonic<f64>>>);
+pub struct DescribedLoads<const N: usize>(Vec<Load<f64, N, Harmonic<f64>>>);
 
 impl<const N: usize> Loads<f64, N> for DescribedLoads<N> {
     #[inline]
@@ -334,6 +334,10 @@ impl<const N: usize> Loads<f64, N> for DescribedLoads<N> {
 
 /// A model of `N` degrees of freedom built from a description.
 type Model<const N: usize> = Mechanical<f64, N, DescribedElements<N>, DescribedLoads<N>>;
+
+/// The [`Mechanical`] model of a described system of `N` degrees of freedom
+/// ([`DescribedSystem::model`]).
+pub type DescribedModel<const N: usize> = Model<N>;
 
 /// Why a described system could not be built at a point: the field, what is wrong, and the
 /// parameter the value came from (if it came from one).
@@ -1064,6 +1068,168 @@ impl Described {
             Ok((model, gaps, period, y0.clone()))
         });
         super::lanes::run_smooth_batch::<M, M2, _, _>(s, starts.collect())
+    }
+}
+
+/// A mechanical system described with the study files' schema (the `system` table with
+/// `model = "mechanical"`), at fixed parameter values: what a study builds at each grid
+/// point, for a caller that runs it with the crate's instruments (the Python package's
+/// described systems).
+///
+/// ```
+/// use nonsmooth::study::{DescribedSystem, SystemSpec};
+/// let spec: SystemSpec = toml::from_str(r#"
+///     model = "mechanical"
+///     masses = [1.0]
+///     parameters = { omega = 1.2 }
+///     elements = [{ law = "linear_spring", dof = 0, k = 1.0 }]
+///     loads = [{ dof = 0, amplitude = 0.1 }]
+/// "#).unwrap();
+/// let system = DescribedSystem::new(&spec)?;
+/// assert_eq!((system.dofs(), system.parameter("omega")), (1, Some(1.2)));
+/// let model = system.model::<1>()?;
+/// # let _ = model;
+/// # Ok::<(), nonsmooth::study::StudyError>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct DescribedSystem {
+    described: Described,
+    point: ParameterPoint,
+}
+
+impl DescribedSystem {
+    /// The system of description `d` with the parameter values `parameters` (the study's
+    /// `system` table; [`DescribedSystem::new`] reads it from a [`SystemSpec`](super::SystemSpec)).
+    pub(super) fn from_description(
+        d: &Description<'_>,
+        parameters: &BTreeMap<String, f64>,
+    ) -> Result<Self, StudyError> {
+        let described = Described::new(d)?;
+        let point = described.point(parameters)?;
+        Self::at(described, point)
+    }
+
+    fn at(described: Described, point: ParameterPoint) -> Result<Self, StudyError> {
+        if let Some(d) = described
+            .params
+            .iter()
+            .zip(point.values())
+            .find_map(|(d, v)| (d.default.is_none() && v.is_nan()).then_some(d))
+        {
+            return Err(invalid(
+                format!("system.parameters.{}", d.name),
+                "is missing: the description uses this parameter and it has no default",
+            ));
+        }
+        described
+            .build_check(&point)
+            .map_err(|e| invalid(e.field, e.message))?;
+        Ok(Self { described, point })
+    }
+
+    /// The number of degrees of freedom (masses); the state has twice as many components.
+    pub fn dofs(&self) -> usize {
+        self.described.masses.len()
+    }
+
+    /// The number of impact surfaces.
+    pub fn surfaces(&self) -> usize {
+        self.described.surfaces.len()
+    }
+
+    /// Whether the (only) surface is a rigid stop with Newton's impact law.
+    pub fn is_rigid(&self) -> bool {
+        self.described
+            .surfaces
+            .iter()
+            .any(|s| s.restitution.is_some())
+    }
+
+    /// The value of parameter `name`, if the system has one.
+    pub fn parameter(&self, name: &str) -> Option<f64> {
+        self.described
+            .parameter_index(name)
+            .map(|i| self.point.value(i))
+    }
+
+    /// Every parameter and its value (`omega`, `amplitude_factor`, then the names the
+    /// description uses), by name.
+    pub fn parameters(&self) -> Vec<(String, f64)> {
+        self.described
+            .params
+            .iter()
+            .zip(self.point.values())
+            .map(|(d, &v)| (d.name.clone(), v))
+            .collect()
+    }
+
+    /// The system with parameter `name` set to `value`.
+    ///
+    /// # Errors
+    /// [`StudyError::InvalidSpec`] for an unknown name or a value the model rejects.
+    pub fn with_parameter(&self, name: &str, value: f64) -> Result<Self, StudyError> {
+        let index = self.described.parameter_index(name).ok_or_else(|| {
+            invalid(
+                format!("system.parameters.{name}"),
+                format!(
+                    "unknown parameter; known: {}",
+                    self.described.parameter_list()
+                ),
+            )
+        })?;
+        let mut point = self.point.clone();
+        point.set(index, value);
+        Self::at(self.described.clone(), point)
+    }
+
+    /// The forcing period `2π/ω`.
+    pub fn period(&self) -> f64 {
+        std::f64::consts::TAU / self.point.value(OMEGA)
+    }
+
+    fn check_dofs<const N: usize>(&self) -> Result<(), StudyError> {
+        if N == self.dofs() {
+            Ok(())
+        } else {
+            Err(invalid(
+                "system.masses",
+                format!("{} degrees of freedom, built as {N}", self.dofs()),
+            ))
+        }
+    }
+
+    /// The model (`N` must be [`dofs`](Self::dofs)).
+    ///
+    /// # Errors
+    /// [`StudyError::InvalidSpec`] if `N` is not the number of degrees of freedom.
+    pub fn model<const N: usize>(&self) -> Result<DescribedModel<N>, StudyError> {
+        self.check_dofs::<N>()?;
+        self.described
+            .model::<N>(&self.point)
+            .map_err(|e| invalid(e.field, e.message))
+    }
+
+    /// The impact surfaces, surface `k` as [`Gap`] `k` (the penetration rises through 0 at
+    /// an impact); as events of one run: [`SurfaceEvents`](super::SurfaceEvents).
+    ///
+    /// # Errors
+    /// As [`model`](Self::model).
+    pub fn gaps<const N: usize>(&self) -> Result<Vec<Gap<f64, N>>, StudyError> {
+        self.check_dofs::<N>()?;
+        self.described
+            .gaps::<N>(&self.point)
+            .map_err(|e| invalid(e.field, e.message))
+    }
+
+    /// The rigid stop's impact law, if the surface has a restitution.
+    ///
+    /// # Errors
+    /// As [`model`](Self::model).
+    pub fn rigid_stop<const N: usize>(&self) -> Result<Option<NewtonImpact<f64, N>>, StudyError> {
+        let model = self.model::<N>()?;
+        self.described
+            .rigid::<N>(&self.point, &model)
+            .map_err(|e| invalid(e.field, e.message))
     }
 }
 

@@ -172,10 +172,14 @@ mod system;
 
 pub use attractor::{AttractorSummary, identify, regime_class};
 pub use compute::{MAX_CELLS, compute_point, run_shard};
-pub use mechanical::{ElementSpec, LoadSpec, MAX_DESCRIBED_DOFS, SpecValue, SurfaceSpec};
+pub use mechanical::{
+    DescribedElements, DescribedLoads, DescribedModel, DescribedSystem, ElementSpec, LoadSpec,
+    MAX_DESCRIBED_DOFS, SpecValue, SurfaceSpec,
+};
 pub use merge::Merged;
 pub use plan::{PlanSettings, sbatch_script};
 pub use record::PointRecord;
+pub use scalar::{MAX_SURFACES, SurfaceEvents};
 pub use shard::{
     SHARD_FORMAT, Shard, ShardManifest, check_output_dir, read_shards, shard_indices, write_shard,
 };

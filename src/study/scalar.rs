@@ -20,12 +20,13 @@ use crate::model::{Elements, Loads, Mechanical};
 use crate::sample::{Regime, Stroboscopic, detect_period};
 
 /// The most impact surfaces of one system on the scalar path (each is an event of the run).
-pub(crate) const MAX_SURFACES: usize = 4;
+pub const MAX_SURFACES: usize = 4;
 
 /// Impact surfaces as events of one run: surface `k` is event `k` (rising crossings of its
-/// penetration, no reset); unused slots never fire.
+/// penetration, no reset); unused slots never fire. At most [`MAX_SURFACES`] surfaces
+/// (the set always has that many events).
 #[derive(Debug, Clone)]
-pub(crate) struct SurfaceEvents<G>(pub Vec<G>);
+pub struct SurfaceEvents<G>(pub Vec<G>);
 
 impl<const M: usize, G: EventFunction<f64, M>> EventSet<f64, M> for SurfaceEvents<G> {
     const LEN: usize = MAX_SURFACES;

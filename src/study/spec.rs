@@ -10,7 +10,9 @@ use std::sync::Arc;
 
 use super::StudyError;
 use super::catalogue;
-use super::mechanical::{Description, ElementSpec, LoadSpec, SpecValue, SurfaceSpec};
+use super::mechanical::{
+    DescribedSystem, Description, ElementSpec, LoadSpec, SpecValue, SurfaceSpec,
+};
 use super::system::{ParameterPoint, StudySystem, is_initial_name};
 
 /// The most grid points of one study (10⁸: a 10⁴ × 10⁴ plane).
@@ -122,6 +124,28 @@ impl SystemSpec {
             loads: &self.loads,
             surfaces: &self.surfaces,
         }
+    }
+}
+
+impl DescribedSystem {
+    /// Checks the description in `system` (`model = "mechanical"`) and its parameters
+    /// (`system.parameters` must give every parameter without a default, `omega` among
+    /// them) and builds it once.
+    ///
+    /// # Errors
+    /// [`StudyError::InvalidSpec`] naming the field: another model than `"mechanical"`, an
+    /// invalid description, an unknown or missing parameter, a value a law rejects.
+    pub fn new(system: &SystemSpec) -> Result<Self, StudyError> {
+        if system.model != "mechanical" {
+            return Err(invalid(
+                "system.model",
+                format!(
+                    "{:?}: a described system has model = \"mechanical\"",
+                    system.model
+                ),
+            ));
+        }
+        Self::from_description(&system.description(), &system.parameters)
     }
 }
 

@@ -52,6 +52,11 @@ impl ParameterPoint {
         self.values.get(index).copied().unwrap_or(f64::NAN)
     }
 
+    /// Every parameter's value, in the order of the system's parameters.
+    pub fn values(&self) -> &[f64] {
+        &self.values
+    }
+
     /// The values of a system of `K` parameters, in order; all NaN for a point of another
     /// number of parameters (not a point of that system: every check then fails).
     pub fn array<const K: usize>(&self) -> [f64; K] {

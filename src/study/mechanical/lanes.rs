@@ -21,9 +21,10 @@ pub(crate) const MAX_LANE_ELEMENTS: usize = 16;
 /// The most loads a described system runs in lanes with.
 pub(crate) const MAX_LANE_LOADS: usize = 8;
 
-/// A [`Law`]'s parameters in lanes: the law's own packed form, by kind.
+/// A [`Law`]'s parameters in lanes: the law's own packed form, by kind (public only as
+/// the packed form of [`DescribedElements`](super::DescribedElements)).
 #[derive(Debug, Clone, Copy)]
-pub(crate) enum LawLanes<V: Lanes> {
+pub enum LawLanes<V: Lanes> {
     Linear(<LinearSpring<f64> as LaneLaw>::Packed<V>),
     Damper(<ViscousDamper<f64> as LaneLaw>::Packed<V>),
     Cubic(<CubicSpring<f64> as LaneLaw>::Packed<V>),
@@ -75,7 +76,7 @@ impl LaneLaw for Law {
 }
 
 /// The elements in lanes, in the description's order (the scalar sum's): the first
-/// [`MAX_LANE_ELEMENTS`] slots, `None` past the last element (elements beyond the slots
+/// `MAX_LANE_ELEMENTS` (16) slots, `None` past the last element (elements beyond the slots
 /// are not packed: a description with more runs its points one by one).
 impl<const N: usize> LaneElements<N> for DescribedElements<N> {
     type Packed<V: Lanes> = [Option<LawLanes<V>>; MAX_LANE_ELEMENTS];
@@ -115,7 +116,7 @@ impl<const N: usize> LaneElements<N> for DescribedElements<N> {
     }
 }
 
-/// The loads in lanes, as the elements ([`MAX_LANE_LOADS`] slots).
+/// The loads in lanes, as the elements (`MAX_LANE_LOADS` (8) slots).
 impl<const N: usize> LaneLoads<N> for DescribedLoads<N> {
     type Packed<V: Lanes> = [Option<<Harmonic<f64> as LaneExcitation>::Packed<V>>; MAX_LANE_LOADS];
     fn pack<V: Lanes>(&self) -> Self::Packed<V> {
