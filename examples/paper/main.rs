@@ -61,7 +61,7 @@ fn step(label: &str, t0: Instant) {
     println!("[{:>6.1} s] {label}", t0.elapsed().as_secs_f64());
 }
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
+fn main() -> nonsmooth::Result<()> {
     let a = args();
     fs::create_dir_all(&a.out)?;
     let t0 = Instant::now();
