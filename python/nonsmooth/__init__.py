@@ -505,7 +505,7 @@ def ensemble(
     if y0 is None:
         y0s = [[float(x) for x in system.rest_state]]
     else:
-        a = np.asarray(y0, dtype=np.float64)
+        a = _c.floats("y0", y0)
         if a.ndim == 1:
             y0s = [_c.vector("y0", a, n_dim)]
         elif a.ndim == 2:

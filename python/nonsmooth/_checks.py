@@ -44,12 +44,22 @@ def integer(name: str, value: Any, lo: int = 0, hi: int = 2**32 - 1) -> int:
     return v
 
 
+def floats(name: str, value: Any) -> npt.NDArray[np.float64]:
+    """The numbers of ``value`` as a float array of any shape. Text is refused, not read as
+    a number (numpy would take ``"0"`` for ``0.0``), and so are objects that are not
+    numbers."""
+    try:
+        raw = value if isinstance(value, np.ndarray) else np.asarray(value)
+    except (TypeError, ValueError) as e:
+        raise ValueError(f"{name} must hold numbers: {e}") from None
+    if raw.dtype.kind not in "biuf":
+        raise TypeError(f"{name} must hold numbers (got entries of type {raw.dtype})")
+    return raw.astype(np.float64, copy=False)
+
+
 def vector(name: str, value: Any, n: Optional[int] = None) -> list[float]:
     """A 1-D vector of finite floats (of length n if given)."""
-    try:
-        a = np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError) as e:
-        raise ValueError(f"{name} must be a vector of numbers: {e}") from None
+    a = floats(name, value)
     if a.ndim != 1:
         raise ValueError(f"{name} must be one-dimensional (got shape {a.shape})")
     if n is not None and a.shape[0] != n:
@@ -66,10 +76,7 @@ def array(name: str, value: Any, max_len: int = MAX_OUTPUT) -> npt.NDArray[np.fl
     if isinstance(value, np.ndarray) and value.size > max_len:
         # Refused before the copy: a broadcast view can stand for more memory than exists.
         raise ValueError(f"{name} has {value.size} values; at most {max_len}")
-    try:
-        a = np.ascontiguousarray(value, dtype=np.float64)
-    except (TypeError, ValueError) as e:
-        raise ValueError(f"{name} must be an array of numbers: {e}") from None
+    a = np.ascontiguousarray(floats(name, value))
     if a.ndim != 1:
         raise ValueError(f"{name} must be one-dimensional (got shape {a.shape})")
     if a.shape[0] > max_len:

@@ -304,3 +304,15 @@ def test_huge_arrays_and_counts_of_the_other_entry_points(n: int) -> None:
     raises(lambda: ns.sweep(PAPER, "omega", big))
     raises(lambda: ns.ensemble(PAPER, parameter="omega", values=big))
     raises(lambda: ns.tsallis_q(big, 0.0, 1.0, 0.1))
+
+
+def test_text_is_not_read_as_a_number() -> None:
+    # numpy reads "0" as 0.0; a state or an array given as text is refused instead (found by
+    # the property tests above, which draw short strings).
+    for y0 in (["0", 0.0], ["1e-3", "0"], [b"0", 0.0]):
+        with pytest.raises(TypeError, match="y0 must hold numbers"):
+            ns.simulate(PAPER, (0.0, 1.0), y0=y0)
+        with pytest.raises(TypeError, match="y0 must hold numbers"):
+            ns.ensemble(PAPER, y0)
+    with pytest.raises(TypeError, match="t_eval must hold numbers"):
+        ns.simulate(PAPER, (0.0, 1.0), t_eval=["0.5"])
