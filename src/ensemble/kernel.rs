@@ -73,132 +73,89 @@ pub(crate) trait Isa: Copy + Send + Sync + 'static {
     }
 }
 
-pub(crate) use baseline::Baseline;
+/// An instruction set's marker and its tail's, each in a module of its own (so that each
+/// marker's lane loops are a codegen unit of their own, see [`Isa`]): `Wide` lanes and the
+/// tail's `Narrow` ones, `vectorize` for both.
+macro_rules! isa {
+    (
+        $(#[$doc:meta])* $module:ident::$name:ident($wide:ty, $narrow:ty),
+        $(#[$tail_doc:meta])* $tail:ident,
+        |$f:ident| $vectorize:expr
+    ) => {
+        mod $module {
+            use super::*;
 
-/// The build's target features (SSE2 on a default x86-64 build).
-mod baseline {
-    use super::{F64x4, Isa};
-    use crate::lanes::F64x2;
+            $(#[$doc])*
+            #[derive(Debug, Clone, Copy)]
+            pub(crate) struct $name;
 
-    /// The build's target features: four lanes (two SSE2 registers per value), two in the
-    /// tail.
-    #[derive(Debug, Clone, Copy)]
-    pub(crate) struct Baseline;
+            impl Isa for $name {
+                type Wide = $wide;
+                type Narrow = $narrow;
+                type Tail = tail::$tail;
+                #[inline(always)]
+                fn vectorize<F: pulp::WithSimd>($f: F) -> F::Output {
+                    $vectorize
+                }
+            }
 
-    impl Isa for Baseline {
-        type Wide = F64x4;
-        type Narrow = F64x2;
-        type Tail = tail::BaselineTail;
-        #[inline(always)]
-        fn vectorize<F: pulp::WithSimd>(f: F) -> F::Output {
-            pulp::Simd::vectorize(pulp::Scalar::new(), f)
-        }
-    }
+            mod tail {
+                use super::*;
 
-    mod tail {
-        use super::{F64x2, Isa};
+                $(#[$tail_doc])*
+                #[derive(Debug, Clone, Copy)]
+                pub(crate) struct $tail;
 
-        /// The baseline's tail: two lanes.
-        #[derive(Debug, Clone, Copy)]
-        pub(crate) struct BaselineTail;
-
-        impl Isa for BaselineTail {
-            type Wide = F64x2;
-            type Narrow = F64x2;
-            type Tail = Self;
-            #[inline(always)]
-            fn vectorize<F: pulp::WithSimd>(f: F) -> F::Output {
-                super::Baseline::vectorize(f)
+                impl Isa for $tail {
+                    type Wide = $narrow;
+                    type Narrow = $narrow;
+                    type Tail = Self;
+                    #[inline(always)]
+                    fn vectorize<F: pulp::WithSimd>(f: F) -> F::Output {
+                        $name::vectorize(f)
+                    }
+                }
             }
         }
-    }
+    };
+}
+
+pub(crate) use baseline::Baseline;
+isa! {
+    /// The build's target features (SSE2 on a default x86-64 build): four lanes (two SSE2
+    /// registers per value), two in the tail.
+    baseline::Baseline(F64x4, crate::lanes::F64x2),
+    /// The baseline's tail: two lanes.
+    BaselineTail,
+    |f| pulp::Simd::vectorize(pulp::Scalar::new(), f)
 }
 
 #[cfg(all(target_arch = "x86_64", not(debug_assertions)))]
 pub(crate) use avx2::Avx2;
 #[cfg(all(target_arch = "x86_64", not(debug_assertions)))]
-pub(crate) use avx512::Avx512;
-
-/// AVX2 and FMA.
-#[cfg(all(target_arch = "x86_64", not(debug_assertions)))]
-mod avx2 {
-    use super::{F64x8, F64x16, Isa};
-
+isa! {
     /// AVX2 and FMA: sixteen lanes (four registers of four per value), eight in the tail.
-    #[derive(Debug, Clone, Copy)]
-    pub(crate) struct Avx2;
-
-    impl Isa for Avx2 {
-        type Wide = F64x16;
-        type Narrow = F64x8;
-        type Tail = tail::Avx2Tail;
-        #[inline(always)]
-        fn vectorize<F: pulp::WithSimd>(f: F) -> F::Output {
-            match pulp::x86::V3::try_new() {
-                Some(v3) => pulp::Simd::vectorize(v3, f),
-                None => pulp::Simd::vectorize(pulp::Scalar::new(), f),
-            }
-        }
-    }
-
-    mod tail {
-        use super::{F64x8, Isa};
-
-        /// AVX2's tail: eight lanes.
-        #[derive(Debug, Clone, Copy)]
-        pub(crate) struct Avx2Tail;
-
-        impl Isa for Avx2Tail {
-            type Wide = F64x8;
-            type Narrow = F64x8;
-            type Tail = Self;
-            #[inline(always)]
-            fn vectorize<F: pulp::WithSimd>(f: F) -> F::Output {
-                super::Avx2::vectorize(f)
-            }
-        }
+    avx2::Avx2(F64x16, F64x8),
+    /// AVX2's tail: eight lanes.
+    Avx2Tail,
+    |f| match pulp::x86::V3::try_new() {
+        Some(v3) => pulp::Simd::vectorize(v3, f),
+        None => pulp::Simd::vectorize(pulp::Scalar::new(), f),
     }
 }
 
-/// AVX-512F with AVX2 and FMA.
 #[cfg(all(target_arch = "x86_64", not(debug_assertions)))]
-mod avx512 {
-    use super::{F64x8, F64x16, Isa};
-
+pub(crate) use avx512::Avx512;
+#[cfg(all(target_arch = "x86_64", not(debug_assertions)))]
+isa! {
     /// AVX-512F with AVX2 and FMA: sixteen lanes (two registers of eight per value), eight
     /// in the tail.
-    #[derive(Debug, Clone, Copy)]
-    pub(crate) struct Avx512;
-
-    impl Isa for Avx512 {
-        type Wide = F64x16;
-        type Narrow = F64x8;
-        type Tail = tail::Avx512Tail;
-        #[inline(always)]
-        fn vectorize<F: pulp::WithSimd>(f: F) -> F::Output {
-            match pulp::x86::V4::try_new() {
-                Some(v4) => pulp::Simd::vectorize(v4, f),
-                None => super::Avx2::vectorize(f),
-            }
-        }
-    }
-
-    mod tail {
-        use super::{F64x8, Isa};
-
-        /// AVX-512's tail: eight lanes.
-        #[derive(Debug, Clone, Copy)]
-        pub(crate) struct Avx512Tail;
-
-        impl Isa for Avx512Tail {
-            type Wide = F64x8;
-            type Narrow = F64x8;
-            type Tail = Self;
-            #[inline(always)]
-            fn vectorize<F: pulp::WithSimd>(f: F) -> F::Output {
-                super::Avx512::vectorize(f)
-            }
-        }
+    avx512::Avx512(F64x16, F64x8),
+    /// AVX-512's tail: eight lanes.
+    Avx512Tail,
+    |f| match pulp::x86::V4::try_new() {
+        Some(v4) => pulp::Simd::vectorize(v4, f),
+        None => Avx2::vectorize(f),
     }
 }
 
