@@ -94,12 +94,7 @@ fn simulate<'py>(
     max_steps: usize,
     max_events: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
-    if !(t0.is_finite() && t_end.is_finite() && t_end > t0) {
-        return Err(value(format!(
-            "the time span must be finite with t_end > t0 (got t0 = {t0}, t_end = {t_end})"
-        ))
-        .into());
-    }
+    time_span(t0, t_end)?;
     let t_eval = t_eval.to_vec()?;
     if t_eval.len() > MAX_OUTPUT {
         return Err(value(format!(
@@ -159,12 +154,7 @@ fn impacts<'py>(
     max_steps: usize,
     capacity: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
-    if !(t0.is_finite() && t_end.is_finite() && t_end > t0) {
-        return Err(value(format!(
-            "the time span must be finite with t_end > t0 (got t0 = {t0}, t_end = {t_end})"
-        ))
-        .into());
-    }
+    time_span(t0, t_end)?;
     if !record_from.is_finite() {
         return Err(value(format!("record_from must be finite (got {record_from})")).into());
     }
@@ -613,12 +603,7 @@ fn timestep<'py>(
     max_records: usize,
     impact_speed: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
-    if !(t0.is_finite() && t_end.is_finite() && t_end > t0) {
-        return Err(value(format!(
-            "the time span must be finite with t_end > t0 (got t0 = {t0}, t_end = {t_end})"
-        ))
-        .into());
-    }
+    time_span(t0, t_end)?;
     positive("h", h)?;
     if (t_end - t0) / h > 1e10 {
         return Err(value(format!(
@@ -721,4 +706,16 @@ fn _nonsmooth(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(study_merge, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
+}
+
+/// A time span `(t0, t_end)` must be finite with `t_end > t0`.
+fn time_span(t0: f64, t_end: f64) -> PyResult<()> {
+    if t0.is_finite() && t_end.is_finite() && t_end > t0 {
+        Ok(())
+    } else {
+        Err(value(format!(
+            "the time span must be finite with t_end > t0 (got t0 = {t0}, t_end = {t_end})"
+        ))
+        .into())
+    }
 }
